@@ -1,0 +1,56 @@
+// Feature interpretation (thesis chapter 5, Figure 5.2): reference line
+// tracing, boundary and loop tracing with repair of discontinuities, and
+// labelling, chained over a one-pixel skeleton.
+//
+// Image coordinates: x right, y down. The skeleton is CV_8UC1, non-zero = line.
+#ifndef BSLS_INTERPRETATION_INTERPRETER_H_
+#define BSLS_INTERPRETATION_INTERPRETER_H_
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "bsls/interpretation/labelling.h"
+#include "bsls/interpretation/loop_trace.h"
+#include "bsls/interpretation/reference_line.h"
+#include "bsls/interpretation/repair.h"
+#include "bsls/interpretation/skeleton_graph.h"
+
+namespace bsls::interpretation {
+
+struct InterpretationParams {
+  GraphParams graph;
+  JunctionParams junction;
+  ReferenceLineParams reference;
+  RepairParams repair;
+  LabellingParams labelling;
+  int max_repair_rounds = 8;    // thesis 5.1.4.7: retrace after each correction
+  int min_component_pixels = 6; // smaller skeleton pieces are noise (thesis 4.4)
+  bool enable_repair = true;    // off: label what is there, seal nothing
+
+  // True when every part is usable; otherwise says which and why.
+  bool IsValid(std::string* error) const;
+};
+
+struct InterpretationResult {
+  bool ok = false;
+  std::string error;         // why the frame could not be labelled (ok == false)
+  cv::Mat skeleton;          // the repaired skeleton
+  ReferenceLine reference;
+  std::vector<Repair> repairs;
+  std::map<LoopClass, int> loop_classes;  // classes found before any repair
+  std::vector<LoopRecord> boundary;       // boundary networks after repair
+  Labelling labelling;
+};
+
+// Interprets a skeleton of the brick slide of `side`. A frame whose reference
+// line cannot be found comes back with ok == false and the reason; nothing is
+// guessed. Throws std::invalid_argument for an empty or non-CV_8UC1 skeleton
+// or invalid params.
+InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
+                               const pattern::PatternSpec& spec,
+                               const InterpretationParams& params = {});
+
+}  // namespace bsls::interpretation
+
+#endif  // BSLS_INTERPRETATION_INTERPRETER_H_

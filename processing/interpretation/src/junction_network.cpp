@@ -1,0 +1,121 @@
+#include "bsls/interpretation/junction_network.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace bsls::interpretation {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double LeanFromVerticalDeg(cv::Point2d d) {
+  return std::atan2(std::abs(d.x), std::abs(d.y)) * 180.0 / kPi;
+}
+
+double AngleBetweenDeg(cv::Point2d a, cv::Point2d b) {
+  const double c = a.x * b.x + a.y * b.y;  // unit vectors
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
+}
+
+}  // namespace
+
+JunctionNetwork::JunctionNetwork(const SkeletonGraph& graph, pattern::Side side,
+                                 const JunctionParams& params)
+    : graph_(graph), side_(side), roles_(graph.nodes().size()) {
+  for (int n = 0; n < static_cast<int>(graph.nodes().size()); ++n) {
+    const SkeletonNode& node = graph.nodes()[n];
+    NodeRole& role = roles_[n];
+    role.centre = node.centre;
+    const std::vector<int>& rot = node.rotation;
+    if (node.kind != NodeKind::kJunction || rot.size() < 3) {
+      // Ends and anchors: a lone branch continues the line if it is vertical.
+      for (int h : rot) {
+        const cv::Point2d d = graph.Departure(h);
+        if (LeanFromVerticalDeg(d) <= params.vertical_tolerance_deg) {
+          (d.y > 0 ? role.down : role.up) = h;
+        } else if (rot.size() == 1) {
+          role.side = h;
+        }
+      }
+      continue;
+    }
+    // Thesis 5.2.3.1 stages 4-5: the most opposite, most vertical pair of
+    // branches is the line; a single remaining, roughly horizontal branch is
+    // the segment.
+    int best_up = -1, best_down = -1;
+    double best_score = 1e9;
+    for (int a : rot) {
+      for (int b : rot) {
+        if (a == b) continue;
+        const cv::Point2d da = graph.Departure(a), db = graph.Departure(b);
+        if (!(da.y < 0 && db.y > 0)) continue;
+        const double opposite = 180.0 - AngleBetweenDeg(da, db);
+        const double lean = std::max(LeanFromVerticalDeg(da), LeanFromVerticalDeg(db));
+        if (opposite > params.opposite_tolerance_deg || lean > params.vertical_tolerance_deg)
+          continue;
+        const double score = opposite + lean;
+        if (score < best_score) {
+          best_score = score;
+          best_up = a;
+          best_down = b;
+        }
+      }
+    }
+    if (best_up < 0) {
+      role.attribute = rot.size() >= 4 ? JunctionAttribute::kCross4 : JunctionAttribute::kCross3;
+      continue;
+    }
+    role.up = best_up;
+    role.down = best_down;
+    std::vector<int> others;
+    for (int h : rot)
+      if (h != best_up && h != best_down) others.push_back(h);
+    if (others.size() != 1) {
+      role.attribute = JunctionAttribute::kCross4;
+      continue;
+    }
+    const cv::Point2d sd = graph.Departure(others[0]);
+    if (90.0 - LeanFromVerticalDeg(sd) > params.horizontal_tolerance_deg) {
+      role.attribute = JunctionAttribute::kCross3;
+      continue;
+    }
+    role.side = others[0];
+    role.attribute = AttributeForSegment(side, sd.x);
+  }
+}
+
+bool JunctionNetwork::IsPatternJunction(int node) const {
+  const auto& a = roles_[node].attribute;
+  return a.has_value() && interpretation::IsPatternJunction(*a);
+}
+
+std::optional<Step> JunctionNetwork::AlongLine(int node, bool downwards) const {
+  const int h = downwards ? roles_[node].down : roles_[node].up;
+  if (h < 0) return std::nullopt;
+  Step step;
+  step.half_edge = h;
+  step.target = graph_.Target(h);
+  const int back = SkeletonGraph::Twin(h);
+  const NodeRole& t = roles_[step.target];
+  step.consistent = downwards ? (t.up == back) : (t.down == back);
+  return step;
+}
+
+std::optional<Step> JunctionNetwork::AcrossSegment(int node) const {
+  const int h = roles_[node].side;
+  if (h < 0) return std::nullopt;
+  Step step;
+  step.half_edge = h;
+  step.target = graph_.Target(h);
+  step.consistent = roles_[step.target].side == SkeletonGraph::Twin(h);
+  return step;
+}
+
+bool JunctionNetwork::IsVertical(int half_edge) const {
+  const cv::Point2d a = graph_.nodes()[graph_.Origin(half_edge)].centre;
+  const cv::Point2d b = graph_.nodes()[graph_.Target(half_edge)].centre;
+  if (graph_.Origin(half_edge) == graph_.Target(half_edge)) return false;
+  return std::abs(b.y - a.y) > std::abs(b.x - a.x);
+}
+
+}  // namespace bsls::interpretation

@@ -1,0 +1,402 @@
+#include "bsls/interpretation/labelling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <queue>
+#include <set>
+
+namespace bsls::interpretation {
+namespace {
+
+using pattern::JunctionKind;
+
+struct Link {
+  int to = -1;
+  int dp = 0;
+  int dv = 0;
+  double weight = 1.0;
+  int first_half_edge = -1;  // for vertical links: the first step taken
+  bool vertical = false;
+};
+
+struct Label {
+  int p = 0;
+  int v = 0;
+  bool operator==(const Label& o) const { return p == o.p && v == o.v; }
+};
+
+constexpr double kTrusted = 0.1;   // weight of a link inside a complete loop
+constexpr double kPlain = 1.0;     // weight of any other single-row link
+constexpr int kNoLabel = std::numeric_limits<int>::min();
+
+JunctionKind KindOf(const JunctionNetwork& net, int node) {
+  return *net.role(node).attribute == JunctionAttribute::kDirect ? JunctionKind::kDirect
+                                                                 : JunctionKind::kCorresponding;
+}
+
+// The kind a junction at (p, v) must have; v is relative but keeps its parity.
+bool KindFits(const pattern::PatternSpec& spec, int p, int v, JunctionKind kind) {
+  if (p < 0 || p >= spec.lines) return false;
+  const bool direct_row = ((v - p) % 2) == 0;
+  if (kind == JunctionKind::kDirect) return direct_row && p + 1 < spec.lines;
+  return !direct_row && p >= 1;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+struct VerticalLink {
+  int a = -1, b = -1;  // a above b
+  int first = -1;      // half-edge leaving a downwards
+  double dy = 0;
+  bool alternating = false;
+  bool trusted = true;
+  cv::Point2d mid;
+};
+
+// Walks down the line from a pattern junction, through crossing points, to
+// the next pattern junction.
+bool WalkDown(const JunctionNetwork& net, const std::vector<char>& trusted_edge, int from,
+              VerticalLink* link) {
+  const SkeletonGraph& g = net.graph();
+  int cur = from;
+  link->a = from;
+  link->trusted = true;
+  for (int guard = 0; guard < 64; ++guard) {
+    const auto step = net.AlongLine(cur, true);
+    if (!step || !step->consistent) return false;
+    if (link->first < 0) link->first = step->half_edge;
+    link->trusted = link->trusted && trusted_edge[step->half_edge];
+    const int t = step->target;
+    if (net.IsPatternJunction(t)) {
+      link->b = t;
+      const cv::Point2d ca = net.role(from).centre, cb = net.role(t).centre;
+      link->dy = cb.y - ca.y;
+      link->alternating = KindOf(net, from) != KindOf(net, t);
+      link->mid = (ca + cb) * 0.5;
+      return link->dy > 0;
+    }
+    if (g.nodes()[t].kind != NodeKind::kJunction) return false;  // an end
+    cur = t;  // a crossing point: the line goes straight on
+  }
+  return false;
+}
+
+// Pixels of a line walked from a node up or down until it stops.
+std::vector<cv::Point> WalkPixels(const JunctionNetwork& net, int from, bool downwards,
+                                  std::set<int>* visited_nodes) {
+  const SkeletonGraph& g = net.graph();
+  std::vector<cv::Point> out;
+  int cur = from;
+  for (int guard = 0; guard < 10000; ++guard) {
+    const auto step = net.AlongLine(cur, downwards);
+    if (!step) break;
+    for (const cv::Point& p : g.Pixels(step->half_edge)) out.push_back(p);
+    const int t = step->target;
+    const cv::Point2d c = net.role(t).centre;
+    out.push_back({cvRound(c.x), cvRound(c.y)});
+    if (!step->consistent || !visited_nodes->insert(t).second) break;
+    if (g.nodes()[t].kind == NodeKind::kEnd) break;
+    cur = t;
+  }
+  return out;
+}
+
+}  // namespace
+
+bool LabellingParams::IsValid(std::string* error) const {
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (max_interpolated_run < 0 || max_interpolated_run > 10)
+    return fail("max_interpolated_run must lie in 0..10");
+  if (max_inner_fraction < 0 || max_inner_fraction > 1)
+    return fail("max_inner_fraction must lie in [0, 1]");
+  if (min_reference_junctions < 1) return fail("min_reference_junctions must be at least 1");
+  if (spacing_radius <= 0) return fail("spacing_radius must be positive");
+  return true;
+}
+
+// Thesis 5.1.4.9: labelling.
+bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loops,
+                  const ReferenceLine& reference, const pattern::PatternSpec& spec,
+                  const LabellingParams& params, Labelling* out, std::string* why) {
+  std::string invalid;
+  if (!params.IsValid(&invalid)) throw std::invalid_argument("LabelNetwork: " + invalid);
+  const SkeletonGraph& g = net.graph();
+  const int n_nodes = static_cast<int>(g.nodes().size());
+  *out = Labelling{};
+
+  // Links inside complete loops are trusted (thesis: a complete loop has its
+  // six junctions in the right order).
+  std::vector<char> trusted(g.HalfEdgeCount(), 0);
+  for (const LoopRecord& loop : loops)
+    if (loop.cls == LoopClass::kComplete)
+      for (int h : loop.walk) trusted[h] = trusted[SkeletonGraph::Twin(h)] = 1;
+
+  // Lines: consecutive pattern junctions along each line.
+  std::vector<VerticalLink> vlinks;
+  for (int n = 0; n < n_nodes; ++n) {
+    if (!net.IsPatternJunction(n)) continue;
+    VerticalLink link;
+    if (WalkDown(net, trusted, n, &link)) vlinks.push_back(link);
+  }
+  // Row spacing samples: alternating steps are one row, equal kinds two.
+  std::vector<double> all_spacing;
+  std::vector<std::pair<cv::Point2d, double>> spacing_samples;
+  for (const VerticalLink& l : vlinks) {
+    const double s = l.alternating ? l.dy : l.dy / 2.0;
+    spacing_samples.push_back({l.mid, s});
+    all_spacing.push_back(s);
+  }
+  const double global_spacing = Median(all_spacing);
+  auto local_spacing = [&](cv::Point2d at) {
+    std::vector<double> near;
+    const double r2 = params.spacing_radius * params.spacing_radius;
+    for (const auto& [pos, s] : spacing_samples) {
+      const cv::Point2d d = pos - at;
+      if (d.x * d.x + d.y * d.y <= r2) near.push_back(s);
+    }
+    return near.size() >= 3 ? Median(near) : global_spacing;
+  };
+
+  std::vector<std::vector<Link>> adj(n_nodes);
+  for (const VerticalLink& l : vlinks) {
+    const double s = local_spacing(l.mid);
+    int best_rows = l.alternating ? 1 : 2;
+    double best_miss = 1e9;
+    for (int rows = l.alternating ? 1 : 2; rows <= 8; rows += 2) {
+      const double miss = std::abs(l.dy - rows * s);
+      if (miss < best_miss) {
+        best_miss = miss;
+        best_rows = rows;
+      }
+    }
+    const bool normal_step = best_rows <= 2;
+    const double w = l.trusted ? kTrusted : (normal_step ? kPlain : 2.0 + best_rows);
+    adj[l.a].push_back({l.b, 0, best_rows, w, l.first, true});
+    adj[l.b].push_back({l.a, 0, -best_rows, w, -1, true});
+  }
+  // Segments: a direct junction's segment ends on the next line's corresponding junction.
+  for (int n = 0; n < n_nodes; ++n) {
+    if (!net.IsPatternJunction(n) || KindOf(net, n) != JunctionKind::kDirect) continue;
+    const auto step = net.AcrossSegment(n);
+    if (!step || !step->consistent || !net.IsPatternJunction(step->target)) continue;
+    if (KindOf(net, step->target) != JunctionKind::kCorresponding) continue;
+    const double w = trusted[step->half_edge] ? kTrusted : kPlain;
+    adj[n].push_back({step->target, +1, 0, w, step->half_edge, false});
+    adj[step->target].push_back({n, -1, 0, w, -1, false});
+  }
+
+  // Seeds: the junctions of line 0 in order along it.
+  std::vector<int> seeds;
+  std::set<int> seen;
+  int inner = 0;
+  for (const cv::Point& px : reference.pixels) {
+    const int n = g.NodeAt(px);
+    if (n < 0 || !seen.insert(n).second || g.nodes()[n].kind != NodeKind::kJunction) continue;
+    if (!net.IsPatternJunction(n)) continue;
+    if (KindOf(net, n) == JunctionKind::kDirect) seeds.push_back(n);
+    else ++inner;
+  }
+  out->reference_junctions = static_cast<int>(seeds.size());
+  if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
+    if (why) *why = "line 0 carries " + std::to_string(seeds.size()) + " junctions";
+    return false;
+  }
+  if (inner > params.max_inner_fraction * (inner + static_cast<double>(seeds.size()))) {
+    if (why)
+      *why = "the traced line has " + std::to_string(inner) +
+             " segments on its inner side, so it is not line 0";
+    return false;
+  }
+  std::sort(seeds.begin(), seeds.end(),
+            [&](int a, int b) { return net.role(a).centre.y < net.role(b).centre.y; });
+  std::vector<double> seed_gaps;
+  for (size_t i = 1; i < seeds.size(); ++i)
+    seed_gaps.push_back(net.role(seeds[i]).centre.y - net.role(seeds[i - 1]).centre.y);
+  const double seed_spacing = Median(seed_gaps);
+  std::vector<int> seed_v{0};
+  for (size_t i = 1; i < seeds.size(); ++i) {
+    const double local = std::max(1.0, local_spacing(net.role(seeds[i]).centre) * 2.0);
+    const double s = seed_spacing > 0 ? 0.5 * (local + seed_spacing) : local;
+    const int steps = std::max(1, static_cast<int>(std::lround(seed_gaps[i - 1] / s)));
+    seed_v.push_back(seed_v.back() + 2 * steps);
+  }
+
+  // Propagation, most trusted links first (a Dijkstra order over link weights).
+  std::vector<Label> label(n_nodes, {kNoLabel, kNoLabel});
+  std::vector<double> cost(n_nodes, std::numeric_limits<double>::infinity());
+  using Item = std::tuple<double, int, int, int>;  // cost, node, p, v
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    cost[seeds[i]] = 0;
+    queue.push({0.0, seeds[i], 0, seed_v[i]});
+  }
+  std::vector<char> done(n_nodes, 0);
+  while (!queue.empty()) {
+    const auto [c, n, p, v] = queue.top();
+    queue.pop();
+    if (done[n]) continue;
+    done[n] = 1;
+    label[n] = {p, v};
+    for (const Link& l : adj[n]) {
+      if (done[l.to]) continue;
+      const int np = p + l.dp, nv = v + l.dv;
+      if (!KindFits(spec, np, nv, KindOf(net, l.to))) continue;
+      const double nc = c + l.weight;
+      if (nc < cost[l.to]) {
+        cost[l.to] = nc;
+        queue.push({nc, l.to, np, nv});
+      }
+    }
+  }
+
+  // A label most of whose neighbours disagree is dropped, not guessed.
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int> drop;
+    for (int n = 0; n < n_nodes; ++n) {
+      if (label[n].p == kNoLabel) continue;
+      int agree = 0, disagree = 0;
+      for (const Link& l : adj[n]) {
+        if (label[l.to].p == kNoLabel) continue;
+        const Label expect{label[n].p + l.dp, label[n].v + l.dv};
+        (expect == label[l.to] ? agree : disagree)++;
+      }
+      if (disagree >= 2 && disagree > agree) drop.push_back(n);
+    }
+    for (int n : drop) label[n] = {kNoLabel, kNoLabel};
+    out->conflicts += static_cast<int>(drop.size());
+  }
+
+  // Thesis point O: line 0's junction nearest the centre row is v = 0.
+  const double centre_row = (g.size().height - 1) / 2.0;
+  int origin_v = 0;
+  double best = 1e18;
+  for (int s : seeds) {
+    if (label[s].p != 0) continue;
+    const double d = std::abs(net.role(s).centre.y - centre_row);
+    if (d < best) {
+      best = d;
+      origin_v = label[s].v;
+    }
+  }
+  std::map<std::pair<int, int>, size_t> by_label;
+  for (int n = 0; n < n_nodes; ++n) {
+    if (label[n].p == kNoLabel) continue;
+    LabelledJunction j;
+    j.node = n;
+    j.position = net.role(n).centre;
+    j.p = label[n].p;
+    j.v = label[n].v - origin_v;
+    j.kind = KindOf(net, n);
+    const auto key = std::make_pair(j.p, j.v);
+    if (by_label.count(key)) {
+      // Two junctions claim one label: keep neither.
+      out->junctions[by_label[key]].node = -2;
+      ++out->conflicts;
+      continue;
+    }
+    by_label[key] = out->junctions.size();
+    out->junctions.push_back(j);
+  }
+  std::erase_if(out->junctions, [](const LabelledJunction& j) { return j.node == -2; });
+  by_label.clear();
+  for (size_t i = 0; i < out->junctions.size(); ++i)
+    by_label[{out->junctions[i].p, out->junctions[i].v}] = i;
+
+  // Thesis 5.1.4.6-5.1.4.7: junctions missing on a continuous line between two
+  // labelled ones are placed on the line at the row of their relative junction.
+  if (params.interpolate_missing) {
+    std::vector<LabelledJunction> added;
+    for (const VerticalLink& l : vlinks) {
+      if (label[l.a].p == kNoLabel || label[l.b].p == kNoLabel) continue;
+      const int p = label[l.a].p;
+      if (label[l.b].p != p) continue;
+      const int va = label[l.a].v - origin_v, vb = label[l.b].v - origin_v;
+      const int step = (p == 0 || p == spec.lines - 1) ? 2 : 1;
+      const int missing = (vb - va) / step - 1;
+      if (missing <= 0 || missing > params.max_interpolated_run) continue;
+      // The line's pixels between the two junctions.
+      std::vector<cv::Point> chain;
+      int cur = l.a;
+      for (int guard = 0; guard < 64 && cur != l.b; ++guard) {
+        const auto s = net.AlongLine(cur, true);
+        if (!s) break;
+        for (const cv::Point& px : g.Pixels(s->half_edge)) chain.push_back(px);
+        cur = s->target;
+      }
+      if (chain.empty()) continue;
+      const cv::Point2d pa = net.role(l.a).centre, pb = net.role(l.b).centre;
+      for (int v = va + step; v < vb; v += step) {
+        const JunctionKind kind =
+            ((v - p) % 2 == 0) ? JunctionKind::kDirect : JunctionKind::kCorresponding;
+        if (!KindFits(spec, p, v, kind) || by_label.count({p, v})) continue;
+        // The segment's other line must be there: a labelled junction on it
+        // within two rows.
+        const int partner_p = kind == JunctionKind::kDirect ? p + 1 : p - 1;
+        bool partner_line = false;
+        for (int dv = -2; dv <= 2; ++dv) partner_line |= by_label.count({partner_p, v + dv}) > 0;
+        if (!partner_line) continue;
+        double target_y = pa.y + (pb.y - pa.y) * (v - va) / static_cast<double>(vb - va);
+        const auto partner = by_label.find({partner_p, v});
+        if (partner != by_label.end()) target_y = out->junctions[partner->second].position.y;
+        const auto nearest = std::min_element(chain.begin(), chain.end(), [&](auto a, auto b) {
+          return std::abs(a.y - target_y) < std::abs(b.y - target_y);
+        });
+        LabelledJunction j;
+        j.position = cv::Point2d(nearest->x, nearest->y);
+        j.p = p;
+        j.v = v;
+        j.kind = kind;
+        j.interpolated = true;
+        added.push_back(j);
+      }
+    }
+    for (const LabelledJunction& j : added) {
+      if (by_label.count({j.p, j.v})) continue;
+      by_label[{j.p, j.v}] = out->junctions.size();
+      out->junctions.push_back(j);
+    }
+  }
+  std::sort(out->junctions.begin(), out->junctions.end(), [](const auto& a, const auto& b) {
+    return a.p != b.p ? a.p < b.p : a.v < b.v;
+  });
+
+  // Lines: walk each labelled line up and down from its junctions.
+  std::map<int, std::vector<int>> nodes_of_line;
+  for (const LabelledJunction& j : out->junctions)
+    if (j.node >= 0) nodes_of_line[j.p].push_back(j.node);
+  for (auto& [p, nodes] : nodes_of_line) {
+    std::sort(nodes.begin(), nodes.end(),
+              [&](int a, int b) { return net.role(a).centre.y < net.role(b).centre.y; });
+    std::set<int> visited;
+    std::vector<std::vector<cv::Point>> runs;
+    for (int n : nodes) {
+      if (visited.count(n)) continue;
+      visited.insert(n);
+      std::vector<cv::Point> up = WalkPixels(net, n, false, &visited);
+      std::vector<cv::Point> run(up.rbegin(), up.rend());
+      const cv::Point2d c = net.role(n).centre;
+      run.push_back({cvRound(c.x), cvRound(c.y)});
+      std::vector<cv::Point> down = WalkPixels(net, n, true, &visited);
+      run.insert(run.end(), down.begin(), down.end());
+      runs.push_back(std::move(run));
+    }
+    std::sort(runs.begin(), runs.end(),
+              [](const auto& a, const auto& b) { return a.front().y < b.front().y; });
+    LabelledLine line;
+    line.p = p;
+    for (const auto& run : runs) line.pixels.insert(line.pixels.end(), run.begin(), run.end());
+    out->lines.push_back(std::move(line));
+  }
+  return true;
+}
+
+}  // namespace bsls::interpretation

@@ -1,0 +1,44 @@
+// Test fixture: scores decoded junction labels against ground truth.
+//
+// Positions are image pixels. q of the decoder is relative (one even offset
+// per image, contracts section 2): the offset is taken from the majority of
+// matched junctions and every junction off that offset counts as wrong.
+#ifndef BSLS_TESTING_LABEL_EVALUATION_H_
+#define BSLS_TESTING_LABEL_EVALUATION_H_
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace bsls::testing {
+
+struct PointLabel {
+  int p = 0;
+  int v = 0;
+  cv::Point2d position;
+};
+
+struct LabelScore {
+  int truth = 0;        // truth junctions considered
+  int found = 0;        // truth junctions with a decoded junction within reach
+  int wrong_p = 0;      // found, but p differs
+  int wrong_v = 0;      // found, p right, v off the image's common offset
+  int unmatched = 0;    // decoded junctions with no truth within reach
+  int v_offset = 0;     // decoded v - true v of the majority
+  double position_rms = 0.0;  // px, over found junctions with the right label
+
+  double Recall() const { return truth ? static_cast<double>(found) / truth : 0.0; }
+  int Wrong() const { return wrong_p + wrong_v; }
+  // One line for test failure messages.
+  std::string Summary() const;
+};
+
+// Matches each truth junction to the nearest decoded one within `reach` px
+// (each decoded junction used once) and scores the labels.
+LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
+                       const std::vector<PointLabel>& decoded, double reach);
+
+}  // namespace bsls::testing
+
+#endif  // BSLS_TESTING_LABEL_EVALUATION_H_

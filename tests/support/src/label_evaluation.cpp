@@ -1,0 +1,68 @@
+#include "bsls/testing/label_evaluation.h"
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace bsls::testing {
+
+std::string LabelScore::Summary() const {
+  std::ostringstream s;
+  s << "truth " << truth << ", found " << found << " (" << 100.0 * Recall() << "%), wrong p "
+    << wrong_p << ", wrong v " << wrong_v << ", unmatched " << unmatched << ", v offset "
+    << v_offset << ", position rms " << position_rms << " px";
+  return s.str();
+}
+
+LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
+                       const std::vector<PointLabel>& decoded, double reach) {
+  LabelScore score;
+  score.truth = static_cast<int>(truth.size());
+  std::vector<int> match(truth.size(), -1);
+  std::vector<char> used(decoded.size(), 0);
+  // Greedy by distance: all pairs within reach, nearest first.
+  std::vector<std::tuple<double, int, int>> pairs;
+  for (size_t t = 0; t < truth.size(); ++t)
+    for (size_t d = 0; d < decoded.size(); ++d) {
+      const double dist = std::hypot(truth[t].position.x - decoded[d].position.x,
+                                     truth[t].position.y - decoded[d].position.y);
+      if (dist <= reach) pairs.emplace_back(dist, static_cast<int>(t), static_cast<int>(d));
+    }
+  std::sort(pairs.begin(), pairs.end());
+  for (const auto& [dist, t, d] : pairs) {
+    if (match[t] >= 0 || used[d]) continue;
+    match[t] = d;
+    used[d] = 1;
+  }
+  std::map<int, int> offsets;
+  for (size_t t = 0; t < truth.size(); ++t)
+    if (match[t] >= 0 && decoded[match[t]].p == truth[t].p)
+      ++offsets[decoded[match[t]].v - truth[t].v];
+  int best = 0;
+  for (const auto& [off, n] : offsets)
+    if (n > best) {
+      best = n;
+      score.v_offset = off;
+    }
+  double sum2 = 0;
+  int n2 = 0;
+  for (size_t t = 0; t < truth.size(); ++t) {
+    if (match[t] < 0) continue;
+    ++score.found;
+    const PointLabel& d = decoded[match[t]];
+    if (d.p != truth[t].p) {
+      ++score.wrong_p;
+    } else if (d.v - truth[t].v != score.v_offset) {
+      ++score.wrong_v;
+    } else {
+      sum2 += std::pow(d.position.x - truth[t].position.x, 2) +
+              std::pow(d.position.y - truth[t].position.y, 2);
+      ++n2;
+    }
+  }
+  for (size_t d = 0; d < decoded.size(); ++d) score.unmatched += !used[d];
+  score.position_rms = n2 ? std::sqrt(sum2 / n2) : 0.0;
+  return score;
+}
+
+}  // namespace bsls::testing
