@@ -2,6 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cstdlib>
+
 #include "bsls/testing/label_evaluation.h"
 #include "bsls/testing/synthetic_brick.h"
 
@@ -74,6 +79,139 @@ TEST(Interpreter, LineOneMistakenForLineZeroIsRejected) {
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.error.find("not line 0"), std::string::npos) << r.error;
 }
+
+}  // namespace
+}  // namespace bsls::interpretation
+
+// ---------------------------------------------------------------------------
+// Thesis Table 5.5 and section 5.1.4.8: one test per class of discontinuity
+// and per overlap case, each cut into a clean brick skeleton; the repair must
+// bring back every junction with its right label.
+
+namespace bsls::interpretation {
+namespace {
+
+struct DefectCase {
+  const char* name;
+  void (*cut)(SyntheticBrick&);
+  LoopClass expected_class;
+};
+
+void OneLineBreak(SyntheticBrick& b) { testing::EraseLineBetween(b, 3, 0.3, 0.7); }
+void OneSegmentBreak(SyntheticBrick& b) { testing::EraseSegmentMiddle(b, 3, 3, 0.35); }
+void DoubleBreak(SyntheticBrick& b) {
+  // Figure 5.34 (a): line 4 broken above and below junction (4, 2).
+  testing::EraseLineBetween(b, 4, 1.3, 1.7);
+  testing::EraseLineBetween(b, 4, 2.3, 2.7);
+}
+void MissingCorrespondingJunction(SyntheticBrick& b) {
+  // Figure 5.35 (a): (5, 2) is corresponding; its segment comes from line 4.
+  testing::EraseDisk(b.skeleton, b.Map(5, 2), 4.0);
+}
+void MissingDirectJunction(SyntheticBrick& b) {
+  // Figure 5.35 (b): (5, 1) is direct; its segment goes to line 6.
+  testing::EraseDisk(b.skeleton, b.Map(5, 1), 4.0);
+}
+void TwoMissingJunctions(SyntheticBrick& b) {
+  // Figure 5.36: the segment (5, 1)-(6, 1) with both its junctions gone.
+  testing::EraseDisk(b.skeleton, b.Map(5, 1), 4.0);
+  testing::EraseDisk(b.skeleton, b.Map(6, 1), 4.0);
+  testing::EraseSegmentMiddle(b, 5, 1, 1.0);
+}
+void LargeArea(SyntheticBrick& b) {
+  // Figure 5.38: a hole over several lines and rows.
+  const cv::Point2d c = b.Map(7.5, 2.5);
+  b.skeleton(cv::Rect(cvRound(c.x) - 16, cvRound(c.y) - 16, 32, 32)).setTo(0);
+}
+
+constexpr DefectCase kDefects[] = {
+    {"one_line_break", OneLineBreak, LoopClass::kOneDiscontinuity},
+    {"one_segment_break", OneSegmentBreak, LoopClass::kOneDiscontinuity},
+    {"double_break", DoubleBreak, LoopClass::kDoubleDiscontinuity},
+    {"missing_corresponding_junction", MissingCorrespondingJunction, LoopClass::kMissingJunction},
+    {"missing_direct_junction", MissingDirectJunction, LoopClass::kMissingJunction},
+    {"two_missing_junctions", TwoMissingJunctions, LoopClass::kTwoMissingJunctions},
+    {"large_area", LargeArea, LoopClass::kLargeArea},
+};
+
+class Table55 : public ::testing::TestWithParam<DefectCase> {};
+
+TEST_P(Table55, RepairRestoresEveryJunctionWithItsLabel) {
+  const DefectCase& c = GetParam();
+  SyntheticBrickParams params;
+  SyntheticBrick b = DrawSyntheticBrick(params);
+  c.cut(b);
+  InterpretationResult r;
+  const auto score = InterpretAndScore(b, &r);
+  std::string classes;
+  for (const auto& [cls, n] : r.loop_classes) classes += std::string(ToString(cls)) + "=" + std::to_string(n) + " ";
+  EXPECT_GE(r.loop_classes[c.expected_class], 1) << c.name << ": " << classes;
+  EXPECT_FALSE(r.repairs.empty()) << c.name;
+  EXPECT_EQ(score.found, score.truth) << c.name << ": " << score.Summary();
+  EXPECT_EQ(score.Wrong(), 0) << c.name << ": " << score.Summary();
+}
+
+INSTANTIATE_TEST_SUITE_P(Classes, Table55, ::testing::ValuesIn(kDefects),
+                         [](const auto& test_info) { return std::string(test_info.param.name); });
+
+// Overlaps happen where lines crowd together (thesis: the side of the nose),
+// so these cases use a brick with lines 8 px apart and rows 20 px apart.
+SyntheticBrickParams Crowded() {
+  SyntheticBrickParams params;
+  params.line_pitch = 8.0;
+  params.row_spacing = 20.0;
+  params.first_row = -10;
+  params.last_row = 10;
+  params.visible_lines = 20;
+  return params;
+}
+
+void DrawPolyline(cv::Mat& sk, const std::vector<cv::Point2d>& pts) {
+  for (size_t i = 1; i < pts.size(); ++i)
+    cv::line(sk, cv::Point(cvRound(pts[i - 1].x), cvRound(pts[i - 1].y)),
+             cv::Point(cvRound(pts[i].x), cvRound(pts[i].y)), 255, 1, cv::LINE_8);
+}
+
+void OverlapCrossing(SyntheticBrick& b) {
+  // Figure 5.39 (a): the lower part of broken line 7 runs up across line 8,
+  // making a crossing point of four lines (a_t = 4) and an end beyond it.
+  testing::EraseLineBetween(b, 7, 0.25, 0.75);
+  DrawPolyline(b.skeleton, {b.Map(7, 0.75), b.Map(8.6, 0.45)});
+}
+void OverlapTouching(SyntheticBrick& b) {
+  // Figure 5.39 (b): line 7 bows over and touches line 8 between two rows;
+  // the touching point is a crossing of three lines (a_t = 3), not a junction.
+  testing::EraseLineBetween(b, 7, 0.2, 0.8);
+  DrawPolyline(b.skeleton, {b.Map(7, 0.2), b.Map(8, 0.5), b.Map(7, 0.8)});
+}
+
+constexpr DefectCase kOverlaps[] = {
+    {"overlap_crossing", OverlapCrossing, LoopClass::kOverlap},
+    {"overlap_touching", OverlapTouching, LoopClass::kOverlap},
+};
+
+class Overlap : public ::testing::TestWithParam<DefectCase> {};
+
+TEST_P(Overlap, LinesCrossingKeepEveryJunctionLabel) {
+  const DefectCase& c = GetParam();
+  SyntheticBrick b = DrawSyntheticBrick(Crowded());
+  c.cut(b);
+  InterpretationResult r;
+  const auto score = InterpretAndScore(b, &r);
+  if (const char* dir = std::getenv("BSLS_DEBUG_DIR")) {
+    cv::imwrite(std::string(dir) + "/" + c.name + "_in.png", b.skeleton);
+    cv::imwrite(std::string(dir) + "/" + c.name + "_out.png", r.skeleton);
+  }
+  int overlaps = 0;
+  for (const auto& [cls, n] : r.loop_classes)
+    if (cls == LoopClass::kOverlap || cls == LoopClass::kIncomplete) overlaps += n;
+  EXPECT_GE(overlaps, 1) << c.name;
+  EXPECT_EQ(score.found, score.truth) << c.name << ": " << score.Summary();
+  EXPECT_EQ(score.Wrong(), 0) << c.name << ": " << score.Summary();
+}
+
+INSTANTIATE_TEST_SUITE_P(Cases, Overlap, ::testing::ValuesIn(kOverlaps),
+                         [](const auto& test_info) { return std::string(test_info.param.name); });
 
 }  // namespace
 }  // namespace bsls::interpretation

@@ -178,6 +178,9 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
         best_rows = rows;
       }
     }
+    // A step that fits no whole number of rows of its parity joins a false
+    // junction (e.g. where two lines overlap, thesis 5.1.4.8): no link.
+    if (best_miss > 0.35 * s) continue;
     const bool normal_step = best_rows <= 2;
     const double w = l.trusted ? kTrusted : (normal_step ? kPlain : 2.0 + best_rows);
     adj[l.a].push_back({l.b, 0, best_rows, w, l.first, true});
@@ -287,6 +290,15 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
       origin_v = label[s].v;
     }
   }
+  // Support of a label: links to labelled neighbours that agree with it.
+  auto support = [&](int n) {
+    int agree = 0;
+    for (const Link& l : adj[n])
+      if (label[l.to].p != kNoLabel &&
+          label[l.to] == Label{label[n].p + l.dp, label[n].v + l.dv})
+        ++agree;
+    return agree;
+  };
   std::map<std::pair<int, int>, size_t> by_label;
   for (int n = 0; n < n_nodes; ++n) {
     if (label[n].p == kNoLabel) continue;
@@ -297,19 +309,18 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     j.v = label[n].v - origin_v;
     j.kind = KindOf(net, n);
     const auto key = std::make_pair(j.p, j.v);
-    if (by_label.count(key)) {
-      // Two junctions claim one label: keep neither.
-      out->junctions[by_label[key]].node = -2;
+    const auto clash = by_label.find(key);
+    if (clash != by_label.end()) {
+      // Two junctions claim one label: the better supported one keeps it.
+      LabelledJunction& other = out->junctions[clash->second];
+      const int mine = support(n), theirs = support(other.node);
       ++out->conflicts;
+      if (mine > theirs || (mine == theirs && cost[n] < cost[other.node])) other = j;
       continue;
     }
     by_label[key] = out->junctions.size();
     out->junctions.push_back(j);
   }
-  std::erase_if(out->junctions, [](const LabelledJunction& j) { return j.node == -2; });
-  by_label.clear();
-  for (size_t i = 0; i < out->junctions.size(); ++i)
-    by_label[{out->junctions[i].p, out->junctions[i].v}] = i;
 
   // Thesis 5.1.4.6-5.1.4.7: junctions missing on a continuous line between two
   // labelled ones are placed on the line at the row of their relative junction.

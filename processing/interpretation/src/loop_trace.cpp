@@ -96,22 +96,26 @@ LoopClass ClassifyLoop(LoopRecord& r) {
     if ((brick6 || brick5) && r.repeated == 0) return r.cls = LoopClass::kComplete;
     return r.cls = (breaks > 1 ? LoopClass::kOverlap : LoopClass::kIncomplete);
   }
-  int vertical = 0, horizontal = 0;
-  for (const LoopEvent& e : r.events) {
-    if (!e.is_end) continue;
-    if (e.end == EndDirection::kTop || e.end == EndDirection::kBottom) ++vertical;
-    else ++horizontal;
-  }
+  int horizontal = 0;
+  for (const LoopEvent& e : r.events)
+    if (e.is_end && (e.end == EndDirection::kLeft || e.end == EndDirection::kRight)) ++horizontal;
   switch (r.n_e) {
     case 1: return r.cls = LoopClass::kIncomplete;
     case 2: return r.cls = LoopClass::kOneDiscontinuity;
     case 3: return r.cls = LoopClass::kMissingJunction;
-    case 4:
-      return r.cls = (horizontal == 0 && r.repeated < 4) ? LoopClass::kTwoMissingJunctions
-                                                         : LoopClass::kDoubleDiscontinuity;
+    case 4: {
+      // Figure 5.34: a double break cuts a junction loose, so the walk passes
+      // it three times; two missing junctions (Figure 5.36) leave two line
+      // gaps and no such junction.
+      std::map<int, int> visits;
+      int most = 0;
+      for (const LoopEvent& e : r.events)
+        if (!e.is_end) most = std::max(most, ++visits[e.node]);
+      return r.cls = (horizontal == 0 && most < 3) ? LoopClass::kTwoMissingJunctions
+                                                    : LoopClass::kDoubleDiscontinuity;
+    }
     default: return r.cls = LoopClass::kLargeArea;
   }
-  (void)vertical;
 }
 
 std::vector<LoopRecord> TraceLoops(const JunctionNetwork& network) {

@@ -101,6 +101,7 @@ bool RepairParams::IsValid(std::string* error) const {
     return fail("repair distances must be positive");
   if (miss_fraction < 0 || miss_constant < 0) return fail("miss tolerances must not be negative");
   if (direction_probe < 1) return fail("direction_probe must be at least 1 pixel");
+  if (min_junction_distance < 0) return fail("min_junction_distance must not be negative");
   return true;
 }
 
@@ -198,6 +199,11 @@ std::vector<Repair> RepairRound(const JunctionNetwork& network,
       cv::Point hit;
       const double reach = segments ? params.max_segment_reach : params.max_line_reach;
       if (!Reach(skeleton, g, e, reach, &hit)) continue;
+      bool crowded = false;
+      for (const SkeletonNode& n : g.nodes())
+        crowded |= n.kind == NodeKind::kJunction &&
+                   std::hypot(n.centre.x - hit.x, n.centre.y - hit.y) < params.min_junction_distance;
+      if (crowded) continue;
       FillGap(skeleton, e.pixel, hit);
       used[i] = 1;
       done.push_back({segments ? RepairKind::kSegmentReach : RepairKind::kLineReach, e.pixel, hit,

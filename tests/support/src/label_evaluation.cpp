@@ -11,6 +11,15 @@ std::string LabelScore::Summary() const {
   s << "truth " << truth << ", found " << found << " (" << 100.0 * Recall() << "%), wrong p "
     << wrong_p << ", wrong v " << wrong_v << ", unmatched " << unmatched << ", v offset "
     << v_offset << ", position rms " << position_rms << " px";
+  auto list = [&s](const char* what, const std::vector<PointLabel>& v) {
+    if (v.empty()) return;
+    s << "; " << what << ":";
+    for (size_t i = 0; i < v.size() && i < 12; ++i)
+      s << " (" << v[i].p << "," << v[i].v << ")@" << cvRound(v[i].position.x) << ","
+        << cvRound(v[i].position.y);
+  };
+  list("missed", missed);
+  list("wrong", wrong);
   return s.str();
 }
 
@@ -47,13 +56,18 @@ LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
   double sum2 = 0;
   int n2 = 0;
   for (size_t t = 0; t < truth.size(); ++t) {
-    if (match[t] < 0) continue;
+    if (match[t] < 0) {
+      score.missed.push_back(truth[t]);
+      continue;
+    }
     ++score.found;
     const PointLabel& d = decoded[match[t]];
     if (d.p != truth[t].p) {
       ++score.wrong_p;
+      score.wrong.push_back(truth[t]);
     } else if (d.v - truth[t].v != score.v_offset) {
       ++score.wrong_v;
+      score.wrong.push_back(truth[t]);
     } else {
       sum2 += std::pow(d.position.x - truth[t].position.x, 2) +
               std::pow(d.position.y - truth[t].position.y, 2);

@@ -27,6 +27,9 @@ struct RepairParams {
   double miss_fraction = 0.25;
   double miss_constant = 2.0;
   int direction_probe = 6;  // px of the piece used to extrapolate an end
+  // px: an end extended onto a line must meet it at least this far from the
+  // line's junctions (two junctions cannot sit closer on one line).
+  double min_junction_distance = 6.0;
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;

@@ -27,6 +27,8 @@ struct LabelScore {
   int unmatched = 0;    // decoded junctions with no truth within reach
   int v_offset = 0;     // decoded v - true v of the majority
   double position_rms = 0.0;  // px, over found junctions with the right label
+  std::vector<PointLabel> missed;  // truth junctions not found
+  std::vector<PointLabel> wrong;   // truth junctions found with a wrong label
 
   double Recall() const { return truth ? static_cast<double>(found) / truth : 0.0; }
   int Wrong() const { return wrong_p + wrong_v; }
