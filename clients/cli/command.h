@@ -1,0 +1,48 @@
+// The subcommands of `bsls` and the one error type they report through.
+//
+// Exit codes scripts can rely on:
+//   0  done
+//   1  the input was read but could not be processed (e.g. no reference line)
+//   2  the command line is wrong
+//   3  an input file is missing, unreadable or not usable
+//   4  an output file could not be written
+//   70 an internal error (a bug: please report it)
+#ifndef BSLS_CLIENTS_CLI_COMMAND_H_
+#define BSLS_CLIENTS_CLI_COMMAND_H_
+
+#include <stdexcept>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace bsls::cli {
+
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitNotProcessed = 1,
+  kExitUsage = 2,
+  kExitInput = 3,
+  kExitOutput = 4,
+  kExitInternal = 70,
+};
+
+// A command that cannot do its job: main prints what() as one line on stderr
+// and exits with code().
+class CommandError : public std::runtime_error {
+ public:
+  CommandError(ExitCode code, const std::string& message)
+      : std::runtime_error(message), code_(code) {}
+  ExitCode code() const { return code_; }
+
+ private:
+  ExitCode code_;
+};
+
+// Adds `bsls process` to the application.
+void AddProcessCommand(CLI::App& app);
+// Adds `bsls simulate` to the application.
+void AddSimulateCommand(CLI::App& app);
+
+}  // namespace bsls::cli
+
+#endif  // BSLS_CLIENTS_CLI_COMMAND_H_

@@ -1,0 +1,96 @@
+// Single-shot decoding: one grey frame of the brick pattern in, labelled
+// junctions and labelled sub-pixel centre lines out (contracts section 5).
+//
+// Stages: feature extraction (thesis chapter 4), interpretation (chapter 5:
+// reference line, boundary and loop tracing, repair, labelling), then
+// sub-pixel centres on the grey frame along every labelled line and junction
+// positions where a line's and its segment's centres meet.
+//
+// Coordinates: image pixels, x = column, y = row, origin at the centre of the
+// top-left pixel. Labels: p absolute (0 = reference line); q relative unless
+// DecodeParams::q_offset is set (contracts section 2).
+//
+// Thread-safety: Decode is a pure function of its arguments.
+#ifndef BSLS_DECODER_DECODER_H_
+#define BSLS_DECODER_DECODER_H_
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "bsls/extraction/feature_extraction.h"
+#include "bsls/extraction/stripe_centre.h"
+#include "bsls/interpretation/interpreter.h"
+#include "bsls/pattern/brick_pattern.h"
+
+namespace bsls::decoder {
+
+struct DecodeParams {
+  pattern::PatternSpec spec;
+  extraction::ExtractionParams extraction;
+  interpretation::InterpretationParams interpretation;
+  extraction::StripeCentreParams centre;
+  int junction_fit_rows = 7;   // rows each side of a junction fitted to place it
+  int junction_clearance = 3;  // px each side of a junction where the other stroke biases centres
+  double max_centre_residual = 0.6;  // px: a line centre further from its neighbours' fit is dropped
+  // A frame whose 1st-99th percentile range is narrower (grey levels) is blank.
+  double min_dynamic_range = 16.0;
+  // A frame with a larger fraction of pixels at 254-255 is saturated.
+  double max_saturated_fraction = 0.4;
+  // Even offset added to every q to make it the slide row; known only from a
+  // calibration (slide-1 views). Unset: q is relative (thesis point O).
+  std::optional<int> q_offset;
+
+  // True when every part is usable; otherwise says which and why.
+  bool IsValid(std::string* error) const;
+};
+
+struct DecodedJunction {
+  cv::Point2d position;  // sub-pixel, image pixels
+  int p = 0;
+  int q = 0;
+  pattern::JunctionKind kind = pattern::JunctionKind::kDirect;
+  bool interpolated = false;  // placed from relative junctions (thesis 5.1.4.6), not seen
+};
+
+struct DecodedLine {
+  int p = 0;
+  std::vector<cv::Point2d> points;  // sub-pixel centres, one per image row, ordered by y
+};
+
+struct StageTimes {
+  double extraction_ms = 0;
+  double interpretation_ms = 0;
+  double subpixel_ms = 0;
+  double total_ms = 0;
+};
+
+struct DecodeResult {
+  bool ok = false;
+  std::string error;  // why nothing could be labelled (ok == false)
+  pattern::Side side = pattern::Side::kLeft;
+  int width = 0;
+  int height = 0;
+  bool q_absolute = false;
+  std::vector<DecodedJunction> junctions;  // ordered by p, then q
+  std::vector<DecodedLine> lines;          // ordered by p
+  StageTimes times;
+  // Diagnostics.
+  int repairs = 0;
+  int label_conflicts = 0;
+  std::map<interpretation::LoopClass, int> loop_classes;
+  cv::Mat skeleton;  // the repaired skeleton, CV_8UC1 0/255
+};
+
+// Decodes a CV_8UC1 frame of the brick slide of `side`. A blank or saturated
+// frame, or one whose reference line cannot be found, comes back with
+// ok == false and a reason; nothing is guessed. Throws std::invalid_argument
+// for an empty or non-CV_8UC1 frame or invalid params.
+DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams& params = {});
+
+}  // namespace bsls::decoder
+
+#endif  // BSLS_DECODER_DECODER_H_

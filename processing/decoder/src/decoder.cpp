@@ -1,0 +1,268 @@
+#include "bsls/decoder/decoder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+namespace bsls::decoder {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+// Says why a frame cannot carry the pattern, or returns an empty string.
+std::string CheckFrame(const cv::Mat& grey, const DecodeParams& params) {
+  int histogram[256] = {0};
+  for (int y = 0; y < grey.rows; ++y) {
+    const uchar* row = grey.ptr<uchar>(y);
+    for (int x = 0; x < grey.cols; ++x) ++histogram[row[x]];
+  }
+  const double total = static_cast<double>(grey.total());
+  auto percentile = [&](double f) {
+    double acc = 0;
+    for (int i = 0; i < 256; ++i) {
+      acc += histogram[i];
+      if (acc >= f * total) return i;
+    }
+    return 255;
+  };
+  const int lo = percentile(0.01), hi = percentile(0.99);
+  const double saturated = (histogram[254] + histogram[255]) / total;
+  if (saturated > params.max_saturated_fraction)
+    return "frame is saturated (" + std::to_string(static_cast<int>(saturated * 100)) +
+           "% of pixels at full scale)";
+  if (hi - lo < params.min_dynamic_range && percentile(0.999) - lo < params.min_dynamic_range)
+    return "frame is blank (grey levels " + std::to_string(lo) + ".." + std::to_string(hi) +
+           " hold 98% of pixels)";
+  return {};
+}
+
+// Least-squares line x = a + b t through (t, x) samples; false with < 2 samples.
+bool FitLine(const std::vector<std::pair<double, double>>& s, double* a, double* b) {
+  if (s.size() < 2) return false;
+  double st = 0, sx = 0, stt = 0, stx = 0;
+  for (const auto& [t, x] : s) {
+    st += t;
+    sx += x;
+    stt += t * t;
+    stx += t * x;
+  }
+  const double n = static_cast<double>(s.size());
+  const double den = n * stt - st * st;
+  if (std::abs(den) < 1e-9) return false;
+  *b = (n * stx - st * sx) / den;
+  *a = (sx - *b * st) / n;
+  return true;
+}
+
+struct LineCentres {
+  std::map<int, double> measured;  // row -> sub-pixel x, outliers removed
+  std::set<int> skipped;           // rows crossed but not measured (beside a segment)
+};
+
+// True when the skeleton has a segment leaving the line near (x, y): a set
+// pixel 2-4 columns to either side within one row.
+bool SegmentNearby(const cv::Mat& skeleton, int x, int y, int clearance) {
+  for (int dy = -clearance; dy <= clearance; ++dy) {
+    const int yy = y + dy;
+    if (yy < 0 || yy >= skeleton.rows) continue;
+    const uchar* row = skeleton.ptr<uchar>(yy);
+    for (int k = 2; k <= 4; ++k)
+      if ((x - k >= 0 && row[x - k]) || (x + k < skeleton.cols && row[x + k])) return true;
+  }
+  return false;
+}
+
+// Sub-pixel centres of one labelled line, one per row its skeleton crosses.
+// Rows beside a segment are skipped (the segment's light biases them), and a
+// centre far from the fit of its neighbours is dropped as an outlier.
+LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
+                        const interpretation::LabelledLine& line, const DecodeParams& params) {
+  std::map<int, std::pair<int, int>> span;  // row -> (min x, max x)
+  for (const cv::Point& p : line.pixels) {
+    auto [it, fresh] = span.try_emplace(p.y, p.x, p.x);
+    if (!fresh) {
+      it->second.first = std::min(it->second.first, p.x);
+      it->second.second = std::max(it->second.second, p.x);
+    }
+  }
+  LineCentres out;
+  for (const auto& [y, range] : span) {
+    const auto [lo, hi] = range;
+    const int x = (lo + hi) / 2;
+    // A row where the skeleton runs sideways is a segment, not the line.
+    if (hi - lo > 2 || SegmentNearby(skeleton, x, y, params.junction_clearance)) {
+      out.skipped.insert(y);
+      continue;
+    }
+    if (auto cx = extraction::StripeCentreInRow(grey, y, 0.5 * (lo + hi), params.centre))
+      out.measured[y] = *cx;
+    else
+      out.skipped.insert(y);
+  }
+  // Outliers: more than max_centre_residual from the line through the
+  // neighbours within junction_fit_rows.
+  std::vector<int> outliers;
+  for (const auto& [y, x] : out.measured) {
+    std::vector<std::pair<double, double>> s;
+    for (auto it = out.measured.lower_bound(y - params.junction_fit_rows);
+         it != out.measured.end() && it->first <= y + params.junction_fit_rows; ++it)
+      if (it->first != y) s.push_back({it->first - y, it->second});
+    double a, b;
+    if (s.size() >= 4 && FitLine(s, &a, &b) && std::abs(x - a) > params.max_centre_residual)
+      outliers.push_back(y);
+  }
+  for (int y : outliers) {
+    out.measured.erase(y);
+    out.skipped.insert(y);
+  }
+  return out;
+}
+
+}  // namespace
+
+bool DecodeParams::IsValid(std::string* error) const {
+  if (!spec.IsValid(error) || !extraction.IsValid(error) || !interpretation.IsValid(error) ||
+      !centre.IsValid(error))
+    return false;
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (junction_fit_rows < 2 || junction_fit_rows > 50) return fail("junction_fit_rows must lie in 2..50");
+  if (junction_clearance < 0 || junction_clearance >= junction_fit_rows)
+    return fail("junction_clearance must lie in 0..junction_fit_rows-1");
+  if (min_dynamic_range < 0 || max_saturated_fraction <= 0 || max_saturated_fraction > 1)
+    return fail("frame checks out of range");
+  if (q_offset && (*q_offset % 2) != 0) return fail("q_offset must be even");
+  return true;
+}
+
+DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams& params) {
+  if (grey.empty() || grey.type() != CV_8UC1)
+    throw std::invalid_argument("Decode: frame must be a non-empty CV_8UC1 image");
+  std::string why;
+  if (!params.IsValid(&why)) throw std::invalid_argument("Decode: " + why);
+
+  const auto start = Clock::now();
+  DecodeResult result;
+  result.side = side;
+  result.width = grey.cols;
+  result.height = grey.rows;
+  result.q_absolute = params.q_offset.has_value();
+  if (std::string bad = CheckFrame(grey, params); !bad.empty()) {
+    result.error = bad;
+    result.times.total_ms = MsSince(start);
+    return result;
+  }
+
+  auto t = Clock::now();
+  const extraction::ExtractionResult features = extraction::ExtractFeatures(grey, params.extraction);
+  result.times.extraction_ms = MsSince(t);
+
+  t = Clock::now();
+  const interpretation::InterpretationResult interp =
+      interpretation::Interpret(features.skeleton, side, params.spec, params.interpretation);
+  result.times.interpretation_ms = MsSince(t);
+  result.skeleton = interp.skeleton;
+  result.repairs = static_cast<int>(interp.repairs.size());
+  result.loop_classes = interp.loop_classes;
+  result.label_conflicts = interp.labelling.conflicts;
+  if (!interp.ok) {
+    result.error = interp.error;
+    result.times.total_ms = MsSince(start);
+    return result;
+  }
+
+  t = Clock::now();
+  const int q_offset = params.q_offset.value_or(0);
+  std::map<int, std::vector<const interpretation::LabelledJunction*>> junctions_of_line;
+  for (const auto& j : interp.labelling.junctions) junctions_of_line[j.p].push_back(&j);
+  std::map<int, LineCentres> centres;
+  for (const interpretation::LabelledLine& line : interp.labelling.lines)
+    centres[line.p] = MeasureLine(grey, interp.skeleton, line, params);
+
+  // Junctions: where the line's centre meets its segment's centre.
+  const int segment_sign_direct = pattern::ImageDirectionOfIncreasingP(side);
+  for (const auto& j : interp.labelling.junctions) {
+    DecodedJunction d;
+    d.p = j.p;
+    d.q = j.v + q_offset;
+    d.kind = j.kind;
+    d.interpolated = j.interpolated;
+    d.position = j.position;
+    const LineCentres& lc = centres[j.p];
+    std::vector<std::pair<double, double>> vertical;  // (y - yj, x)
+    for (int y = cvRound(j.position.y) - params.junction_fit_rows;
+         y <= cvRound(j.position.y) + params.junction_fit_rows; ++y) {
+      const auto it = lc.measured.find(y);
+      if (it != lc.measured.end()) vertical.push_back({y - j.position.y, it->second});
+    }
+    double a, b;
+    if (!FitLine(vertical, &a, &b)) {
+      result.junctions.push_back(d);
+      continue;
+    }
+    double jy = j.position.y;
+    if (!j.interpolated) {
+      const int dir = j.kind == pattern::JunctionKind::kDirect ? segment_sign_direct
+                                                               : -segment_sign_direct;
+      std::vector<std::pair<double, double>> horizontal;  // (x - xj, y)
+      const double x_line = a;
+      for (int k = params.junction_clearance + 1;
+           k <= params.junction_clearance + params.junction_fit_rows; ++k) {
+        const int x = cvRound(x_line) + dir * k;
+        if (x < 0 || x >= grey.cols) break;
+        if (auto y = extraction::StripeCentreInColumn(grey, x, j.position.y, params.centre))
+          horizontal.push_back({x - x_line, *y});
+      }
+      double c, e;
+      if (horizontal.size() >= 3 && FitLine(horizontal, &c, &e)) {
+        // x = x_line + b (y - yj);  y = c + e (x - x_line)  =>  solve for y.
+        const double den = 1.0 - e * b;
+        if (std::abs(den) > 1e-6) {
+          const double yy = (c - e * b * j.position.y) / den;
+          if (std::abs(yy - j.position.y) <= params.junction_clearance + 1.0) jy = yy;
+        }
+      }
+    }
+    d.position = cv::Point2d(a + b * (jy - j.position.y), jy);
+    result.junctions.push_back(d);
+  }
+
+  // Lines: measured centres, and the skipped rows filled from the line's own
+  // fit where measured rows lie on both sides.
+  for (const interpretation::LabelledLine& line : interp.labelling.lines) {
+    DecodedLine out;
+    out.p = line.p;
+    const LineCentres& lc = centres[line.p];
+    std::map<int, double> points = lc.measured;
+    for (int y : lc.skipped) {
+      std::vector<std::pair<double, double>> s;
+      bool above = false, below = false;
+      for (auto it = lc.measured.lower_bound(y - params.junction_fit_rows);
+           it != lc.measured.end() && it->first <= y + params.junction_fit_rows; ++it) {
+        s.push_back({it->first - y, it->second});
+        (it->first < y ? above : below) = true;
+      }
+      double a, b;
+      if (above && below && s.size() >= 4 && FitLine(s, &a, &b)) points[y] = a;
+    }
+    for (const auto& [y, x] : points) out.points.emplace_back(x, y);
+    if (!out.points.empty()) result.lines.push_back(std::move(out));
+  }
+  result.times.subpixel_ms = MsSince(t);
+  result.ok = true;
+  result.times.total_ms = MsSince(start);
+  return result;
+}
+
+}  // namespace bsls::decoder

@@ -1,0 +1,57 @@
+// Reading frames from image files and writing output files so that a reader
+// never sees them half-written (contracts section 5).
+#ifndef BSLS_IO_FRAME_FILE_H_
+#define BSLS_IO_FRAME_FILE_H_
+
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace bsls::io {
+
+// An input file that cannot be used; what() names the file and the reason.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// An output file that could not be written; what() names the file and the reason.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct FrameLimits {
+  int min_side = 16;     // px: smaller frames cannot hold the pattern
+  int max_side = 16384;  // px: larger ones are refused as absurd
+};
+
+// What LoadGreyFrame had to do to the file's pixels, for the user to know.
+struct FrameConversion {
+  int source_channels = 1;
+  int source_depth_bits = 8;
+  bool converted() const { return source_channels != 1 || source_depth_bits != 8; }
+  // e.g. "converted 3-channel 16-bit to 8-bit grey"; empty when nothing was done.
+  std::string Describe() const;
+};
+
+// Reads an image file as an 8-bit grey frame (CV_8UC1). Colour is converted
+// to grey and 16-bit to 8-bit (scaled by 1/257); `conversion` says what was
+// done. Throws InputError naming the file for a missing, unreadable, empty,
+// truncated or undecodable file, or a size outside `limits`.
+cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion = nullptr,
+                      const FrameLimits& limits = {});
+
+// Writes bytes to `path` atomically: a temporary file in the same folder,
+// fsync, rename over the target, fsync of the folder. Throws OutputError.
+void WriteFileAtomically(const std::string& path, std::string_view bytes);
+
+// Encodes an image as PNG and writes it atomically. Throws OutputError.
+void WritePngAtomically(const std::string& path, const cv::Mat& image);
+
+}  // namespace bsls::io
+
+#endif  // BSLS_IO_FRAME_FILE_H_

@@ -1,0 +1,128 @@
+#include "bsls/io/frame_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+namespace bsls::io {
+namespace {
+
+std::string Errno() { return std::strerror(errno); }
+
+}  // namespace
+
+std::string FrameConversion::Describe() const {
+  if (!converted()) return {};
+  return "converted " + std::to_string(source_channels) + "-channel " +
+         std::to_string(source_depth_bits) + "-bit to 8-bit grey";
+}
+
+cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion,
+                      const FrameLimits& limits) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw InputError(path + ": no such file");
+  if (std::filesystem::is_directory(status)) throw InputError(path + ": is a folder, not an image");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot be opened: " + Errno());
+  std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.empty()) throw InputError(path + ": file is empty");
+  cv::Mat raw;
+  try {
+    raw = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw InputError(path + ": cannot be decoded as an image: " + e.err);
+  }
+  if (raw.empty()) throw InputError(path + ": not a readable image (truncated or unknown format)");
+  if (raw.dims != 2) throw InputError(path + ": not a two-dimensional image");
+  if (raw.cols < limits.min_side || raw.rows < limits.min_side || raw.cols > limits.max_side ||
+      raw.rows > limits.max_side)
+    throw InputError(path + ": size " + std::to_string(raw.cols) + "x" + std::to_string(raw.rows) +
+                     " is outside " + std::to_string(limits.min_side) + ".." +
+                     std::to_string(limits.max_side) + " pixels a side");
+  FrameConversion conv;
+  conv.source_channels = raw.channels();
+  switch (raw.depth()) {
+    case CV_8U: conv.source_depth_bits = 8; break;
+    case CV_16U: conv.source_depth_bits = 16; break;
+    default:
+      throw InputError(path + ": pixel depth is neither 8 nor 16 bits");
+  }
+  cv::Mat grey;
+  switch (raw.channels()) {
+    case 1: grey = raw; break;
+    case 3: cv::cvtColor(raw, grey, cv::COLOR_BGR2GRAY); break;
+    case 4: cv::cvtColor(raw, grey, cv::COLOR_BGRA2GRAY); break;
+    case 2: {
+      std::vector<cv::Mat> planes;
+      cv::split(raw, planes);  // grey + alpha
+      grey = planes[0];
+      break;
+    }
+    default:
+      throw InputError(path + ": " + std::to_string(raw.channels()) + " channels per pixel");
+  }
+  if (grey.depth() == CV_16U) grey.convertTo(grey, CV_8U, 1.0 / 257.0);
+  if (conversion) *conversion = conv;
+  return grey.isContinuous() ? grey : grey.clone();
+}
+
+void WriteFileAtomically(const std::string& path, std::string_view bytes) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::random_device rd;
+  const fs::path temp =
+      folder / ("." + target.filename().string() + ".tmp" + std::to_string(rd() % 1000000));
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+  if (fd < 0) throw OutputError(path + ": cannot create a temporary file: " + Errno());
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const std::string why = Errno();
+      ::close(fd);
+      ::unlink(temp.c_str());
+      throw OutputError(path + ": write failed: " + why);
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0 || ::close(fd) != 0) {
+    const std::string why = Errno();
+    ::unlink(temp.c_str());
+    throw OutputError(path + ": cannot flush to disk: " + why);
+  }
+  if (::rename(temp.c_str(), target.c_str()) != 0) {
+    const std::string why = Errno();
+    ::unlink(temp.c_str());
+    throw OutputError(path + ": cannot be put in place: " + why);
+  }
+  const int dir = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+}
+
+void WritePngAtomically(const std::string& path, const cv::Mat& image) {
+  std::vector<uchar> png;
+  try {
+    if (!cv::imencode(".png", image, png)) throw OutputError(path + ": PNG encoding failed");
+  } catch (const cv::Exception& e) {
+    throw OutputError(path + ": PNG encoding failed: " + e.err);
+  }
+  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+}
+
+}  // namespace bsls::io
