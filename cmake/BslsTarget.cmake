@@ -3,6 +3,10 @@ function(bsls_target_defaults target)
   target_compile_features(${target} PUBLIC cxx_std_20)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow
                                            -Wno-missing-field-initializers)
+  if(BSLS_FUZZ)
+    # Coverage for libFuzzer in every library; the fuzz programs link the driver.
+    target_compile_options(${target} PRIVATE -fsanitize=fuzzer-no-link)
+  endif()
   if(BSLS_SANITIZE)
     target_compile_options(${target} PRIVATE -fsanitize=${BSLS_SANITIZE}
                                              -fno-omit-frame-pointer -fno-sanitize-recover=all)

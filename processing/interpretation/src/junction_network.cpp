@@ -39,29 +39,45 @@ JunctionNetwork::JunctionNetwork(const SkeletonGraph& graph, pattern::Side side,
       }
       continue;
     }
-    // Thesis 5.2.3.1 stages 4-5: the most opposite, most vertical pair of
-    // branches is the line; a single remaining, roughly horizontal branch is
-    // the segment.
+    // Thesis 5.2.3.1 stages 4-5: of three branches the most horizontal is the
+    // segment, and the other two must leave upwards and downwards (the line,
+    // which may bend sharply where the surface folds, e.g. at the lips).
     int best_up = -1, best_down = -1;
-    double best_score = 1e9;
-    for (int a : rot) {
-      for (int b : rot) {
-        if (a == b) continue;
-        const cv::Point2d da = graph.Departure(a), db = graph.Departure(b);
-        if (!(da.y < 0 && db.y > 0)) continue;
-        const double opposite = 180.0 - AngleBetweenDeg(da, db);
-        const double lean = std::max(LeanFromVerticalDeg(da), LeanFromVerticalDeg(db));
-        if (opposite > params.opposite_tolerance_deg || lean > params.vertical_tolerance_deg)
-          continue;
-        const double score = opposite + lean;
-        if (score < best_score) {
-          best_score = score;
-          best_up = a;
-          best_down = b;
+    if (rot.size() == 3) {
+      int side = rot[0];
+      for (int h : rot)
+        if (std::abs(graph.Departure(h).y) < std::abs(graph.Departure(side).y)) side = h;
+      for (int h : rot) {
+        if (h == side) continue;
+        const cv::Point2d d = graph.Departure(h);
+        if (LeanFromVerticalDeg(d) > params.vertical_tolerance_deg) continue;
+        (d.y < 0 ? best_up : best_down) = h;
+      }
+      if (best_up >= 0 && best_down >= 0 &&
+          180.0 - AngleBetweenDeg(graph.Departure(best_up), graph.Departure(best_down)) >
+              params.opposite_tolerance_deg)
+        best_up = best_down = -1;
+    } else {
+      // Four or more branches: a crossing; keep the straightest vertical pair
+      // so lines can be followed through it (thesis 5.1.4.8).
+      double best_score = 1e9;
+      for (int a : rot) {
+        for (int b : rot) {
+          const cv::Point2d da = graph.Departure(a), db = graph.Departure(b);
+          if (a == b || !(da.y < 0 && db.y > 0)) continue;
+          const double opposite = 180.0 - AngleBetweenDeg(da, db);
+          const double lean = std::max(LeanFromVerticalDeg(da), LeanFromVerticalDeg(db));
+          if (opposite > params.opposite_tolerance_deg || lean > params.vertical_tolerance_deg)
+            continue;
+          if (opposite + lean < best_score) {
+            best_score = opposite + lean;
+            best_up = a;
+            best_down = b;
+          }
         }
       }
     }
-    if (best_up < 0) {
+    if (best_up < 0 || best_down < 0) {
       role.attribute = rot.size() >= 4 ? JunctionAttribute::kCross4 : JunctionAttribute::kCross3;
       continue;
     }

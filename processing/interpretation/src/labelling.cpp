@@ -27,8 +27,9 @@ struct Label {
   bool operator==(const Label& o) const { return p == o.p && v == o.v; }
 };
 
-constexpr double kTrusted = 0.1;   // weight of a link inside a complete loop
-constexpr double kPlain = 1.0;     // weight of any other single-row link
+constexpr double kTrusted = 0.01;  // weight of a link inside a complete loop
+constexpr double kPlain = 10.0;    // weight of any other single-row link: a path of
+                                   // complete loops beats any path with one such link
 constexpr int kNoLabel = std::numeric_limits<int>::min();
 
 JunctionKind KindOf(const JunctionNetwork& net, int node) {
@@ -87,19 +88,38 @@ bool WalkDown(const JunctionNetwork& net, const std::vector<char>& trusted_edge,
   return false;
 }
 
-// Pixels of a line walked from a node up or down until it stops.
+// Pixels of a line walked from a node up or down until it stops. A line runs
+// one way in y: where the chain turns back or runs sideways (into a segment,
+// e.g. round the corner of a brick cut off at the image border) the walk ends.
 std::vector<cv::Point> WalkPixels(const JunctionNetwork& net, int from, bool downwards,
                                   std::set<int>* visited_nodes) {
+  constexpr int kMaxSideways = 2;  // consecutive steps without progress in y
   const SkeletonGraph& g = net.graph();
+  const int sign = downwards ? 1 : -1;
   std::vector<cv::Point> out;
+  int extreme = cvRound(net.role(from).centre.y);
+  int sideways = 0;
+  auto accept = [&](const cv::Point& p) {
+    if ((p.y - extreme) * sign > 0) {
+      extreme = p.y;
+      sideways = 0;
+    } else if (p.y == extreme) {
+      if (++sideways > kMaxSideways) return false;
+    } else {
+      return false;  // turned back
+    }
+    out.push_back(p);
+    return true;
+  };
   int cur = from;
   for (int guard = 0; guard < 10000; ++guard) {
     const auto step = net.AlongLine(cur, downwards);
     if (!step) break;
-    for (const cv::Point& p : g.Pixels(step->half_edge)) out.push_back(p);
+    for (const cv::Point& p : g.Pixels(step->half_edge))
+      if (!accept(p)) return out;
     const int t = step->target;
     const cv::Point2d c = net.role(t).centre;
-    out.push_back({cvRound(c.x), cvRound(c.y)});
+    if (!accept({cvRound(c.x), cvRound(c.y)})) return out;
     if (!step->consistent || !visited_nodes->insert(t).second) break;
     if (g.nodes()[t].kind == NodeKind::kEnd) break;
     cur = t;
@@ -182,7 +202,7 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     // junction (e.g. where two lines overlap, thesis 5.1.4.8): no link.
     if (best_miss > 0.35 * s) continue;
     const bool normal_step = best_rows <= 2;
-    const double w = l.trusted ? kTrusted : (normal_step ? kPlain : 2.0 + best_rows);
+    const double w = l.trusted ? kTrusted : (normal_step ? kPlain : kPlain * best_rows);
     adj[l.a].push_back({l.b, 0, best_rows, w, l.first, true});
     adj[l.b].push_back({l.a, 0, -best_rows, w, -1, true});
   }
@@ -236,19 +256,20 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
   // Propagation, most trusted links first (a Dijkstra order over link weights).
   std::vector<Label> label(n_nodes, {kNoLabel, kNoLabel});
   std::vector<double> cost(n_nodes, std::numeric_limits<double>::infinity());
-  using Item = std::tuple<double, int, int, int>;  // cost, node, p, v
+  using Item = std::tuple<double, int, int, int, int>;  // cost, node, p, v, parent
   std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
   for (size_t i = 0; i < seeds.size(); ++i) {
     cost[seeds[i]] = 0;
-    queue.push({0.0, seeds[i], 0, seed_v[i]});
+    queue.push({0.0, seeds[i], 0, seed_v[i], -1});
   }
   std::vector<char> done(n_nodes, 0);
   while (!queue.empty()) {
-    const auto [c, n, p, v] = queue.top();
+    const auto [c, n, p, v, parent] = queue.top();
     queue.pop();
     if (done[n]) continue;
     done[n] = 1;
     label[n] = {p, v};
+    out->provenance[n] = {parent, c};
     for (const Link& l : adj[n]) {
       if (done[l.to]) continue;
       const int np = p + l.dp, nv = v + l.dv;
@@ -256,7 +277,7 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
       const double nc = c + l.weight;
       if (nc < cost[l.to]) {
         cost[l.to] = nc;
-        queue.push({nc, l.to, np, nv});
+        queue.push({nc, l.to, np, nv, n});
       }
     }
   }

@@ -36,6 +36,12 @@ cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion,
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot be opened: " + Errno());
   std::vector<uchar> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InputError(path + ": read failed: " + Errno());
+  return DecodeGreyFrame(bytes, path, conversion, limits);
+}
+
+cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::string& path,
+                        FrameConversion* conversion, const FrameLimits& limits) {
   if (bytes.empty()) throw InputError(path + ": file is empty");
   cv::Mat raw;
   try {

@@ -25,10 +25,10 @@ struct JunctionParams {
   int min_radius = 2;  // the 5x5 fall-back window
   // How far (degrees) a path may lean from vertical and still be a line, or
   // from horizontal and still be a segment (thesis: compared with 0 and 45).
-  double vertical_tolerance_deg = 40.0;
+  double vertical_tolerance_deg = 55.0;
   double horizontal_tolerance_deg = 55.0;
   // How far (degrees) the two line paths may be from opposite.
-  double opposite_tolerance_deg = 50.0;
+  double opposite_tolerance_deg = 75.0;
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;

@@ -15,6 +15,7 @@
 #ifndef BSLS_INTERPRETATION_LABELLING_H_
 #define BSLS_INTERPRETATION_LABELLING_H_
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,9 @@ struct LabelledLine {
 struct Labelling {
   std::vector<LabelledJunction> junctions;  // ordered by p, then v
   std::vector<LabelledLine> lines;          // ordered by p
+  // For each labelled node, the node its label came from (-1 for line 0's
+  // junctions) and the cost of its path: how far it trusts untrusted links.
+  std::map<int, std::pair<int, double>> provenance;
   int conflicts = 0;  // labels dropped because their neighbours disagreed
   int reference_junctions = 0;
 };

@@ -45,6 +45,11 @@ struct FrameConversion {
 cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion = nullptr,
                       const FrameLimits& limits = {});
 
+// The same for an image already in memory; `name` stands for the file in
+// error messages.
+cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::string& name,
+                        FrameConversion* conversion = nullptr, const FrameLimits& limits = {});
+
 // Writes bytes to `path` atomically: a temporary file in the same folder,
 // fsync, rename over the target, fsync of the folder. Throws OutputError.
 void WriteFileAtomically(const std::string& path, std::string_view bytes);
