@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <stdexcept>
 
@@ -65,6 +66,7 @@ bool FitLine(const std::vector<std::pair<double, double>>& s, double* a, double*
 
 struct LineCentres {
   std::map<int, double> measured;  // row -> sub-pixel x, outliers removed
+  std::map<int, double> skeleton;  // row -> mean x of the line's skeleton pixels
   std::set<int> skipped;           // rows crossed but not measured (beside a segment)
 };
 
@@ -97,6 +99,7 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
   LineCentres out;
   for (const auto& [y, range] : span) {
     const auto [lo, hi] = range;
+    out.skeleton[y] = 0.5 * (lo + hi);
     const int x = (lo + hi) / 2;
     // A row where the skeleton runs sideways is a segment, not the line.
     if (hi - lo > 2 || SegmentNearby(skeleton, x, y, params.junction_clearance)) {
@@ -125,6 +128,58 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
     out.skipped.insert(y);
   }
   return out;
+}
+
+// The junction where the line's centre curve meets the segment's: the line's
+// measured centres near the junction fitted as x(y), the segment's centres
+// measured column by column along its skeleton and fitted as y(x). An
+// interpolated junction, or one whose segment cannot be measured, is placed on
+// the line's fit at its row. nullopt when the line has too few centres near it.
+std::optional<cv::Point2d> RefineJunction(const cv::Mat& grey, const LineCentres& line,
+                                          const interpretation::LabelledJunction& j,
+                                          const DecodeParams& params) {
+  const double y0 = j.position.y;
+  // The line as x(y): sub-pixel centres, or where a steep or crowded line has
+  // too few of them, its skeleton (within a pixel of the centre).
+  auto near = [&](const std::map<int, double>& rows, int exclude) {
+    std::vector<std::pair<double, double>> out;  // (y - y0, x)
+    for (auto it = rows.lower_bound(cvFloor(y0) - params.junction_fit_rows);
+         it != rows.end() && it->first <= y0 + params.junction_fit_rows; ++it)
+      if (std::abs(it->first - y0) > exclude) out.push_back({it->first - y0, it->second});
+    return out;
+  };
+  double a, b;
+  std::vector<std::pair<double, double>> vertical = near(line.measured, 0);
+  if (vertical.size() < 3 || !FitLine(vertical, &a, &b)) {
+    vertical = near(line.skeleton, 1);
+    if (vertical.size() < 3 || !FitLine(vertical, &a, &b)) return std::nullopt;
+  }
+  double y = y0;
+  if (!j.interpolated && !j.segment.empty()) {
+    // The segment as y(x): centres column by column along its skeleton, or the
+    // skeleton itself; its ends are skipped, where the lines' light biases it.
+    std::vector<std::pair<double, double>> measured, skeleton;  // (x - a, y)
+    const int n = static_cast<int>(j.segment.size());
+    for (int i = 0; i < n - 2; ++i) {
+      const cv::Point& s = j.segment[i];
+      if (std::abs(s.x - a) <= params.junction_clearance) continue;
+      skeleton.push_back({s.x - a, static_cast<double>(s.y)});
+      if (auto cy = extraction::StripeCentreInColumn(grey, s.x, s.y, params.centre))
+        measured.push_back({s.x - a, *cy});
+    }
+    double c, e;
+    const bool fitted = (measured.size() >= 2 && FitLine(measured, &c, &e)) ||
+                        (skeleton.size() >= 2 && FitLine(skeleton, &c, &e));
+    if (fitted) {
+      // x = a + b (y - y0) and y = c + e (x - a)  =>  y = (c - e b y0) / (1 - e b).
+      const double den = 1.0 - e * b;
+      if (std::abs(den) > 1e-6) {
+        const double yy = (c - e * b * y0) / den;
+        if (std::abs(yy - y0) <= 2.0 * params.junction_clearance) y = yy;
+      }
+    }
+  }
+  return cv::Point2d(a + b * (y - y0), y);
 }
 
 }  // namespace
@@ -191,7 +246,6 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     centres[line.p] = MeasureLine(grey, interp.skeleton, line, params);
 
   // Junctions: where the line's centre meets its segment's centre.
-  const int segment_sign_direct = pattern::ImageDirectionOfIncreasingP(side);
   for (const auto& j : interp.labelling.junctions) {
     DecodedJunction d;
     d.p = j.p;
@@ -199,42 +253,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     d.kind = j.kind;
     d.interpolated = j.interpolated;
     d.position = j.position;
-    const LineCentres& lc = centres[j.p];
-    std::vector<std::pair<double, double>> vertical;  // (y - yj, x)
-    for (int y = cvRound(j.position.y) - params.junction_fit_rows;
-         y <= cvRound(j.position.y) + params.junction_fit_rows; ++y) {
-      const auto it = lc.measured.find(y);
-      if (it != lc.measured.end()) vertical.push_back({y - j.position.y, it->second});
-    }
-    double a, b;
-    if (!FitLine(vertical, &a, &b)) {
-      result.junctions.push_back(d);
-      continue;
-    }
-    double jy = j.position.y;
-    if (!j.interpolated) {
-      const int dir = j.kind == pattern::JunctionKind::kDirect ? segment_sign_direct
-                                                               : -segment_sign_direct;
-      std::vector<std::pair<double, double>> horizontal;  // (x - xj, y)
-      const double x_line = a;
-      for (int k = params.junction_clearance + 1;
-           k <= params.junction_clearance + params.junction_fit_rows; ++k) {
-        const int x = cvRound(x_line) + dir * k;
-        if (x < 0 || x >= grey.cols) break;
-        if (auto y = extraction::StripeCentreInColumn(grey, x, j.position.y, params.centre))
-          horizontal.push_back({x - x_line, *y});
-      }
-      double c, e;
-      if (horizontal.size() >= 3 && FitLine(horizontal, &c, &e)) {
-        // x = x_line + b (y - yj);  y = c + e (x - x_line)  =>  solve for y.
-        const double den = 1.0 - e * b;
-        if (std::abs(den) > 1e-6) {
-          const double yy = (c - e * b * j.position.y) / den;
-          if (std::abs(yy - j.position.y) <= params.junction_clearance + 1.0) jy = yy;
-        }
-      }
-    }
-    d.position = cv::Point2d(a + b * (jy - j.position.y), jy);
+    if (auto refined = RefineJunction(grey, centres[j.p], j, params)) d.position = *refined;
     result.junctions.push_back(d);
   }
 

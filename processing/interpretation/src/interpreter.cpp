@@ -49,7 +49,7 @@ int PruneFalseJunctions(cv::Mat& sk, pattern::Side side, const InterpretationPar
 }  // namespace
 
 bool InterpretationParams::IsValid(std::string* error) const {
-  if (!graph.IsValid(error) || !junction.IsValid(error) || !reference.IsValid(error) ||
+  if (!graph.IsValid(error) || !junction.IsValid(error) || !corners.IsValid(error) || !reference.IsValid(error) ||
       !repair.IsValid(error) || !labelling.IsValid(error))
     return false;
   if (max_repair_rounds < 0 || max_repair_rounds > 100) {
@@ -84,6 +84,9 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
     result.skeleton = sk;
     return result;
   }
+
+  // Thesis 5.2.3.3: corners become junctions with a one-stroke stub.
+  result.corners = ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk);
 
   // Thesis 5.2.3 and 5.1.4: trace boundary and loops, correct, retrace.
   for (int round = 0; params.enable_repair && round < params.max_repair_rounds; ++round) {

@@ -329,6 +329,7 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     j.p = label[n].p;
     j.v = label[n].v - origin_v;
     j.kind = KindOf(net, n);
+    if (net.role(n).side >= 0) j.segment = g.Pixels(net.role(n).side);
     const auto key = std::make_pair(j.p, j.v);
     const auto clash = by_label.find(key);
     if (clash != by_label.end()) {

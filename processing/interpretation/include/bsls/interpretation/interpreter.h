@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bsls/interpretation/corner_extension.h"
 #include "bsls/interpretation/labelling.h"
 #include "bsls/interpretation/loop_trace.h"
 #include "bsls/interpretation/reference_line.h"
@@ -21,6 +22,7 @@ namespace bsls::interpretation {
 struct InterpretationParams {
   GraphParams graph;
   JunctionParams junction;
+  CornerParams corners;
   ReferenceLineParams reference;
   RepairParams repair;
   LabellingParams labelling;
@@ -38,6 +40,7 @@ struct InterpretationResult {
   cv::Mat skeleton;          // the repaired skeleton
   ReferenceLine reference;
   std::vector<Repair> repairs;
+  std::vector<cv::Point> corners;  // degree-2 corners extended to junctions (5.2.3.3)
   std::map<LoopClass, int> loop_classes;  // classes found before any repair
   std::vector<LoopRecord> boundary;       // boundary networks after repair
   Labelling labelling;

@@ -25,10 +25,11 @@ struct JunctionParams {
   int min_radius = 2;  // the 5x5 fall-back window
   // How far (degrees) a path may lean from vertical and still be a line, or
   // from horizontal and still be a segment (thesis: compared with 0 and 45).
-  double vertical_tolerance_deg = 55.0;
+  double vertical_tolerance_deg = 70.0;
   double horizontal_tolerance_deg = 55.0;
-  // How far (degrees) the two line paths may be from opposite.
-  double opposite_tolerance_deg = 75.0;
+  // How far (degrees) the two line paths may be from opposite (a line can
+  // fold sharply at a junction, e.g. at the lips).
+  double opposite_tolerance_deg = 89.0;
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;

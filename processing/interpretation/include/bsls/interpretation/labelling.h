@@ -48,6 +48,7 @@ struct LabelledJunction {
   int v = 0;              // slide row, relative (see above)
   pattern::JunctionKind kind = pattern::JunctionKind::kDirect;
   bool interpolated = false;  // placed from relative junctions, not seen
+  std::vector<cv::Point> segment;  // skeleton pixels of its segment, from the junction on
 };
 
 struct LabelledLine {

@@ -1,0 +1,38 @@
+// Thesis 5.2.3.3, ambiguity of a junction or line (Figures 5.21-5.23): where
+// a line and a segment meet in a corner (a point of degree 2) the third
+// stroke of the T-junction is missing, e.g. cut off by the face's outline or
+// lost in a gap. The thesis extends such a point to degree 3 by adding a
+// junction pixel p and an end pixel p1 one pixel on, along the line; the
+// junction can then be found and labelled, and the end takes part in the
+// repairs like any other.
+//
+// Image coordinates: x right, y down; the skeleton is CV_8UC1, non-zero = line.
+#ifndef BSLS_INTERPRETATION_CORNER_EXTENSION_H_
+#define BSLS_INTERPRETATION_CORNER_EXTENSION_H_
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "bsls/interpretation/skeleton_graph.h"
+
+namespace bsls::interpretation {
+
+struct CornerParams {
+  int leg = 5;                   // px of each leg used to measure its direction
+  double leg_tolerance_deg = 30; // how far a leg may lean from vertical / horizontal
+  int stub = 2;                  // px added along the line beyond the corner
+
+  // True when the numbers are usable; otherwise says why.
+  bool IsValid(std::string* error) const;
+};
+
+// Finds the corners on the graph's chains and draws their stubs into
+// `skeleton`; returns the corner pixels extended.
+std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerParams& params,
+                                     cv::Mat& skeleton);
+
+}  // namespace bsls::interpretation
+
+#endif  // BSLS_INTERPRETATION_CORNER_EXTENSION_H_
