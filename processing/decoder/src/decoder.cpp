@@ -64,6 +64,28 @@ bool FitLine(const std::vector<std::pair<double, double>>& s, double* a, double*
   return true;
 }
 
+// Least-squares x = c0 + c1 t + c2 t^2 through (t, x) samples (a line when
+// there are fewer than five); returns the value at t = 0, or nullopt.
+std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s) {
+  if (s.size() < 5) {
+    double a, b;
+    if (!FitLine(s, &a, &b)) return std::nullopt;
+    return a;
+  }
+  cv::Matx33d ata = cv::Matx33d::zeros();
+  cv::Vec3d atb(0, 0, 0);
+  for (const auto& [t, x] : s) {
+    const cv::Vec3d row(1.0, t, t * t);
+    for (int i = 0; i < 3; ++i) {
+      atb[i] += row[i] * x;
+      for (int k = 0; k < 3; ++k) ata(i, k) += row[i] * row[k];
+    }
+  }
+  cv::Vec3d c;
+  if (!cv::solve(ata, atb, c, cv::DECOMP_CHOLESKY)) return std::nullopt;
+  return c[0];
+}
+
 struct LineCentres {
   std::map<int, double> measured;  // row -> sub-pixel x, outliers removed
   std::map<int, double> skeleton;  // row -> mean x of the line's skeleton pixels
@@ -71,14 +93,17 @@ struct LineCentres {
 };
 
 // True when the skeleton has a segment leaving the line near (x, y): a set
-// pixel 2-4 columns to either side within one row.
-bool SegmentNearby(const cv::Mat& skeleton, int x, int y, int clearance) {
+// pixel 2-4 columns to either side within `clearance` rows that is not part of
+// the line itself.
+bool SegmentNearby(const cv::Mat& skeleton, const std::set<std::pair<int, int>>& own, int x, int y,
+                   int clearance) {
   for (int dy = -clearance; dy <= clearance; ++dy) {
     const int yy = y + dy;
     if (yy < 0 || yy >= skeleton.rows) continue;
     const uchar* row = skeleton.ptr<uchar>(yy);
     for (int k = 2; k <= 4; ++k)
-      if ((x - k >= 0 && row[x - k]) || (x + k < skeleton.cols && row[x + k])) return true;
+      for (int xx : {x - k, x + k})
+        if (xx >= 0 && xx < skeleton.cols && row[xx] && !own.count({xx, yy})) return true;
   }
   return false;
 }
@@ -89,7 +114,9 @@ bool SegmentNearby(const cv::Mat& skeleton, int x, int y, int clearance) {
 LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
                         const interpretation::LabelledLine& line, const DecodeParams& params) {
   std::map<int, std::pair<int, int>> span;  // row -> (min x, max x)
+  std::set<std::pair<int, int>> own;
   for (const cv::Point& p : line.pixels) {
+    own.insert({p.x, p.y});
     auto [it, fresh] = span.try_emplace(p.y, p.x, p.x);
     if (!fresh) {
       it->second.first = std::min(it->second.first, p.x);
@@ -99,10 +126,10 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
   LineCentres out;
   for (const auto& [y, range] : span) {
     const auto [lo, hi] = range;
-    out.skeleton[y] = 0.5 * (lo + hi);
+    if (hi - lo <= 2) out.skeleton[y] = 0.5 * (lo + hi);
     const int x = (lo + hi) / 2;
     // A row where the skeleton runs sideways is a segment, not the line.
-    if (hi - lo > 2 || SegmentNearby(skeleton, x, y, params.junction_clearance)) {
+    if (hi - lo > 2 || SegmentNearby(skeleton, own, x, y, params.junction_clearance)) {
       out.skipped.insert(y);
       continue;
     }
@@ -119,9 +146,9 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
     for (auto it = out.measured.lower_bound(y - params.junction_fit_rows);
          it != out.measured.end() && it->first <= y + params.junction_fit_rows; ++it)
       if (it->first != y) s.push_back({it->first - y, it->second});
-    double a, b;
-    if (s.size() >= 4 && FitLine(s, &a, &b) && std::abs(x - a) > params.max_centre_residual)
-      outliers.push_back(y);
+    if (s.size() < 4) continue;
+    const auto fit = FitAtZero(s);
+    if (fit && std::abs(x - *fit) > params.max_centre_residual) outliers.push_back(y);
   }
   for (int y : outliers) {
     out.measured.erase(y);
@@ -171,12 +198,26 @@ std::optional<cv::Point2d> RefineJunction(const cv::Mat& grey, const LineCentres
     const bool fitted = (measured.size() >= 2 && FitLine(measured, &c, &e)) ||
                         (skeleton.size() >= 2 && FitLine(skeleton, &c, &e));
     if (fitted) {
-      // x = a + b (y - y0) and y = c + e (x - a)  =>  y = (c - e b y0) / (1 - e b).
-      const double den = 1.0 - e * b;
-      if (std::abs(den) > 1e-6) {
-        const double yy = (c - e * b * y0) / den;
-        if (std::abs(yy - y0) <= 2.0 * params.junction_clearance) y = yy;
+      // Where x = a' + b' (y - y0) meets y = c + e (x - a):
+      //   y = (c + e (a' - a) - e b' y0) / (1 - e b').
+      auto meet = [&](double a2, double b2, double* out) {
+        const double den = 1.0 - e * b2;
+        if (std::abs(den) < 1e-6) return false;
+        *out = (c + e * (a2 - a) - e * b2 * y0) / den;
+        return std::abs(*out - y0) <= 2.0 * params.junction_clearance;
+      };
+      // A line may fold at its junction (the lips): then the branches above
+      // and below meet the segment each on its own, and the junction lies
+      // between the two meeting points.
+      std::vector<std::pair<double, double>> upper, lower;
+      for (const auto& v : vertical) (v.first < 0 ? upper : lower).push_back(v);
+      double au, bu, al, bl, yu, yl, ya;
+      if (upper.size() >= 2 && lower.size() >= 2 && FitLine(upper, &au, &bu) &&
+          FitLine(lower, &al, &bl) && meet(au, bu, &yu) && meet(al, bl, &yl)) {
+        const double xu = au + bu * (yu - y0), xl = al + bl * (yl - y0);
+        return cv::Point2d(0.5 * (xu + xl), 0.5 * (yu + yl));
       }
+      if (meet(a, b, &ya)) y = ya;
     }
   }
   return cv::Point2d(a + b * (y - y0), y);
@@ -272,8 +313,8 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
         s.push_back({it->first - y, it->second});
         (it->first < y ? above : below) = true;
       }
-      double a, b;
-      if (above && below && s.size() >= 4 && FitLine(s, &a, &b)) points[y] = a;
+      if (!above || !below || s.size() < 4) continue;
+      if (const auto fit = FitAtZero(s)) points[y] = *fit;
     }
     for (const auto& [y, x] : points) out.points.emplace_back(x, y);
     if (!out.points.empty()) result.lines.push_back(std::move(out));

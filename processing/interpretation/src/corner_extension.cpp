@@ -1,5 +1,6 @@
 #include "bsls/interpretation/corner_extension.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "bsls/interpretation/chain_code.h"
@@ -16,6 +17,33 @@ bool IsSet(const cv::Mat& sk, cv::Point p) {
   return p.x >= 0 && p.y >= 0 && p.x < sk.cols && p.y < sk.rows && sk.at<uchar>(p) != 0;
 }
 
+// Draws params.stub pixels from `corner` along `dir` if they touch nothing but
+// the corner (`own` pixels) and each other; returns whether it drew them.
+bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& own,
+             const CornerParams& params, cv::Mat& skeleton) {
+  dir *= 1.0 / std::hypot(dir.x, dir.y);
+  auto near_own = [&](cv::Point r) {
+    for (const cv::Point& o : own)
+      if (std::abs(r.x - o.x) <= 1 && std::abs(r.y - o.y) <= 1) return true;
+    return false;
+  };
+  std::vector<cv::Point> stub;
+  for (int k = 1; k <= params.stub; ++k) {
+    const cv::Point q(cvRound(corner.x + k * dir.x), cvRound(corner.y + k * dir.y));
+    if (q.x < 0 || q.y < 0 || q.x >= skeleton.cols || q.y >= skeleton.rows || IsSet(skeleton, q))
+      return false;
+    for (int c = 0; c < 8; ++c) {
+      const cv::Point r = q + CodeStep(c);
+      if (IsSet(skeleton, r) && !near_own(r) && !(!stub.empty() && r == stub.back()) &&
+          std::find(own.begin(), own.end(), r) == own.end())
+        return false;
+    }
+    stub.push_back(q);
+  }
+  for (const cv::Point& q : stub) skeleton.at<uchar>(q) = 255;
+  return true;
+}
+
 }  // namespace
 
 bool CornerParams::IsValid(std::string* error) const {
@@ -30,6 +58,21 @@ bool CornerParams::IsValid(std::string* error) const {
 std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerParams& params,
                                      cv::Mat& skeleton) {
   std::vector<cv::Point> corners;
+  // A corner may also be a small cluster of pixels (a node with two branches).
+  for (const SkeletonNode& node : graph.nodes()) {
+    if (node.kind != NodeKind::kJunction || node.rotation.size() != 2) continue;
+    const cv::Point2d d0 = graph.Departure(node.rotation[0]);
+    const cv::Point2d d1 = graph.Departure(node.rotation[1]);
+    cv::Point2d line_dir;  // from the corner along the line
+    if (LeanDeg(d0) <= params.leg_tolerance_deg && LeanDeg(d1) >= 90 - params.leg_tolerance_deg)
+      line_dir = d0;
+    else if (LeanDeg(d1) <= params.leg_tolerance_deg && LeanDeg(d0) >= 90 - params.leg_tolerance_deg)
+      line_dir = d1;
+    else
+      continue;
+    const cv::Point corner(cvRound(node.centre.x), cvRound(node.centre.y));
+    if (AddStub(corner, -line_dir, node.pixels, params, skeleton)) corners.push_back(corner);
+  }
   for (const SkeletonEdge& edge : graph.edges()) {
     const std::vector<cv::Point>& px = edge.pixels;
     const int n = static_cast<int>(px.size());
@@ -57,28 +100,8 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     }
     if (best < 0) continue;
     // The stub goes on along the line, beyond the corner.
-    const cv::Point2d dir = best_vertical * (1.0 / std::hypot(best_vertical.x, best_vertical.y));
     const cv::Point corner = px[best];
-    std::vector<cv::Point> stub;
-    bool clear = true;
-    for (int k = 1; k <= params.stub && clear; ++k) {
-      const cv::Point q(cvRound(corner.x + k * dir.x), cvRound(corner.y + k * dir.y));
-      if (q.x < 0 || q.y < 0 || q.x >= skeleton.cols || q.y >= skeleton.rows || IsSet(skeleton, q)) {
-        clear = false;
-        break;
-      }
-      // The stub must not touch other strokes.
-      for (int c = 0; c < 8 && clear; ++c) {
-        const cv::Point r = q + CodeStep(c);
-        if (!IsSet(skeleton, r)) continue;
-        const bool own = std::abs(r.x - corner.x) <= 1 && std::abs(r.y - corner.y) <= 1;
-        const bool previous = !stub.empty() && r == stub.back();
-        if (!own && !previous) clear = false;
-      }
-      stub.push_back(q);
-    }
-    if (!clear) continue;
-    for (const cv::Point& q : stub) skeleton.at<uchar>(q) = 255;
+    if (!AddStub(corner, best_vertical, {corner}, params, skeleton)) continue;
     corners.push_back(corner);
   }
   return corners;

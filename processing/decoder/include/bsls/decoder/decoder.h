@@ -35,7 +35,7 @@ struct DecodeParams {
   extraction::StripeCentreParams centre;
   int junction_fit_rows = 7;   // rows each side of a junction fitted to place it
   int junction_clearance = 3;  // px each side of a junction where the other stroke biases centres
-  double max_centre_residual = 0.6;  // px: a line centre further from its neighbours' fit is dropped
+  double max_centre_residual = 0.35;  // px: a line centre further from its neighbours' fit is dropped
   // A frame whose 1st-99th percentile range is narrower (grey levels) is blank.
   double min_dynamic_range = 16.0;
   // A frame with a larger fraction of pixels at 254-255 is saturated.
