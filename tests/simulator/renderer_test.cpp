@@ -169,7 +169,12 @@ TEST(Renderer, LeftAndRightPlaneScenesAreMirrorImages) {
 }
 
 TEST(Renderer, BallHidesJunctionsBehindItFromTheCamera) {
-  const Scene scene = ThesisScene(Side::kLeft, SurfaceKind::kBall, TestOptions());
+  // A ball standing high above the base plane (cut 15 mm below its equator),
+  // not the default low cap, so that it hides part of the plane.
+  ThesisSceneOptions options = TestOptions();
+  options.ball.centre_mm = {-70.0, 0.0, -15.0};
+  options.ball.radius_mm = 60.0;
+  const Scene scene = ThesisScene(Side::kLeft, SurfaceKind::kBall, options);
   const GroundTruth truth = ComputeGroundTruth(scene);
   int hidden_on_base = 0;
   for (const TruthJunction& j : truth.junctions) {

@@ -164,10 +164,13 @@ struct ThesisSceneOptions {
   // Rises towards +x (towards the left camera, 12 deg off its view axis) from
   // x = -120 to +30 mm, 150 mm high: the whole lit half and line 0 stay visible.
   RampParams ramp;
-  // A 40 mm high cap of a 75 mm ball rising from the base plane (rim slope
-  // 62 deg): its surface joins the plane along the rim, so every line can be
-  // followed onto it; only a sliver of its far rim is hidden from the camera.
-  BallParams ball{.centre_mm = {-75.0, 0.0, -35.0}, .radius_mm = 75.0};
+  // A 20 mm high cap of a 130 mm ball rising from the base plane (rim slope
+  // 32 deg): its surface joins the plane along the rim, so every line can be
+  // followed onto it, and even its far side (facing away from the camera)
+  // keeps the lines 5 px or more apart. A steeper ball hides whole lines from
+  // the camera behind its rim, which no decoder can label without a
+  // calibration (docs/decoding.md).
+  BallParams ball{.centre_mm = {-75.0, 0.0, -110.0}, .radius_mm = 130.0};
   BunnyParams bunny;
   // Smooth +-10 % variation around 0.8; patches here apply to every scene kind.
   AlbedoParams albedo;
