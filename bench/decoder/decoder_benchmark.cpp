@@ -1,0 +1,88 @@
+// Decode of one simulated face frame at 512x512 and 2048x2048, against a
+// baseline measured in the same run on the same frame: cv::GaussianBlur
+// (5x5, sigma 1) followed by cv::Canny. Counters: median_ms of the decode,
+// baseline_ms, and ratio = median decode / median baseline (goal at 512: <= 4).
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "bsls/decoder/decoder.h"
+#include "bsls/simulator/renderer.h"
+#include "bsls/simulator/scene.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+const cv::Mat& FaceFrame(int size) {
+  static std::map<int, cv::Mat> frames;
+  auto it = frames.find(size);
+  if (it != frames.end()) return it->second;
+  bsls::simulator::ThesisSceneOptions options;
+  options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
+  options.rig.width = size;
+  options.rig.height = size;
+  bsls::simulator::RenderParams params;
+  params.supersampling = size > 1024 ? 1 : 3;
+  params.noise_sigma = 3.0;
+  const auto scene =
+      bsls::simulator::ThesisScene(bsls::pattern::Side::kLeft, bsls::simulator::SurfaceKind::kFace, options);
+  return frames[size] = bsls::simulator::Renderer(scene, params).RenderImage(1);
+}
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+double BaselineOnce(const cv::Mat& frame) {
+  const auto t = Clock::now();
+  cv::Mat blurred, edges;
+  cv::GaussianBlur(frame, blurred, cv::Size(5, 5), 1.0);
+  cv::Canny(blurred, edges, 30, 90);
+  benchmark::DoNotOptimize(edges.data);
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+void BM_GaussianBlurCanny(benchmark::State& state) {
+  const cv::Mat& frame = FaceFrame(static_cast<int>(state.range(0)));
+  std::vector<double> ms;
+  for (auto _ : state) ms.push_back(BaselineOnce(frame));
+  state.counters["median_ms"] = Median(ms);
+}
+
+void BM_Decode(benchmark::State& state) {
+  const cv::Mat& frame = FaceFrame(static_cast<int>(state.range(0)));
+  // The baseline, measured in this run on this frame.
+  std::vector<double> base;
+  for (int i = 0; i < 30; ++i) base.push_back(BaselineOnce(frame));
+  std::vector<double> ms;
+  int junctions = 0;
+  for (auto _ : state) {
+    const auto t = Clock::now();
+    const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame, bsls::pattern::Side::kLeft);
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+    junctions = static_cast<int>(r.junctions.size());
+    benchmark::DoNotOptimize(junctions);
+  }
+  const double median = Median(ms), baseline = Median(base);
+  state.counters["median_ms"] = median;
+  state.counters["baseline_ms"] = baseline;
+  state.counters["ratio"] = median / baseline;
+  state.counters["junctions"] = junctions;
+  state.counters["pixels"] = static_cast<double>(frame.total());
+}
+
+}  // namespace
+
+BENCHMARK(BM_GaussianBlurCanny)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Decode)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_Decode)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+BENCHMARK_MAIN();
