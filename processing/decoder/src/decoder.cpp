@@ -187,7 +187,8 @@ std::optional<cv::Point2d> RefineJunction(const cv::Mat& grey, const LineCentres
     // skeleton itself; its ends are skipped, where the lines' light biases it.
     std::vector<std::pair<double, double>> measured, skeleton;  // (x - a, y)
     const int n = static_cast<int>(j.segment.size());
-    for (int i = 0; i < n - 2; ++i) {
+    for (int i = 0; i < n - 2 && static_cast<int>(skeleton.size()) < params.segment_fit_columns;
+         ++i) {
       const cv::Point& s = j.segment[i];
       if (std::abs(s.x - a) <= params.junction_clearance) continue;
       skeleton.push_back({s.x - a, static_cast<double>(s.y)});
@@ -234,6 +235,7 @@ bool DecodeParams::IsValid(std::string* error) const {
     return false;
   };
   if (junction_fit_rows < 2 || junction_fit_rows > 50) return fail("junction_fit_rows must lie in 2..50");
+  if (segment_fit_columns < 2) return fail("segment_fit_columns must be at least 2");
   if (junction_clearance < 0 || junction_clearance >= junction_fit_rows)
     return fail("junction_clearance must lie in 0..junction_fit_rows-1");
   if (min_dynamic_range < 0 || max_saturated_fraction <= 0 || max_saturated_fraction > 1)

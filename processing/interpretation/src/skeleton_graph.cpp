@@ -120,17 +120,19 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
   auto set = [&](int x, int y) { return bin.at<uchar>(y + 1, x + 1) != 0; };
   // Corner pixels of 4-connected steps (an L of three pixels) make their
   // neighbours look like junctions; the skeleton stays 8-connected without them.
-  for (int y = 0; y < rows; ++y) {
-    for (int x = 0; x < cols; ++x) {
-      if (!set(x, y)) continue;
-      int n = 0;
-      for (int c = 0; c < 8; ++c) n += set(x + kCodeDx[c], y + kCodeDy[c]);
-      if (n != 2) continue;
-      const bool horizontal = set(x - 1, y) || set(x + 1, y);
-      const bool vertical = set(x, y - 1) || set(x, y + 1);
-      if (horizontal && vertical) bin.at<uchar>(y + 1, x + 1) = 0;
-    }
+  // Only the set pixels are visited from here on (a skeleton is sparse).
+  std::vector<cv::Point> lit;
+  cv::findNonZero(skeleton, lit);
+  for (const cv::Point& p : lit) {
+    const int x = p.x, y = p.y;
+    int n = 0;
+    for (int c = 0; c < 8; ++c) n += set(x + kCodeDx[c], y + kCodeDy[c]);
+    if (n != 2) continue;
+    const bool horizontal = set(x - 1, y) || set(x + 1, y);
+    const bool vertical = set(x, y - 1) || set(x, y + 1);
+    if (horizontal && vertical) bin.at<uchar>(y + 1, x + 1) = 0;
   }
+  std::erase_if(lit, [&](const cv::Point& p) { return !set(p.x, p.y); });
   auto degree = [&](int x, int y) {
     int d = 0;
     for (int c = 0; c < 8; ++c) d += set(x + kCodeDx[c], y + kCodeDy[c]);
@@ -139,19 +141,16 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
 
   g.owner_ = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNone));
   cv::Mat deg(rows, cols, CV_8UC1, cv::Scalar(0));
-  for (int y = 0; y < rows; ++y) {
-    const uchar* row = bin.ptr<uchar>(y + 1) + 1;
-    for (int x = 0; x < cols; ++x)
-      if (row[x]) deg.at<uchar>(y, x) = static_cast<uchar>(degree(x, y));
-  }
+  for (const cv::Point& p : lit) deg.at<uchar>(p) = static_cast<uchar>(degree(p.x, p.y));
 
   // Junction clusters: 8-connected groups of pixels with three or more neighbours.
   auto new_node = [&](NodeKind kind) {
     g.nodes_.push_back(SkeletonNode{kind, {}, {}, {}});
     return static_cast<int>(g.nodes_.size()) - 1;
   };
-  for (int y = 0; y < rows; ++y) {
-    for (int x = 0; x < cols; ++x) {
+  for (const cv::Point& p0 : lit) {
+    {
+      const int x = p0.x, y = p0.y;
       if (deg.at<uchar>(y, x) < 3 || g.owner_.at<int>(y, x) != kNone) continue;
       const int id = new_node(NodeKind::kJunction);
       std::vector<cv::Point> stack{{x, y}};
@@ -171,8 +170,9 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     }
   }
   // A two-neighbour pixel whose neighbours all belong to one cluster is part of it.
-  for (int y = 0; y < rows; ++y) {
-    for (int x = 0; x < cols; ++x) {
+  for (const cv::Point& p0 : lit) {
+    {
+      const int x = p0.x, y = p0.y;
       if (deg.at<uchar>(y, x) != 2 || g.owner_.at<int>(y, x) != kNone) continue;
       int cluster = kNone;
       bool same = true;
@@ -191,13 +191,12 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     }
   }
   // Line ends.
-  for (int y = 0; y < rows; ++y)
-    for (int x = 0; x < cols; ++x)
-      if (deg.at<uchar>(y, x) == 1 && g.owner_.at<int>(y, x) == kNone) {
-        const int id = new_node(NodeKind::kEnd);
-        g.nodes_[id].pixels.push_back({x, y});
-        g.owner_.at<int>(y, x) = id;
-      }
+  for (const cv::Point& p : lit)
+    if (deg.at<uchar>(p) == 1 && g.owner_.at<int>(p) == kNone) {
+      const int id = new_node(NodeKind::kEnd);
+      g.nodes_[id].pixels.push_back(p);
+      g.owner_.at<int>(p) = id;
+    }
 
   // Chains between nodes.
   std::set<std::pair<int, int>> direct_links;
@@ -267,9 +266,10 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     }
   }
   // Closed chains without any node get an anchor.
-  for (int y = 0; y < rows; ++y) {
-    for (int x = 0; x < cols; ++x) {
-      if (!set(x, y) || g.owner_.at<int>(y, x) != kNone || deg.at<uchar>(y, x) == 0) continue;
+  for (const cv::Point& p0 : lit) {
+    {
+      const int x = p0.x, y = p0.y;
+      if (g.owner_.at<int>(y, x) != kNone || deg.at<uchar>(y, x) == 0) continue;
       const int id = new_node(NodeKind::kAnchor);
       g.nodes_[id].pixels.push_back({x, y});
       g.owner_.at<int>(y, x) = id;

@@ -1,0 +1,528 @@
+#include "bsls/extraction/thinning.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <opencv2/imgproc.hpp>
+#include <optional>
+#include <vector>
+
+#include "input_checks.h"
+#include "neighbourhood.h"
+
+namespace bsls::extraction {
+namespace {
+
+using internal::Neighbours;
+using internal::PaddedBinary;
+using internal::RequireGrey8;
+using internal::RequireValid;
+
+// ---------------------------------------------------------------------------
+// Thesis 4.3.1: line-following thinning.
+
+struct Run {
+  int lo = 0;  // first set pixel along the scan axis
+  int hi = 0;  // last set pixel, inclusive
+  int Mid() const { return (lo + hi) / 2; }
+};
+
+// A deferred join: from a trace end, the nearest skeleton pixel inside the
+// box reaching `reach` pixels along (dx, dy) and `band` pixels across it.
+struct Link {
+  cv::Point from;
+  int dx = 0;
+  int dy = 0;
+  int reach = 0;
+  int band = 0;
+};
+
+struct VerticalTask {
+  int y = 0;
+  Run run;
+  std::optional<cv::Point> join_from;  // skeleton pixel this branch leaves
+};
+
+class LineFollower {
+ public:
+  LineFollower(const cv::Mat& binary, const LineFollowingParams& params)
+      : img_(binary != 0), skel_(cv::Mat::zeros(binary.size(), CV_8UC1)), p_(params) {}
+
+  cv::Mat Thin() {
+    // Raster scan, rows top to bottom, each row right to left (thesis 4.3.1).
+    for (int y = 0; y < img_.rows; ++y) {
+      const unsigned char* row = img_.ptr<unsigned char>(y);
+      for (int x = img_.cols - 1; x >= 0; --x) {
+        if (!row[x]) continue;
+        StartAt(x, y);
+        Erase(x, y);  // progress even when the start pixel was left to a junction
+      }
+    }
+    for (const Link& link : links_) Resolve(link);
+    return skel_;
+  }
+
+ private:
+  bool At(int x, int y) const {
+    return x >= 0 && y >= 0 && x < img_.cols && y < img_.rows && img_.at<unsigned char>(y, x);
+  }
+  void Erase(int x, int y) {
+    if (x >= 0 && y >= 0 && x < img_.cols && y < img_.rows) img_.at<unsigned char>(y, x) = 0;
+  }
+  // Writes a skeleton pixel and joins it to the previous one of its trace.
+  void Mark(cv::Point p, std::optional<cv::Point>* prev) {
+    if (*prev && (std::abs(p.x - (*prev)->x) > 1 || std::abs(p.y - (*prev)->y) > 1))
+      cv::line(skel_, **prev, p, 255, 1, cv::LINE_8);
+    skel_.at<unsigned char>(p) = 255;
+    *prev = p;
+  }
+
+  // Maximal runs of set pixels of row y (column x) inside [a, b], clamped.
+  std::vector<Run> RowRuns(int y, int a, int b) const {
+    return Runs(a, b, img_.cols, [&](int i) { return At(i, y); });
+  }
+  std::vector<Run> ColRuns(int x, int a, int b) const {
+    return Runs(a, b, img_.rows, [&](int i) { return At(x, i); });
+  }
+  template <typename IsSet>
+  static std::vector<Run> Runs(int a, int b, int length, IsSet is_set) {
+    std::vector<Run> runs;
+    a = std::max(a, 0);
+    b = std::min(b, length - 1);
+    for (int i = a; i <= b; ++i) {
+      if (!is_set(i)) continue;
+      int j = i;
+      while (j + 1 <= b && is_set(j + 1)) ++j;
+      runs.push_back({i, j});
+      i = j;
+    }
+    return runs;
+  }
+  // Runs separated by at most bridge_gap black pixels are one run.
+  std::vector<Run> Bridged(const std::vector<Run>& runs) const {
+    std::vector<Run> out;
+    for (const Run& r : runs) {
+      if (!out.empty() && r.lo - out.back().hi - 1 <= p_.bridge_gap)
+        out.back().hi = r.hi;
+      else
+        out.push_back(r);
+    }
+    return out;
+  }
+  // The run through a set pixel at `i`, grown both ways across gaps of up to
+  // bridge_gap black pixels.
+  template <typename IsSet>
+  Run Grow(int i, IsSet is_set) const {
+    Run r{i, i};
+    for (bool grown = true; grown;) {
+      grown = false;
+      for (int k = 1; k <= p_.bridge_gap + 1; ++k)
+        if (is_set(r.lo - k)) {
+          r.lo -= k;
+          grown = true;
+          break;
+        }
+      for (int k = 1; k <= p_.bridge_gap + 1; ++k)
+        if (is_set(r.hi + k)) {
+          r.hi += k;
+          grown = true;
+          break;
+        }
+    }
+    return r;
+  }
+  Run GrowRow(int x, int y) const {
+    return Grow(x, [&](int i) { return At(i, y); });
+  }
+  Run GrowCol(int x, int y) const {
+    return Grow(y, [&](int i) { return At(x, i); });
+  }
+  // Number of consecutive set pixels from (x, y) stepping by (dx, dy).
+  int Extent(int x, int y, int dx, int dy, int limit) const {
+    int n = 0;
+    while (n < limit && At(x + n * dx, y + n * dy)) ++n;
+    return n;
+  }
+
+  void StartAt(int x, int y) {
+    const Run row_run = GrowRow(x, y);
+    const int m = row_run.Mid();
+    const int width = row_run.hi - row_run.lo + 1;
+    // Height: rows from y down whose window [lo - l, hi + l] holds set pixels.
+    const int cap = 2 * width + p_.margin + 1;
+    int height = 0;
+    while (height < cap &&
+           !RowRuns(y + height, row_run.lo - p_.margin, row_run.hi + p_.margin).empty())
+      ++height;
+    if (width > 2 * height + p_.margin) {
+      // Wider than tall: a horizontal structure, followed both ways from its middle.
+      const Run left_run = GrowCol(m, y);
+      std::optional<Run> right_run;
+      const auto right = ColRuns(m + 1, left_run.lo - p_.margin, left_run.hi + p_.margin);
+      if (!right.empty()) right_run = Run{right.front().lo, right.back().hi};
+      const cv::Point first = FollowHorizontal(m, left_run, -1);
+      if (right_run) {
+        const cv::Point second = FollowHorizontal(m + 1, *right_run, +1);
+        cv::line(skel_, first, second, 255, 1, cv::LINE_8);
+      }
+      return;
+    }
+    FollowVertical({y, row_run, std::nullopt});
+  }
+
+  // Thesis 4.3.1, vertical (main) following with the adaptive window.
+  void FollowVertical(const VerticalTask& start) {
+    std::vector<VerticalTask> pending{start};
+    while (!pending.empty()) {
+      const VerticalTask task = pending.back();
+      pending.pop_back();
+      const auto live = RowRuns(task.y, task.run.lo, task.run.hi);
+      if (live.empty()) continue;  // taken by another trace meanwhile
+      Run run{live.front().lo, live.back().hi};
+      int y = task.y;
+      int split_rows = 0;
+      int held_rows = 0;
+      std::optional<cv::Point> prev;
+      bool first = true;
+      for (;;) {
+        for (int x = run.lo; x <= run.hi; ++x) Erase(x, y);
+        const cv::Point median(run.Mid(), y);
+        if (first && task.join_from) cv::line(skel_, *task.join_from, median, 255, 1, cv::LINE_8);
+        first = false;
+        Mark(median, &prev);
+        const int ny = y + 1;
+        if (ny >= img_.rows) break;
+        const int wl = std::max(0, run.lo - p_.margin);
+        const int wr = std::min(img_.cols - 1, run.hi + p_.margin);
+        const std::vector<Run> subs = Bridged(RowRuns(ny, wl, wr));
+        if (subs.empty()) {  // End_of_line
+          links_.push_back({median, 0, 1, p_.margin + 1, (run.hi - run.lo) / 2 + p_.margin});
+          break;
+        }
+        // Junction: the set pixels leave the window sideways.
+        const bool right = At(wr, ny) && SideBranch(wr + 1, ny, +1);
+        const bool left = At(wl, ny) && SideBranch(wl - 1, ny, -1);
+        Run next;
+        if (subs.size() > 1 && ++split_rows > p_.max_split_rows) {
+          // A split lasting too long: a fork. Follow the branch nearest the
+          // median, the others later, each joined to this median.
+          size_t nearest = 0;
+          int best = img_.cols;
+          for (size_t i = 0; i < subs.size(); ++i) {
+            const int d = std::max({0, subs[i].lo - median.x, median.x - subs[i].hi});
+            if (d < best) {
+              best = d;
+              nearest = i;
+            }
+          }
+          for (size_t i = 0; i < subs.size(); ++i)
+            if (i != nearest) pending.push_back({ny, subs[i], median});
+          next = subs[nearest];
+          split_rows = 0;
+          held_rows = p_.max_split_rows;  // the branch is narrower by nature
+        } else if (subs.size() > 1) {
+          next = {subs.front().lo, subs.back().hi};  // black pixels inside: assume white
+        } else {
+          split_rows = 0;
+          next = subs.front();
+          // A run that suddenly loses one side (a flank edge opening where a
+          // branch leaves, or a hole at the side) keeps its extent for up to
+          // max_split_rows rows: "assume all the pixels are white".
+          const bool shrunk = next.hi - next.lo < run.hi - run.lo - p_.bridge_gap;
+          if (shrunk && held_rows < p_.max_split_rows) {
+            next = {std::min(next.lo, run.lo), std::max(next.hi, run.hi)};
+            ++held_rows;
+          } else if (!shrunk) {
+            held_rows = 0;
+          }
+        }
+        // On a junction row keep the run on the line, not on the branch.
+        if (right) next.hi = std::max(next.lo, std::min(next.hi, run.hi + 1));
+        if (left) next.lo = std::min(next.hi, std::max(next.lo, run.lo - 1));
+        if (right) FollowBranch(ny, next, wr + 1, +1);
+        if (left) FollowBranch(ny, next, wl - 1, -1);
+        run = next;
+        y = ny;
+      }
+    }
+  }
+
+  // True when at least min_branch_length set pixels continue from (x, y)
+  // along dx; shorter bumps are erased as noise.
+  bool SideBranch(int x, int y, int dx) {
+    const int n = Extent(x, y, dx, 0, p_.min_branch_length);
+    if (n >= p_.min_branch_length) return true;
+    for (int i = 0; i < n; ++i) Erase(x + i * dx, y);
+    return false;
+  }
+
+  // Thesis 4.3.1, junction: follow the horizontal branch leaving the
+  // vertical line (run `line_run` of row y) at column `start` along dx.
+  void FollowBranch(int y, const Run& line_run, int start, int dx) {
+    const Run branch = GrowCol(start, y);
+    const cv::Point first = FollowHorizontal(start, branch, dx);
+    // Erase the corner between the line's run and the branch start.
+    const int a = dx > 0 ? line_run.hi + 1 : start + 1;
+    const int b = dx > 0 ? start - 1 : line_run.lo - 1;
+    for (int r = branch.lo; r <= branch.hi; ++r)
+      for (int c = a; c <= b; ++c) Erase(c, r);
+    // Join the branch to the line's skeleton once that exists (deferred).
+    links_.push_back({first, -dx, 0, std::abs(start - line_run.Mid()) + 2, 1});
+  }
+
+  // Thesis 4.3.1, horizontal following from column x (run along the column)
+  // in direction dx until a junction or the end of the line. Returns the
+  // first skeleton pixel.
+  cv::Point FollowHorizontal(int x, Run run, int dx) {
+    std::optional<cv::Point> prev;
+    cv::Point first;
+    bool is_first = true;
+    for (;;) {
+      for (int r = run.lo; r <= run.hi; ++r) Erase(x, r);
+      const cv::Point median(x, run.Mid());
+      Mark(median, &prev);
+      if (is_first) first = median;
+      is_first = false;
+      const int nx = x + dx;
+      if (nx < 0 || nx >= img_.cols) break;
+      const int wt = std::max(0, run.lo - p_.margin);
+      const int wb = std::min(img_.rows - 1, run.hi + p_.margin);
+      const std::vector<Run> subs = Bridged(ColRuns(nx, wt, wb));
+      if (subs.empty()) {  // End_of_line
+        links_.push_back({median, dx, 0, p_.margin + 2, p_.margin});
+        break;
+      }
+      const bool up =
+          At(nx, wt) && Extent(nx, wt - 1, 0, -1, p_.min_branch_length) >= p_.min_branch_length;
+      const bool down =
+          At(nx, wb) && Extent(nx, wb + 1, 0, 1, p_.min_branch_length) >= p_.min_branch_length;
+      if (up || down) {
+        // The next junction: a vertical line. Stop; it is followed on its own
+        // and this branch is joined to its skeleton.
+        const int line_width = Extent(nx, median.y, dx, 0, 4 * img_.cols);
+        links_.push_back({median, dx, 0, line_width + p_.margin + 2, 2});
+        break;
+      }
+      for (int k = 1; At(nx, wt - k); ++k) Erase(nx, wt - k);  // short bumps
+      for (int k = 1; At(nx, wb + k); ++k) Erase(nx, wb + k);
+      run = {subs.front().lo, subs.back().hi};
+      x = nx;
+    }
+    return first;
+  }
+
+  void Resolve(const Link& link) {
+    // Box ahead of the trace end: along (dx, dy) from 1 to reach, +-band across.
+    std::optional<cv::Point> best;
+    int best_d2 = 0;
+    for (int along = 1; along <= link.reach; ++along)
+      for (int across = -link.band; across <= link.band; ++across) {
+        const cv::Point q = link.dx != 0
+                                ? cv::Point(link.from.x + along * link.dx, link.from.y + across)
+                                : cv::Point(link.from.x + across, link.from.y + along * link.dy);
+        if (q.x < 0 || q.y < 0 || q.x >= skel_.cols || q.y >= skel_.rows) continue;
+        if (!skel_.at<unsigned char>(q)) continue;
+        const int d2 =
+            (q.x - link.from.x) * (q.x - link.from.x) + (q.y - link.from.y) * (q.y - link.from.y);
+        if (!best || d2 < best_d2) {
+          best = q;
+          best_d2 = d2;
+        }
+      }
+    if (best) cv::line(skel_, link.from, *best, 255, 1, cv::LINE_8);
+  }
+
+  cv::Mat img_;   // working copy, erased as the lines are followed (0/255)
+  cv::Mat skel_;  // the skeleton being written (0/255)
+  LineFollowingParams p_;
+  std::vector<Link> links_;
+};
+
+// ---------------------------------------------------------------------------
+// Thesis 4.3.2: Zhang-Suen.
+
+// Conditions of eq. 4.18 (step 0) or eq. 4.20 (step 1) for the pixel at index i.
+bool ZhangSuenDeletable(const PaddedBinary& img, size_t i, int step) {
+  const Neighbours n = img.NeighboursOf(i);
+  const int count = n.Count();
+  if (count < 2 || count > 6) return false;                                  // (a)
+  if (n.Transitions() != 1) return false;                                    // (b)
+  if (step == 0) return !(n.p2 && n.p4 && n.p6) && !(n.p4 && n.p6 && n.p8);  // (c), (d)
+  return !(n.p2 && n.p4 && n.p8) && !(n.p2 && n.p6 && n.p8);                 // (c'), (d')
+}
+
+}  // namespace
+
+bool LineFollowingParams::IsValid(std::string* error) const {
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (margin < 1 || margin > 16) return fail("line-following margin must lie in 1..16 px");
+  if (max_split_rows < 0 || max_split_rows > 100) return fail("max_split_rows must lie in 0..100");
+  if (bridge_gap < 0 || bridge_gap > 32) return fail("bridge_gap must lie in 0..32 px");
+  if (min_branch_length < 1 || min_branch_length > 100)
+    return fail("min_branch_length must lie in 1..100 px");
+  return true;
+}
+
+bool ZhangSuenParams::IsValid(std::string* error) const {
+  if (max_iterations < 1) {
+    if (error) *error = "Zhang-Suen max_iterations must be >= 1";
+    return false;
+  }
+  return true;
+}
+
+cv::Mat LineFollowingThin(const cv::Mat& binary, const LineFollowingParams& params) {
+  RequireGrey8(binary, "LineFollowingThin", "binary image");
+  RequireValid(params, "LineFollowingThin");
+  return LineFollower(binary, params).Thin();
+}
+
+cv::Mat ZhangSuenThin(const cv::Mat& binary, const ZhangSuenParams& params) {
+  RequireGrey8(binary, "ZhangSuenThin", "binary image");
+  RequireValid(params, "ZhangSuenThin");
+  PaddedBinary img(binary);
+  std::vector<size_t> live = img.SetIndices();
+  std::vector<size_t> flagged;
+  for (int iteration = 0; iteration < params.max_iterations; ++iteration) {
+    bool changed = false;
+    for (int step = 0; step < 2; ++step) {
+      flagged.clear();
+      for (size_t i : live)
+        if (img.data[i] && ZhangSuenDeletable(img, i, step)) flagged.push_back(i);
+      for (size_t i : flagged) {
+        if (params.preserve_topology) {
+          // Sequential re-check: keep what has become an end point or non-simple.
+          const Neighbours n = img.NeighboursOf(i);
+          if (n.Count() < 2 || n.ConnectivityNumber8() != 1) continue;
+        }
+        img.data[i] = 0;
+        changed = true;
+      }
+    }
+    std::erase_if(live, [&img](size_t i) { return !img.data[i]; });
+    if (!changed) break;
+  }
+  return img.ToMat();
+}
+
+cv::Mat MakeOnePixelWide(const cv::Mat& skeleton, TJunctionShape t_junctions) {
+  RequireGrey8(skeleton, "MakeOnePixelWide", "skeleton");
+  const bool keep_t_centres = t_junctions == TJunctionShape::kCentreKept;
+  PaddedBinary img(skeleton);
+  std::vector<size_t> live = img.SetIndices();
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t i : live) {
+      if (!img.data[i]) continue;
+      const Neighbours n = img.NeighboursOf(i);
+      if (n.Count() < 2 || n.ConnectivityNumber8() != 1) continue;
+      if (keep_t_centres && n.p2 + n.p4 + n.p6 + n.p8 >= 3) continue;
+      img.data[i] = 0;
+      changed = true;
+    }
+    std::erase_if(live, [&img](size_t i) { return !img.data[i]; });
+  }
+  return img.ToMat();
+}
+
+bool RecentreParams::IsValid(std::string* error) const {
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!(sigma > 0.0 && sigma <= 20.0)) return fail("recentre sigma must lie in (0, 20] px");
+  if (!(min_gain >= 0.0)) return fail("recentre min_gain must be >= 0");
+  if (passes < 1 || passes > 20) return fail("recentre passes must lie in 1..20");
+  if (junction_clearance < 0 || junction_clearance > 50)
+    return fail("recentre junction_clearance must lie in 0..50 px");
+  return true;
+}
+
+cv::Mat RecentreOnRidge(const cv::Mat& skeleton, const cv::Mat& grey,
+                        const RecentreParams& params) {
+  RequireGrey8(skeleton, "RecentreOnRidge", "skeleton");
+  RequireGrey8(grey, "RecentreOnRidge", "grey image");
+  RequireValid(params, "RecentreOnRidge");
+  if (grey.size() != skeleton.size())
+    throw std::invalid_argument("RecentreOnRidge: skeleton and grey image differ in size");
+  cv::Mat f;
+  grey.convertTo(f, CV_32F);
+  const int half = static_cast<int>(std::ceil(3.0 * params.sigma));
+  cv::GaussianBlur(f, f, cv::Size(2 * half + 1, 2 * half + 1), params.sigma, params.sigma,
+                   cv::BORDER_REPLICATE);
+  cv::Mat s = skeleton != 0;
+  auto at = [&s](int x, int y) {
+    return x >= 0 && y >= 0 && x < s.cols && y < s.rows && s.at<unsigned char>(y, x) != 0;
+  };
+  const float min_gain = static_cast<float>(params.min_gain);
+  // Near junctions the grey ridge bends towards the branches: keep clear.
+  cv::Mat near_junction = cv::Mat::zeros(s.size(), CV_8UC1);
+  {
+    std::vector<cv::Point> pixels;
+    cv::findNonZero(s, pixels);
+    for (const cv::Point& p : pixels) {
+      int count = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) count += (dx || dy) && at(p.x + dx, p.y + dy);
+      if (count >= 3) near_junction.at<unsigned char>(p) = 255;
+    }
+    const int side = 2 * params.junction_clearance + 1;
+    cv::dilate(near_junction, near_junction, cv::Mat::ones(side, side, CV_8U));
+  }
+  for (int pass = 0; pass < params.passes; ++pass) {
+    std::vector<cv::Point> pixels;
+    cv::findNonZero(s, pixels);
+    cv::Mat moved = cv::Mat::zeros(s.size(), CV_8UC1);
+    bool any = false;
+    for (const cv::Point& p : pixels) {
+      if (!at(p.x, p.y) || moved.at<unsigned char>(p) || near_junction.at<unsigned char>(p))
+        continue;
+      cv::Point nb[2];
+      int count = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if ((dx || dy) && at(p.x + dx, p.y + dy)) {
+            if (count < 2) nb[count] = {p.x + dx, p.y + dy};
+            ++count;
+          }
+      if (count != 2) continue;  // ends and junctions stay
+      cv::Point step;
+      if (std::abs(nb[0].y - nb[1].y) == 2)
+        step = {1, 0};  // neighbours above and below: move across, along x
+      else if (std::abs(nb[0].x - nb[1].x) == 2)
+        step = {0, 1};  // neighbours left and right: move along y
+      else
+        continue;  // a corner
+      const float here = f.at<float>(p);
+      std::optional<cv::Point> best;
+      float best_value = here + min_gain;
+      for (int sign : {-1, 1}) {
+        const cv::Point q = p + sign * step;
+        if (q.x < 0 || q.y < 0 || q.x >= s.cols || q.y >= s.rows || at(q.x, q.y)) continue;
+        bool ok = true;
+        for (const cv::Point& n : nb)
+          ok = ok && std::abs(n.x - q.x) <= 1 && std::abs(n.y - q.y) <= 1;
+        for (int dy = -1; dy <= 1 && ok; ++dy)
+          for (int dx = -1; dx <= 1 && ok; ++dx) {
+            const cv::Point r(q.x + dx, q.y + dy);
+            if ((dx || dy) && r != p && r != nb[0] && r != nb[1] && at(r.x, r.y)) ok = false;
+          }
+        if (ok && f.at<float>(q) >= best_value) {
+          best = q;
+          best_value = f.at<float>(q);
+        }
+      }
+      if (!best) continue;
+      s.at<unsigned char>(p) = 0;
+      s.at<unsigned char>(*best) = 255;
+      moved.at<unsigned char>(*best) = 255;
+      any = true;
+    }
+    if (!any) break;
+  }
+  return s;
+}
+
+}  // namespace bsls::extraction
