@@ -54,25 +54,18 @@ void BM_Method(benchmark::State& state) {
     if (j.visible) truth.push_back({j.p, j.v, {j.image.x(), j.image.y()}});
   for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
   const auto score = bsls::testing::ScoreLabels(truth, decoded, 2.5);
-  std::map<int, std::multimap<int, double>> rows;
-  for (const auto& line : frame.truth.lines)
-    for (const auto& p : line.points) rows[line.p].emplace(std::lround(p.y()), p.x());
-  double sum2 = 0;
-  int n = 0;
-  for (const auto& line : r.lines)
-    for (const auto& p : line.points) {
-      const auto range = rows[line.p].equal_range(std::lround(p.y));
-      double best = 1e9;
-      for (auto it = range.first; it != range.second; ++it) best = std::min(best, std::abs(it->second - p.x));
-      if (best < 1e8) {
-        sum2 += best * best;
-        ++n;
-      }
-    }
+  std::vector<bsls::testing::LinePoints> truth_lines, decoded_lines;
+  for (const auto& line : frame.truth.lines) {
+    bsls::testing::LinePoints l{line.p, {}};
+    for (const auto& p : line.points) l.points.emplace_back(p.x(), p.y());
+    truth_lines.push_back(std::move(l));
+  }
+  for (const auto& line : r.lines) decoded_lines.push_back({line.p, line.points});
+  const auto lines = bsls::testing::ScoreLines(truth_lines, decoded_lines);
   std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
   state.counters["recall"] = score.Recall();
   state.counters["wrong"] = score.Wrong();
-  state.counters["centre_rms_px"] = n ? std::sqrt(sum2 / n) : 0.0;
+  state.counters["centre_rms_px"] = lines.rms;
   state.counters["median_ms"] = ms[ms.size() / 2];
   state.SetLabel(std::string(method == ExtractionMethod::kModern ? "modern " : "thesis ") +
                  std::string(bsls::simulator::ToString(kind)) + (r.ok ? "" : " FAILED: " + r.error));

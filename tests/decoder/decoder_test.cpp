@@ -4,9 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <filesystem>
-#include <map>
 
 #include "bsls/decoder/decode_output.h"
 #include "bsls/simulator/renderer.h"
@@ -58,24 +56,16 @@ Evaluation Evaluate(const simulator::Frame& frame, const DecodeResult& r) {
   Evaluation e;
   e.all = testing::ScoreLabels(truth_all, decoded, kMatchReach);
   e.inner = testing::ScoreLabels(truth_inner, decoded, kMatchReach);
-  // Line centres: each decoded point against the true crossing of its row.
-  std::map<int, std::multimap<int, double>> truth_rows;
-  for (const auto& line : frame.truth.lines)
-    for (const auto& p : line.points) truth_rows[line.p].emplace(std::lround(p.y()), p.x());
-  double sum2 = 0;
-  for (const DecodedLine& line : r.lines) {
-    const auto& rows = truth_rows[line.p];
-    for (const cv::Point2d& p : line.points) {
-      const auto range = rows.equal_range(std::lround(p.y));
-      double best = 1e9;
-      for (auto it = range.first; it != range.second; ++it)
-        best = std::min(best, std::abs(it->second - p.x));
-      if (best > 1e8) continue;
-      sum2 += best * best;
-      ++e.line_points;
-    }
+  std::vector<testing::LinePoints> truth_lines, decoded_lines;
+  for (const auto& line : frame.truth.lines) {
+    testing::LinePoints l{line.p, {}};
+    for (const auto& p : line.points) l.points.emplace_back(p.x(), p.y());
+    truth_lines.push_back(std::move(l));
   }
-  e.line_rms = e.line_points ? std::sqrt(sum2 / e.line_points) : 0.0;
+  for (const DecodedLine& line : r.lines) decoded_lines.push_back({line.p, line.points});
+  const testing::LineScore lines = testing::ScoreLines(truth_lines, decoded_lines);
+  e.line_rms = lines.rms;
+  e.line_points = lines.points;
   return e;
 }
 

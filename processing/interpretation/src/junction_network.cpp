@@ -44,11 +44,11 @@ JunctionNetwork::JunctionNetwork(const SkeletonGraph& graph, pattern::Side side,
     // which may bend sharply where the surface folds, e.g. at the lips).
     int best_up = -1, best_down = -1;
     if (rot.size() == 3) {
-      int side = rot[0];
+      int segment = rot[0];
       for (int h : rot)
-        if (std::abs(graph.Departure(h).y) < std::abs(graph.Departure(side).y)) side = h;
+        if (std::abs(graph.Departure(h).y) < std::abs(graph.Departure(segment).y)) segment = h;
       for (int h : rot) {
-        if (h == side) continue;
+        if (h == segment) continue;
         const cv::Point2d d = graph.Departure(h);
         if (LeanFromVerticalDeg(d) > params.vertical_tolerance_deg) continue;
         (d.y < 0 ? best_up : best_down) = h;

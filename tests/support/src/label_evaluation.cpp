@@ -1,5 +1,6 @@
 #include "bsls/testing/label_evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -76,6 +77,27 @@ LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
   }
   for (size_t d = 0; d < decoded.size(); ++d) score.unmatched += !used[d];
   score.position_rms = n2 ? std::sqrt(sum2 / n2) : 0.0;
+  return score;
+}
+
+LineScore ScoreLines(const std::vector<LinePoints>& truth, const std::vector<LinePoints>& decoded) {
+  std::map<int, std::multimap<long, double>> rows;
+  for (const LinePoints& line : truth)
+    for (const cv::Point2d& p : line.points) rows[line.p].emplace(std::lround(p.y), p.x);
+  LineScore score;
+  double sum2 = 0;
+  for (const LinePoints& line : decoded) {
+    const auto& r = rows[line.p];
+    for (const cv::Point2d& p : line.points) {
+      const auto range = r.equal_range(std::lround(p.y));
+      if (range.first == range.second) continue;
+      double best = 1e300;
+      for (auto it = range.first; it != range.second; ++it) best = std::min(best, std::abs(it->second - p.x));
+      sum2 += best * best;
+      ++score.points;
+    }
+  }
+  score.rms = score.points ? std::sqrt(sum2 / score.points) : 0.0;
   return score;
 }
 

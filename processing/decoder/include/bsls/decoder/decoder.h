@@ -34,7 +34,7 @@ struct DecodeParams {
   interpretation::InterpretationParams interpretation;
   extraction::StripeCentreParams centre;
   int junction_fit_rows = 7;   // rows each side of a junction fitted to place it
-  int segment_fit_columns = 5;  // columns of a segment measured to place its junction
+  int segment_fit_columns = 50;  // columns of a segment measured to place its junction
   int junction_clearance = 3;  // px each side of a junction where the other stroke biases centres
   double max_centre_residual = 0.35;  // px: a line centre further from its neighbours' fit is dropped
   // A frame whose 1st-99th percentile range is narrower (grey levels) is blank.

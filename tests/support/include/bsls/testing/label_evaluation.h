@@ -36,6 +36,20 @@ struct LabelScore {
   std::string Summary() const;
 };
 
+// Sampled centre line of one vertical line p, image pixels.
+struct LinePoints {
+  int p = 0;
+  std::vector<cv::Point2d> points;
+};
+
+struct LineScore {
+  int points = 0;     // decoded points with a true crossing on their row
+  double rms = 0.0;   // px, horizontal distance to the nearest true crossing of the row
+};
+
+// Scores decoded line points against the true crossings of the same row.
+LineScore ScoreLines(const std::vector<LinePoints>& truth, const std::vector<LinePoints>& decoded);
+
 // Matches each truth junction to the nearest decoded one within `reach` px
 // (each decoded junction used once) and scores the labels.
 LabelScore ScoreLabels(const std::vector<PointLabel>& truth,

@@ -1,0 +1,154 @@
+#include "bsls/extraction/stripe_centre.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <iostream>
+#include <random>
+#include <vector>
+
+#include "expect_invalid.h"
+#include "synthetic_images.h"
+
+namespace bsls::extraction {
+namespace {
+
+using testing::ExpectInvalid;
+
+// Accuracy target of the brief: noise sigma 3, contrast >= 60 grey levels.
+constexpr double kRmsTarget = 0.1;          // px
+constexpr double kNoiseFreeBias = 0.03;     // px, worst case without noise (8-bit rounding)
+constexpr double kMinFoundFraction = 0.99;  // proper stripes must be found
+
+constexpr double kPsf = 0.8;  // px, optical blur of the test stripes
+constexpr double kBackground = 30.0;
+constexpr double kContrast = 60.0;  // box height above the ground
+constexpr double kNoise = 3.0;
+constexpr double kSlope = 0.073;  // px per row: every sub-pixel phase occurs
+
+struct Accuracy {
+  double rms = 0.0;
+  double worst = 0.0;
+  double found = 0.0;  // fraction of rows with an answer
+};
+
+// Measures StripeCentreInRow (or, on the transposed image, ...InColumn)
+// along a slanted stripe; the approximate position is off by up to 1.5 px.
+Accuracy Measure(double width, double noise, bool columns, std::uint32_t seed) {
+  const cv::Size size(64, 160);
+  const double x0 = 28.3;
+  cv::Mat image = testing::RenderSlantedStripe(size, x0, kSlope, width, kPsf, kBackground,
+                                               kContrast, noise, seed);
+  if (columns) image = image.t();
+  std::mt19937 rng(seed + 1000);
+  std::uniform_real_distribution<double> offset(-1.5, 1.5);
+  double sum_sq = 0.0, worst = 0.0;
+  int found = 0, total = 0;
+  for (int i = 2; i < size.height - 2; ++i) {
+    const double truth = x0 + kSlope * i;
+    const double guess = truth + offset(rng);
+    const auto c =
+        columns ? StripeCentreInColumn(image, i, guess) : StripeCentreInRow(image, i, guess);
+    ++total;
+    if (!c) continue;
+    ++found;
+    const double e = *c - truth;
+    sum_sq += e * e;
+    worst = std::max(worst, std::abs(e));
+  }
+  return {std::sqrt(sum_sq / std::max(found, 1)), worst, static_cast<double>(found) / total};
+}
+
+TEST(StripeCentre, RmsErrorMeetsTheTargetForWidthsOneToTen) {
+  for (double width : {1.0, 2.0, 3.0, 6.0, 10.0}) {
+    const Accuracy a = Measure(width, kNoise, /*columns=*/false, 17);
+    std::cout << "[ stripe centre ] width " << width << " px: RMS " << a.rms << " px, worst "
+              << a.worst << " px, found " << a.found << "\n";
+    EXPECT_LE(a.rms, kRmsTarget) << "width " << width;
+    EXPECT_GE(a.found, kMinFoundFraction) << "width " << width;
+  }
+}
+
+TEST(StripeCentre, ColumnVersionMeasuresHorizontalStripesAsWell) {
+  for (double width : {1.0, 3.0, 10.0}) {
+    const Accuracy a = Measure(width, kNoise, /*columns=*/true, 23);
+    EXPECT_LE(a.rms, kRmsTarget) << "width " << width;
+    EXPECT_GE(a.found, kMinFoundFraction) << "width " << width;
+  }
+}
+
+TEST(StripeCentre, NoPixelLockingWithoutNoise) {
+  // Without noise only the method's own bias remains (8-bit rounding included).
+  for (double width : {1.0, 2.0, 3.0, 6.0, 10.0}) {
+    const Accuracy a = Measure(width, 0.0, false, 5);
+    EXPECT_LE(a.worst, kNoiseFreeBias) << "width " << width;
+  }
+}
+
+TEST(StripeCentre, NeighbouringStripesThirteenPixelsApartBarelyBias) {
+  // A second stripe on one side only, 13 px away, widths up to 6 px.
+  for (double width : {2.0, 4.0, 6.0}) {
+    const auto a = testing::RenderStripeProfile(80, 30.4, width, kPsf, kBackground, kContrast);
+    const auto b = testing::RenderStripeProfile(80, 43.4, width, kPsf, 0.0, kContrast);
+    std::vector<double> both(a.size());
+    for (size_t i = 0; i < a.size(); ++i) both[i] = a[i] + b[i];
+    const auto m = MeasureStripeProfile(both, 30.0, {});
+    ASSERT_TRUE(m.has_value()) << width;
+    EXPECT_NEAR(m->centre, 30.4, 0.03) << width;
+  }
+}
+
+TEST(StripeCentre, ProfileMeasurementReportsWidthAndContrast) {
+  const auto p = testing::RenderStripeProfile(60, 25.25, 6.0, kPsf, kBackground, kContrast);
+  const auto m = MeasureStripeProfile(p, 26.0, {});
+  ASSERT_TRUE(m.has_value());
+  EXPECT_NEAR(m->centre, 25.25, 0.01);
+  EXPECT_NEAR(m->width, 6.0, 1.0);
+  EXPECT_NEAR(m->contrast, kContrast, 6.0);
+}
+
+TEST(StripeCentre, NoAnswerWhereThereIsNoRidge) {
+  const StripeCentreParams params;
+  // Flat.
+  EXPECT_FALSE(MeasureStripeProfile(std::vector<double>(40, 50.0), 20.0, params).has_value());
+  // A step edge.
+  std::vector<double> step(40, 20.0);
+  for (size_t i = 20; i < step.size(); ++i) step[i] = 140.0;
+  EXPECT_FALSE(MeasureStripeProfile(step, 20.0, params).has_value());
+  // A stripe whose peak lies outside the search radius.
+  const auto far = testing::RenderStripeProfile(60, 35.0, 3.0, kPsf, kBackground, kContrast);
+  EXPECT_FALSE(MeasureStripeProfile(far, 25.0, params).has_value());
+  // Too weak.
+  const auto weak = testing::RenderStripeProfile(60, 30.0, 3.0, kPsf, kBackground, 5.0);
+  EXPECT_FALSE(MeasureStripeProfile(weak, 30.0, params).has_value());
+  // Too wide to be a stripe (a bright plateau of 30 px).
+  const auto plateau = testing::RenderStripeProfile(120, 60.0, 30.0, kPsf, kBackground, kContrast);
+  EXPECT_FALSE(MeasureStripeProfile(plateau, 60.0, params).has_value());
+  // Approximate position outside the image.
+  const cv::Mat image = testing::RenderSlantedStripe({40, 10}, 20, 0, 3, kPsf, 30, 60, 0, 1);
+  EXPECT_FALSE(StripeCentreInRow(image, 5, -3.0).has_value());
+  EXPECT_FALSE(StripeCentreInRow(image, 5, 45.0).has_value());
+}
+
+TEST(StripeCentre, InvalidInputsGiveTheDocumentedError) {
+  const cv::Mat empty;
+  const cv::Mat colour(8, 8, CV_8UC3, cv::Scalar::all(1));
+  const cv::Mat wide(8, 8, CV_16UC1, cv::Scalar(1));
+  for (const cv::Mat* bad : {&empty, &colour, &wide}) {
+    ExpectInvalid([&] { StripeCentreInRow(*bad, 2, 3.0); }, "StripeCentreInRow");
+    ExpectInvalid([&] { StripeCentreInColumn(*bad, 2, 3.0); }, "StripeCentreInColumn");
+  }
+  const cv::Mat ok(8, 8, CV_8UC1, cv::Scalar(1));
+  ExpectInvalid([&] { StripeCentreInRow(ok, 8, 3.0); }, "StripeCentreInRow");
+  ExpectInvalid([&] { StripeCentreInColumn(ok, -1, 3.0); }, "StripeCentreInColumn");
+  StripeCentreParams bad;
+  bad.along_radius = 9;
+  ExpectInvalid([&] { StripeCentreInRow(ok, 2, 3.0, bad); }, "StripeCentreInRow");
+  // A float image is accepted.
+  cv::Mat f;
+  ok.convertTo(f, CV_32F);
+  EXPECT_NO_THROW(StripeCentreInRow(f, 2, 3.0));
+}
+
+}  // namespace
+}  // namespace bsls::extraction
