@@ -205,7 +205,7 @@ std::optional<cv::Point2d> RefineJunction(const cv::Mat& grey, const LineCentres
         const double den = 1.0 - e * b2;
         if (std::abs(den) < 1e-6) return false;
         *out = (c + e * (a2 - a) - e * b2 * y0) / den;
-        return std::abs(*out - y0) <= 2.0 * params.junction_clearance;
+        return std::abs(*out - y0) <= params.junction_clearance + 1.0;
       };
       // A line may fold at its junction (the lips): then the branches above
       // and below meet the segment each on its own, and the junction lies

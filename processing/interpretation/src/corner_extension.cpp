@@ -28,10 +28,12 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
     return false;
   };
   std::vector<cv::Point> stub;
-  for (int k = 1; k <= params.stub; ++k) {
+  for (int k = 1; static_cast<int>(stub.size()) < params.stub && k <= params.stub + 4; ++k) {
     const cv::Point q(cvRound(corner.x + k * dir.x), cvRound(corner.y + k * dir.y));
-    if (q.x < 0 || q.y < 0 || q.x >= skeleton.cols || q.y >= skeleton.rows || IsSet(skeleton, q))
-      return false;
+    if (q.x < 0 || q.y < 0 || q.x >= skeleton.cols || q.y >= skeleton.rows) return false;
+    // Pixels of the corner's own cluster are passed over.
+    if (std::find(own.begin(), own.end(), q) != own.end()) continue;
+    if (IsSet(skeleton, q)) return false;
     for (int c = 0; c < 8; ++c) {
       const cv::Point r = q + CodeStep(c);
       if (IsSet(skeleton, r) && !near_own(r) && !(!stub.empty() && r == stub.back()) &&
@@ -40,6 +42,7 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
     }
     stub.push_back(q);
   }
+  if (static_cast<int>(stub.size()) < params.stub) return false;
   for (const cv::Point& q : stub) skeleton.at<uchar>(q) = 255;
   return true;
 }
@@ -70,6 +73,9 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
       line_dir = d1;
     else
       continue;
+    // The segment must end on a line (a junction), not run off along an outline.
+    const int segment = line_dir == d0 ? node.rotation[1] : node.rotation[0];
+    if (graph.nodes()[graph.Target(segment)].kind != NodeKind::kJunction) continue;
     const cv::Point corner(cvRound(node.centre.x), cvRound(node.centre.y));
     if (AddStub(corner, -line_dir, node.pixels, params, skeleton)) corners.push_back(corner);
   }
@@ -79,15 +85,19 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     int best = -1;
     double best_turn = 0;
     cv::Point2d best_vertical;
+    bool segment_after = false;  // the segment leg is the part after the corner
     for (int i = params.leg; i + params.leg < n; ++i) {
       const cv::Point2d in(px[i] - px[i - params.leg]);
       const cv::Point2d out(px[i + params.leg] - px[i]);
       const double lin = LeanDeg(in), lout = LeanDeg(out);
       cv::Point2d vertical_towards_corner;
+      bool after;
       if (lin <= params.leg_tolerance_deg && lout >= 90 - params.leg_tolerance_deg) {
         vertical_towards_corner = in;  // from the line into the corner
+        after = true;
       } else if (lout <= params.leg_tolerance_deg && lin >= 90 - params.leg_tolerance_deg) {
         vertical_towards_corner = -out;
+        after = false;
       } else {
         continue;
       }
@@ -96,9 +106,13 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
         best_turn = turn;
         best = i;
         best_vertical = vertical_towards_corner;
+        segment_after = after;
       }
     }
     if (best < 0) continue;
+    // The segment must end on a line (a junction), not run off along an outline.
+    const int segment_end = segment_after ? edge.to : edge.from;
+    if (graph.nodes()[segment_end].kind != NodeKind::kJunction) continue;
     // The stub goes on along the line, beyond the corner.
     const cv::Point corner = px[best];
     if (!AddStub(corner, best_vertical, {corner}, params, skeleton)) continue;

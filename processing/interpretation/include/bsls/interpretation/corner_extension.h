@@ -22,7 +22,8 @@ namespace bsls::interpretation {
 struct CornerParams {
   int leg = 5;                   // px of each leg used to measure its direction
   double leg_tolerance_deg = 30; // how far a leg may lean from vertical / horizontal
-  int stub = 2;                  // px added along the line beyond the corner
+  int stub = 3;                  // px added along the line beyond the corner (a shorter
+                                 // stub melts into the corner's pixel cluster)
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;
