@@ -107,9 +107,10 @@ INSTANTIATE_TEST_SUITE_P(
 
 class Faces : public ::testing::TestWithParam<Side> {};
 
-// Simulated faces with eyebrow patches and noise: no junction with a wrong p.
-// The issue asks for >= 98 % recall and <= 0.15 px line RMS; these bounds are
-// what the decoder reaches today (see docs/decoding.md) and must not regress.
+// Simulated faces with eyebrow patches and noise: no junction with a wrong p,
+// line centres within 0.15 px RMS. The issue asks for >= 98 % recall; 96.5 %
+// is what the decoder reaches today on every seed tried (docs/decoding.md)
+// and must not regress.
 TEST_P(Faces, LabelsAreRightAndCentresSubPixel) {
   const Side side = GetParam();
   for (std::uint32_t seed : {1u, 2u}) {
@@ -119,8 +120,8 @@ TEST_P(Faces, LabelsAreRightAndCentresSubPixel) {
     const Evaluation e = Evaluate(frame, r);
     EXPECT_EQ(e.all.wrong_p, 0) << e.all.Summary();
     EXPECT_EQ(e.all.wrong_v, 0) << e.all.Summary();
-    EXPECT_GE(e.all.Recall(), 0.96) << e.all.Summary();
-    EXPECT_LE(e.line_rms, 0.21) << "points " << e.line_points;
+    EXPECT_GE(e.all.Recall(), 0.965) << e.all.Summary();
+    EXPECT_LE(e.line_rms, 0.15) << "points " << e.line_points;
     EXPECT_GT(e.line_points, 4000);
   }
 }

@@ -89,6 +89,7 @@ std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s)
 struct LineCentres {
   std::map<int, double> measured;  // row -> sub-pixel x, outliers removed
   std::map<int, double> skeleton;  // row -> mean x of the line's skeleton pixels
+  std::map<int, double> slope;     // row -> |dx/dy| of the skeleton there
   std::set<int> skipped;           // rows crossed but not measured (beside a segment)
 };
 
@@ -108,6 +109,16 @@ bool SegmentNearby(const cv::Mat& skeleton, const std::set<std::pair<int, int>>&
   return false;
 }
 
+// |dx/dy| of a line's skeleton over three rows each side of row y (0 when unknown).
+double LocalSlope(const std::map<int, double>& skeleton, int y) {
+  const auto a = skeleton.lower_bound(y - 3);
+  const auto b = skeleton.upper_bound(y + 3);
+  if (a == skeleton.end() || b == skeleton.begin()) return 0.0;
+  const auto last = std::prev(b);
+  if (last->first <= a->first) return 0.0;
+  return std::abs((last->second - a->second) / (last->first - a->first));
+}
+
 // Sub-pixel centres of one labelled line, one per row its skeleton crosses.
 // Rows beside a segment are skipped (the segment's light biases them), and a
 // centre far from the fit of its neighbours is dropped as an outlier.
@@ -124,12 +135,20 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
     }
   }
   LineCentres out;
+  for (const auto& [y, range] : span)
+    if (range.second - range.first <= 2) out.skeleton[y] = 0.5 * (range.first + range.second);
   for (const auto& [y, range] : span) {
     const auto [lo, hi] = range;
-    if (hi - lo <= 2) out.skeleton[y] = 0.5 * (lo + hi);
+    // A steep line's row profile is wide, so a segment biases more rows of it.
+    const double slope = LocalSlope(out.skeleton, y);
+    out.slope[y] = slope;
+    const int clearance =
+        params.junction_clearance +
+        static_cast<int>(std::lround(2.0 * params.junction_clearance *
+                                     std::max(0.0, slope - params.max_fill_slope)));
     const int x = (lo + hi) / 2;
     // A row where the skeleton runs sideways is a segment, not the line.
-    if (hi - lo > 2 || SegmentNearby(skeleton, own, x, y, params.junction_clearance)) {
+    if (hi - lo > 2 || SegmentNearby(skeleton, own, x, y, clearance)) {
       out.skipped.insert(y);
       continue;
     }
@@ -236,6 +255,7 @@ bool DecodeParams::IsValid(std::string* error) const {
   };
   if (junction_fit_rows < 2 || junction_fit_rows > 50) return fail("junction_fit_rows must lie in 2..50");
   if (segment_fit_columns < 2) return fail("segment_fit_columns must be at least 2");
+  if (!(max_fill_slope >= 0)) return fail("max_fill_slope must not be negative");
   if (junction_clearance < 0 || junction_clearance >= junction_fit_rows)
     return fail("junction_clearance must lie in 0..junction_fit_rows-1");
   if (min_dynamic_range < 0 || max_saturated_fraction <= 0 || max_saturated_fraction > 1)
@@ -308,6 +328,9 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     const LineCentres& lc = centres[line.p];
     std::map<int, double> points = lc.measured;
     for (int y : lc.skipped) {
+      // Rows of a steep stretch are not invented: its fit is not good enough.
+      const auto slope = lc.slope.find(y);
+      if (slope != lc.slope.end() && slope->second > params.max_fill_slope) continue;
       std::vector<std::pair<double, double>> s;
       bool above = false, below = false;
       for (auto it = lc.measured.lower_bound(y - params.junction_fit_rows);
