@@ -89,7 +89,7 @@ TEST_P(TestObjects, EveryJunctionRightlyLabelled) {
   const Evaluation e = Evaluate(frame, r);
   EXPECT_EQ(e.inner.found, e.inner.truth) << Name(c) << ": " << e.inner.Summary();
   EXPECT_EQ(e.all.Wrong(), 0) << Name(c) << ": " << e.all.Summary();
-  EXPECT_GE(e.all.Recall(), 0.96) << Name(c) << ": " << e.all.Summary();
+  EXPECT_GE(e.all.Recall(), 0.98) << Name(c) << ": " << e.all.Summary();
   EXPECT_EQ(e.all.v_offset % 2, 0);
   EXPECT_LE(e.line_rms, 0.1) << Name(c);
   EXPECT_GT(e.line_points, 5000) << Name(c);
@@ -108,7 +108,7 @@ INSTANTIATE_TEST_SUITE_P(
 class Faces : public ::testing::TestWithParam<Side> {};
 
 // Simulated faces with eyebrow patches and noise: no junction with a wrong p,
-// line centres within 0.15 px RMS. The issue asks for >= 98 % recall; 96.5 %
+// line centres within 0.15 px RMS. The issue asks for >= 98 % recall; 97.4 %
 // is what the decoder reaches today on every seed tried (docs/decoding.md)
 // and must not regress.
 TEST_P(Faces, LabelsAreRightAndCentresSubPixel) {
@@ -120,7 +120,7 @@ TEST_P(Faces, LabelsAreRightAndCentresSubPixel) {
     const Evaluation e = Evaluate(frame, r);
     EXPECT_EQ(e.all.wrong_p, 0) << e.all.Summary();
     EXPECT_EQ(e.all.wrong_v, 0) << e.all.Summary();
-    EXPECT_GE(e.all.Recall(), 0.965) << e.all.Summary();
+    EXPECT_GE(e.all.Recall(), 0.97) << e.all.Summary();
     EXPECT_LE(e.line_rms, 0.15) << "points " << e.line_points;
     EXPECT_GT(e.line_points, 4000);
   }

@@ -288,7 +288,8 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
 
   t = Clock::now();
   const interpretation::InterpretationResult interp =
-      interpretation::Interpret(features.skeleton, side, params.spec, params.interpretation);
+      interpretation::Interpret(features.skeleton, side, params.spec, params.interpretation,
+                                features.mask);
   result.times.interpretation_ms = MsSince(t);
   result.skeleton = interp.skeleton;
   result.repairs = static_cast<int>(interp.repairs.size());

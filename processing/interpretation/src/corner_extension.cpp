@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "bsls/interpretation/chain_code.h"
 
@@ -20,7 +21,7 @@ bool IsSet(const cv::Mat& sk, cv::Point p) {
 // Draws params.stub pixels from `corner` along `dir` if they touch nothing but
 // the corner (`own` pixels) and each other; returns whether it drew them.
 bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& own,
-             const CornerParams& params, cv::Mat& skeleton) {
+             const CornerParams& params, cv::Mat& skeleton, const cv::Mat& mask) {
   dir *= 1.0 / std::hypot(dir.x, dir.y);
   auto near_own = [&](cv::Point r) {
     for (const cv::Point& o : own)
@@ -34,6 +35,8 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
     // Pixels of the corner's own cluster are passed over.
     if (std::find(own.begin(), own.end(), q) != own.end()) continue;
     if (IsSet(skeleton, q)) return false;
+    // The stroke must show in the image right beyond the corner.
+    if (!mask.empty() && stub.empty() && !IsSet(mask, q)) return false;
     for (int c = 0; c < 8; ++c) {
       const cv::Point r = q + CodeStep(c);
       if (IsSet(skeleton, r) && !near_own(r) && !(!stub.empty() && r == stub.back()) &&
@@ -59,7 +62,9 @@ bool CornerParams::IsValid(std::string* error) const {
 
 // Thesis 5.2.3.3: extending a degree-2 point to degree 3.
 std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerParams& params,
-                                     cv::Mat& skeleton) {
+                                     cv::Mat& skeleton, const cv::Mat& stripe_mask) {
+  if (!stripe_mask.empty() && (stripe_mask.type() != CV_8UC1 || stripe_mask.size() != skeleton.size()))
+    throw std::invalid_argument("ExtendCorners: stripe mask must be CV_8UC1 of the skeleton's size");
   std::vector<cv::Point> corners;
   // A corner may also be a small cluster of pixels (a node with two branches).
   for (const SkeletonNode& node : graph.nodes()) {
@@ -77,46 +82,51 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     const int segment = line_dir == d0 ? node.rotation[1] : node.rotation[0];
     if (graph.nodes()[graph.Target(segment)].kind != NodeKind::kJunction) continue;
     const cv::Point corner(cvRound(node.centre.x), cvRound(node.centre.y));
-    if (AddStub(corner, -line_dir, node.pixels, params, skeleton)) corners.push_back(corner);
+    if (AddStub(corner, -line_dir, node.pixels, params, skeleton, stripe_mask)) corners.push_back(corner);
   }
   for (const SkeletonEdge& edge : graph.edges()) {
     const std::vector<cv::Point>& px = edge.pixels;
     const int n = static_cast<int>(px.size());
-    int best = -1;
-    double best_turn = 0;
-    cv::Point2d best_vertical;
-    bool segment_after = false;  // the segment leg is the part after the corner
+    // Every sharp turn between a vertical and a horizontal leg along the
+    // chain (a chain may hold several, e.g. both top corners of a brick
+    // whose stubs are cut off), the strongest of each run of turning pixels.
+    struct Corner {
+      int index;
+      double turn;
+      cv::Point2d vertical;  // from the line into the corner
+      bool segment_after;    // the segment leg follows the corner along the chain
+    };
+    std::vector<Corner> found;
     for (int i = params.leg; i + params.leg < n; ++i) {
       const cv::Point2d in(px[i] - px[i - params.leg]);
       const cv::Point2d out(px[i + params.leg] - px[i]);
       const double lin = LeanDeg(in), lout = LeanDeg(out);
-      cv::Point2d vertical_towards_corner;
-      bool after;
+      Corner c{i, std::abs(lin - lout), {}, false};
       if (lin <= params.leg_tolerance_deg && lout >= 90 - params.leg_tolerance_deg) {
-        vertical_towards_corner = in;  // from the line into the corner
-        after = true;
+        c.vertical = in;
+        c.segment_after = true;
       } else if (lout <= params.leg_tolerance_deg && lin >= 90 - params.leg_tolerance_deg) {
-        vertical_towards_corner = -out;
-        after = false;
+        c.vertical = -out;
       } else {
         continue;
       }
-      const double turn = std::abs(lin - lout);
-      if (turn > best_turn) {
-        best_turn = turn;
-        best = i;
-        best_vertical = vertical_towards_corner;
-        segment_after = after;
+      if (!found.empty() && i - found.back().index < params.leg) {
+        if (c.turn > found.back().turn) found.back() = c;
+      } else {
+        found.push_back(c);
       }
     }
-    if (best < 0) continue;
-    // The segment must end on a line (a junction), not run off along an outline.
-    const int segment_end = segment_after ? edge.to : edge.from;
-    if (graph.nodes()[segment_end].kind != NodeKind::kJunction) continue;
-    // The stub goes on along the line, beyond the corner.
-    const cv::Point corner = px[best];
-    if (!AddStub(corner, best_vertical, {corner}, params, skeleton)) continue;
-    corners.push_back(corner);
+    for (size_t k = 0; k < found.size(); ++k) {
+      const Corner& c = found[k];
+      // The segment must end on a line: another corner further along it, or
+      // a junction at the chain's end, not run off along an outline.
+      const bool ends_on_line =
+          c.segment_after ? (k + 1 < found.size() || graph.nodes()[edge.to].kind == NodeKind::kJunction)
+                          : (k > 0 || graph.nodes()[edge.from].kind == NodeKind::kJunction);
+      if (!ends_on_line) continue;
+      const cv::Point corner = px[c.index];
+      if (AddStub(corner, c.vertical, {corner}, params, skeleton, stripe_mask)) corners.push_back(corner);
+    }
   }
   return corners;
 }

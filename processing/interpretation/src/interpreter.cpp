@@ -64,8 +64,8 @@ bool InterpretationParams::IsValid(std::string* error) const {
 }
 
 InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
-                               const pattern::PatternSpec& spec,
-                               const InterpretationParams& params) {
+                               const pattern::PatternSpec& spec, const InterpretationParams& params,
+                               const cv::Mat& stripe_mask) {
   if (skeleton.empty() || skeleton.type() != CV_8UC1)
     throw std::invalid_argument("Interpret: skeleton must be a non-empty CV_8UC1 image");
   std::string why;
@@ -86,7 +86,8 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   }
 
   // Thesis 5.2.3.3: corners become junctions with a one-stroke stub.
-  result.corners = ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk);
+  result.corners =
+      ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, stripe_mask);
 
   // Thesis 5.2.3 and 5.1.4: trace boundary and loops, correct, retrace.
   for (int round = 0; params.enable_repair && round < params.max_repair_rounds; ++round) {

@@ -30,9 +30,13 @@ struct CornerParams {
 };
 
 // Finds the corners on the graph's chains and draws their stubs into
-// `skeleton`; returns the corner pixels extended.
+// `skeleton`; returns the corner pixels extended. With a stripe mask (CV_8UC1,
+// non-zero = stripe, e.g. the one the skeleton was thinned from), a stub is
+// drawn only where the mask shows the line going on beyond the corner, i.e.
+// where thinning or pruning lost a short stroke; a corner where a line really
+// turns (along the face's outline) is left alone.
 std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerParams& params,
-                                     cv::Mat& skeleton);
+                                     cv::Mat& skeleton, const cv::Mat& stripe_mask = cv::Mat());
 
 }  // namespace bsls::interpretation
 

@@ -48,11 +48,14 @@ struct InterpretationResult {
 
 // Interprets a skeleton of the brick slide of `side`. A frame whose reference
 // line cannot be found comes back with ok == false and the reason; nothing is
-// guessed. Throws std::invalid_argument for an empty or non-CV_8UC1 skeleton
-// or invalid params.
+// guessed. `stripe_mask` (optional, CV_8UC1 of the same size) is the stripe
+// mask the skeleton was thinned from; it lets corner extension (5.2.3.3) tell
+// a stroke lost in thinning from a line that really turns. Throws
+// std::invalid_argument for an empty or non-CV_8UC1 skeleton or invalid params.
 InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
                                const pattern::PatternSpec& spec,
-                               const InterpretationParams& params = {});
+                               const InterpretationParams& params = {},
+                               const cv::Mat& stripe_mask = cv::Mat());
 
 }  // namespace bsls::interpretation
 
