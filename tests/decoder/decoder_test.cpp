@@ -78,6 +78,9 @@ std::string Name(const SceneCase& c) {
   return std::string(simulator::ToString(c.kind)) + "_" + std::string(pattern::ToString(c.side));
 }
 
+// Readable names in test listings.
+void PrintTo(const SceneCase& c, std::ostream* os) { *os << Name(c); }
+
 class TestObjects : public ::testing::TestWithParam<SceneCase> {};
 
 // Planes, ramp and ball: every junction, no wrong label.

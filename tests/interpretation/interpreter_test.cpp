@@ -134,6 +134,9 @@ constexpr DefectCase kDefects[] = {
     {"large_area", LargeArea, LoopClass::kLargeArea},
 };
 
+// Readable names in test listings.
+void PrintTo(const DefectCase& c, std::ostream* os) { *os << c.name; }
+
 class Table55 : public ::testing::TestWithParam<DefectCase> {};
 
 TEST_P(Table55, RepairRestoresEveryJunctionWithItsLabel) {

@@ -305,21 +305,33 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   const int q_offset = params.q_offset.value_or(0);
   std::map<int, std::vector<const interpretation::LabelledJunction*>> junctions_of_line;
   for (const auto& j : interp.labelling.junctions) junctions_of_line[j.p].push_back(&j);
+  // Lines, then junctions, are measured independently of each other: in
+  // parallel (cv::parallel_for_, OpenCV's thread pool).
+  const auto& lines = interp.labelling.lines;
+  std::vector<LineCentres> measured(lines.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i)
+      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], params);
+  });
   std::map<int, LineCentres> centres;
-  for (const interpretation::LabelledLine& line : interp.labelling.lines)
-    centres[line.p] = MeasureLine(grey, interp.skeleton, line, params);
+  for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);
+  for (const auto& j : interp.labelling.junctions) centres.try_emplace(j.p);  // read-only below
 
   // Junctions: where the line's centre meets its segment's centre.
-  for (const auto& j : interp.labelling.junctions) {
-    DecodedJunction d;
-    d.p = j.p;
-    d.q = j.v + q_offset;
-    d.kind = j.kind;
-    d.interpolated = j.interpolated;
-    d.position = j.position;
-    if (auto refined = RefineJunction(grey, centres[j.p], j, params)) d.position = *refined;
-    result.junctions.push_back(d);
-  }
+  const auto& junctions = interp.labelling.junctions;
+  result.junctions.resize(junctions.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const interpretation::LabelledJunction& j = junctions[i];
+      DecodedJunction& d = result.junctions[i];
+      d.p = j.p;
+      d.q = j.v + q_offset;
+      d.kind = j.kind;
+      d.interpolated = j.interpolated;
+      d.position = j.position;
+      if (auto refined = RefineJunction(grey, centres.at(j.p), j, params)) d.position = *refined;
+    }
+  });
 
   // Lines: measured centres, and the skipped rows filled from the line's own
   // fit where measured rows lie on both sides.
