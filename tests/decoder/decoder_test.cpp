@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
 
 #include "bsls/decoder/decode_output.h"
 #include "bsls/simulator/renderer.h"
@@ -24,10 +23,8 @@ constexpr double kNoiseSigma = 3.0;   // grey levels
 constexpr double kBorderMargin = 10.0;  // px
 
 simulator::Frame RenderFrame(SurfaceKind kind, Side side, std::uint32_t seed) {
-  simulator::ThesisSceneOptions options;
-  const std::filesystem::path data(BSLS_TEST_DATA_DIR);
-  options.face.obj_path = data / "canonical_face_model.obj";
-  options.bunny.json_path = data / "stanford_bunny.json";
+  // The default options find the bundled face in the source tree.
+  const simulator::ThesisSceneOptions options;
   simulator::RenderParams params;
   params.noise_sigma = kNoiseSigma;
   params.seed = seed;

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_options.h"
+
 #include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
@@ -16,14 +18,6 @@ constexpr double kSlideTolerance = 1e-9;         // d
 constexpr double kLineMaximumTolerancePx = 0.3;  // truth line point vs intensity peak
 constexpr double kBrightFraction = 0.6;          // junction grey vs local maximum
 constexpr double kNoiseSigmaTolerance = 0.05;    // relative
-const std::filesystem::path kDataDir = BSLS_TEST_DATA_DIR;
-
-ThesisSceneOptions TestOptions() {
-  ThesisSceneOptions options;
-  options.face.obj_path = kDataDir / "canonical_face_model.obj";
-  options.bunny.json_path = kDataDir / "stanford_bunny.json";
-  return options;
-}
 
 RenderParams NoiselessParams() {
   RenderParams params;

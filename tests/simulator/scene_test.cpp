@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "test_options.h"
+
 #include <algorithm>
 #include <map>
 #include <random>
@@ -14,14 +16,6 @@ namespace {
 using pattern::Side;
 
 constexpr double kPixelTolerance = 1e-9;
-const std::filesystem::path kDataDir = BSLS_TEST_DATA_DIR;
-
-ThesisSceneOptions TestOptions() {
-  ThesisSceneOptions options;
-  options.face.obj_path = kDataDir / "canonical_face_model.obj";
-  options.bunny.json_path = kDataDir / "stanford_bunny.json";
-  return options;
-}
 
 double Median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
