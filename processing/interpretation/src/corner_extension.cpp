@@ -116,14 +116,19 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
         found.push_back(c);
       }
     }
-    for (size_t k = 0; k < found.size(); ++k) {
-      const Corner& c = found[k];
-      // The segment must end on a line: another corner further along it, or
-      // a junction at the chain's end, not run off along an outline.
-      const bool ends_on_line =
-          c.segment_after ? (k + 1 < found.size() || graph.nodes()[edge.to].kind == NodeKind::kJunction)
-                          : (k > 0 || graph.nodes()[edge.from].kind == NodeKind::kJunction);
-      if (!ends_on_line) continue;
+    // True when the chain, walked from index i in direction step, leaves the
+    // horizontal (turns into a line) before it ends, or ends at a junction.
+    auto segment_ends_on_line = [&](int i, int step) {
+      for (int k = i + step * params.leg; k >= 0 && k < n; k += step) {
+        const cv::Point2d d(px[k] - px[k - step * params.leg]);
+        if (LeanDeg(d) < 90 - params.leg_tolerance_deg) return true;
+      }
+      const int end = step > 0 ? edge.to : edge.from;
+      return graph.nodes()[end].kind == NodeKind::kJunction;
+    };
+    for (const Corner& c : found) {
+      // The segment must end on a line, not run off along an outline.
+      if (!segment_ends_on_line(c.index, c.segment_after ? 1 : -1)) continue;
       const cv::Point corner = px[c.index];
       if (AddStub(corner, c.vertical, {corner}, params, skeleton, stripe_mask)) corners.push_back(corner);
     }
