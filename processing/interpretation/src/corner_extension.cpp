@@ -32,10 +32,12 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
   for (int k = 1; static_cast<int>(stub.size()) < params.stub && k <= params.stub + 4; ++k) {
     const cv::Point q(cvRound(corner.x + k * dir.x), cvRound(corner.y + k * dir.y));
     if (q.x < 0 || q.y < 0 || q.x >= skeleton.cols || q.y >= skeleton.rows) return false;
-    // Pixels of the corner's own cluster are passed over.
+    // Pixels of the corner's own cluster are passed over, and so is the
+    // elbow pixel of a 4-connected corner (the skeleton graph leaves it out).
     if (std::find(own.begin(), own.end(), q) != own.end()) continue;
+    if (k == 1 && stub.empty() && IsSet(skeleton, q)) continue;
     if (IsSet(skeleton, q)) return false;
-    // The stroke must show in the image right beyond the corner.
+    // The stroke must show in the image beyond the corner.
     if (!mask.empty() && stub.empty() && !IsSet(mask, q)) return false;
     for (int c = 0; c < 8; ++c) {
       const cv::Point r = q + CodeStep(c);
