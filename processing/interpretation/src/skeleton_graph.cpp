@@ -214,20 +214,18 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
       g.owner_.at<int>(cur) = EncodeEdge(id);
       edge.pixels.push_back(cur);
       cv::Point next(-1, -1);
-      bool reached_node = false;
       // Prefer stepping onto a node pixel (other than the one we came from at
       // the very start) so chains stop at their junction.
       for (int c = 0; c < 8; ++c) {
         const int nx = cur.x + kCodeDx[c], ny = cur.y + kCodeDy[c];
         if (!Inside(deg, nx, ny) || !set(nx, ny) || cv::Point(nx, ny) == prev) continue;
-        const int on = g.owner_.at<int>(ny, nx);
-        if (on >= 0) {
-          if (edge.pixels.size() == 1 && on == node && cv::Point(nx, ny) != start) continue;
+        const int owner = g.owner_.at<int>(ny, nx);
+        if (owner >= 0) {
+          if (edge.pixels.size() == 1 && owner == node && cv::Point(nx, ny) != start) continue;
           next = {nx, ny};
-          reached_node = true;
           break;
         }
-        if (on == kNone) next = {nx, ny};
+        if (owner == kNone) next = {nx, ny};
       }
       if (next.x < 0) {
         // Dead end inside a chain (cannot happen on a thin skeleton): close at an end node.
@@ -238,7 +236,6 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
         edge.to = end;
         break;
       }
-      (void)reached_node;
       prev = cur;
       cur = next;
     }
