@@ -1,5 +1,6 @@
 #include "bsls/interpretation/chain_code.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -20,6 +21,17 @@ int DirectionCode(int dx, int dy) {
   for (int c = 0; c < 8; ++c)
     if (kCodeDx[c] == dx && kCodeDy[c] == dy) return c;
   return -1;
+}
+
+double LeanFromVerticalDeg(cv::Point2d d) {
+  return std::atan2(std::abs(d.x), std::abs(d.y)) * 180.0 / 3.14159265358979323846;
+}
+
+double AngleBetweenDeg(cv::Point2d a, cv::Point2d b) {
+  const double norms = std::hypot(a.x, a.y) * std::hypot(b.x, b.y);
+  if (norms <= 0.0) return 0.0;
+  const double c = (a.x * b.x + a.y * b.y) / norms;
+  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / 3.14159265358979323846;
 }
 
 int DifferenceCode(int code, int next_code) {

@@ -9,15 +9,6 @@
 namespace bsls::interpretation {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-// Degrees a direction leans from vertical.
-double LeanDeg(cv::Point2d d) { return std::atan2(std::abs(d.x), std::abs(d.y)) * 180.0 / kPi; }
-
-bool IsSet(const cv::Mat& sk, cv::Point p) {
-  return p.x >= 0 && p.y >= 0 && p.x < sk.cols && p.y < sk.rows && sk.at<uchar>(p) != 0;
-}
-
 // Draws params.stub pixels from `corner` along `dir` if they touch nothing but
 // the corner (`own` pixels) and each other; returns whether it drew them.
 bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& own,
@@ -35,13 +26,13 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
     // Pixels of the corner's own cluster are passed over, and so is the
     // elbow pixel of a 4-connected corner (the skeleton graph leaves it out).
     if (std::find(own.begin(), own.end(), q) != own.end()) continue;
-    if (k == 1 && stub.empty() && IsSet(skeleton, q)) continue;
-    if (IsSet(skeleton, q)) return false;
+    if (k == 1 && stub.empty() && IsSetPixel(skeleton, q)) continue;
+    if (IsSetPixel(skeleton, q)) return false;
     // The stroke must show in the image beyond the corner.
-    if (!mask.empty() && stub.empty() && !IsSet(mask, q)) return false;
+    if (!mask.empty() && stub.empty() && !IsSetPixel(mask, q)) return false;
     for (int c = 0; c < 8; ++c) {
       const cv::Point r = q + CodeStep(c);
-      if (IsSet(skeleton, r) && !near_own(r) && !(!stub.empty() && r == stub.back()) &&
+      if (IsSetPixel(skeleton, r) && !near_own(r) && !(!stub.empty() && r == stub.back()) &&
           std::find(own.begin(), own.end(), r) == own.end())
         return false;
     }
@@ -74,9 +65,9 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     const cv::Point2d d0 = graph.Departure(node.rotation[0]);
     const cv::Point2d d1 = graph.Departure(node.rotation[1]);
     cv::Point2d line_dir;  // from the corner along the line
-    if (LeanDeg(d0) <= params.leg_tolerance_deg && LeanDeg(d1) >= 90 - params.leg_tolerance_deg)
+    if (LeanFromVerticalDeg(d0) <= params.leg_tolerance_deg && LeanFromVerticalDeg(d1) >= 90 - params.leg_tolerance_deg)
       line_dir = d0;
-    else if (LeanDeg(d1) <= params.leg_tolerance_deg && LeanDeg(d0) >= 90 - params.leg_tolerance_deg)
+    else if (LeanFromVerticalDeg(d1) <= params.leg_tolerance_deg && LeanFromVerticalDeg(d0) >= 90 - params.leg_tolerance_deg)
       line_dir = d1;
     else
       continue;
@@ -102,7 +93,7 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     for (int i = params.leg; i + params.leg < n; ++i) {
       const cv::Point2d in(px[i] - px[i - params.leg]);
       const cv::Point2d out(px[i + params.leg] - px[i]);
-      const double lin = LeanDeg(in), lout = LeanDeg(out);
+      const double lin = LeanFromVerticalDeg(in), lout = LeanFromVerticalDeg(out);
       Corner c{i, std::abs(lin - lout), {}, false};
       if (lin <= params.leg_tolerance_deg && lout >= 90 - params.leg_tolerance_deg) {
         c.vertical = in;
@@ -123,7 +114,7 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     auto segment_ends_on_line = [&](int i, int step) {
       for (int k = i + step * params.leg; k >= 0 && k < n; k += step) {
         const cv::Point2d d(px[k] - px[k - step * params.leg]);
-        if (LeanDeg(d) < 90 - params.leg_tolerance_deg) return true;
+        if (LeanFromVerticalDeg(d) < 90 - params.leg_tolerance_deg) return true;
       }
       const int end = step > 0 ? edge.to : edge.from;
       return graph.nodes()[end].kind == NodeKind::kJunction;

@@ -10,18 +10,6 @@
 namespace bsls::interpretation {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-double AngleBetweenDeg(cv::Point2d a, cv::Point2d b) {
-  const double c = (a.x * b.x + a.y * b.y) / (std::hypot(a.x, a.y) * std::hypot(b.x, b.y));
-  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
-}
-
-// Degrees a direction leans from the vertical axis (0 = straight up or down).
-double LeanFromVerticalDeg(cv::Point2d d) {
-  return std::atan2(std::abs(d.x), std::abs(d.y)) * 180.0 / kPi;
-}
-
 // Pixels on the border of the (2r+1)^2 window, in order around it.
 std::vector<cv::Point> Ring(cv::Point c, int r) {
   std::vector<cv::Point> ring;

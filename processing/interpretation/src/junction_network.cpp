@@ -3,21 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include "bsls/interpretation/chain_code.h"
+
 namespace bsls::interpretation {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-double LeanFromVerticalDeg(cv::Point2d d) {
-  return std::atan2(std::abs(d.x), std::abs(d.y)) * 180.0 / kPi;
-}
-
-double AngleBetweenDeg(cv::Point2d a, cv::Point2d b) {
-  const double c = a.x * b.x + a.y * b.y;  // unit vectors
-  return std::acos(std::clamp(c, -1.0, 1.0)) * 180.0 / kPi;
-}
-
-}  // namespace
 
 JunctionNetwork::JunctionNetwork(const SkeletonGraph& graph, pattern::Side side,
                                  const JunctionParams& params)

@@ -10,10 +10,6 @@
 namespace bsls::interpretation {
 namespace {
 
-bool IsSet(const cv::Mat& sk, cv::Point p) {
-  return p.x >= 0 && p.y >= 0 && p.x < sk.cols && p.y < sk.rows && sk.at<uchar>(p) != 0;
-}
-
 cv::Point2d Normalised(cv::Point2d d) {
   const double n = std::hypot(d.x, d.y);
   return n > 1e-9 ? d * (1.0 / n) : cv::Point2d(0, 0);
@@ -59,7 +55,7 @@ bool FindOverlap(const cv::Mat& sk, pattern::Side side, const ReferenceLineParam
     int vertical = 0;
     for (int dy : {-2, -1, 1, 2})
       for (int dx = -2; dx <= 2; ++dx)
-        if (IsSet(sk, {x + dx, y + dy})) {
+        if (IsSetPixel(sk, {x + dx, y + dy})) {
           ++vertical;
           break;
         }
@@ -117,7 +113,7 @@ class Tracer {
     bool found = false;
     for (int c = 0; c < 8; ++c) {
       const cv::Point q = p + CodeStep(c);
-      if (!IsSet(sk_, q) || visited_.at<uchar>(q)) continue;
+      if (!IsSetPixel(sk_, q) || visited_.at<uchar>(q)) continue;
       const cv::Point2d step = Normalised(cv::Point2d(CodeStep(c)));
       if (step.x * dir.x + step.y * dir.y <= 0.2) continue;
       const cv::Point2d ahead = Normalised(cv::Point2d(Lookahead(q, p) - p));
@@ -142,7 +138,7 @@ class Tracer {
       const cv::Point2d heading = Normalised(cv::Point2d(cur - prev));
       for (int c = 0; c < 8; ++c) {
         const cv::Point r = cur + CodeStep(c);
-        if (r == prev || r == p || !IsSet(sk_, r)) continue;
+        if (r == prev || r == p || !IsSetPixel(sk_, r)) continue;
         const cv::Point2d s = Normalised(cv::Point2d(CodeStep(c)));
         const double score = s.x * heading.x + s.y * heading.y;
         if (score > best) {
@@ -166,7 +162,7 @@ class Tracer {
     for (int dy = -half; dy <= half; ++dy) {
       for (int dx = -half; dx <= half; ++dx) {
         const cv::Point q(p.x + dx, p.y + dy);
-        if (!IsSet(sk_, q) || visited_.at<uchar>(q)) continue;
+        if (!IsSetPixel(sk_, q) || visited_.at<uchar>(q)) continue;
         const double along = dx * dir.x + dy * dir.y;
         const double across = std::abs(dx * dir.y - dy * dir.x);
         if (along < 1.5) continue;

@@ -23,10 +23,6 @@ struct Candidate {
   RepairKind kind = RepairKind::kLineGap;
 };
 
-bool IsSet(const cv::Mat& sk, cv::Point p) {
-  return p.x >= 0 && p.y >= 0 && p.x < sk.cols && p.y < sk.rows && sk.at<uchar>(p) != 0;
-}
-
 // Sideways distance of `target` from the ray (origin, dir); negative `along`
 // means the target lies behind the ray.
 void RayMiss(cv::Point2d origin, cv::Point2d dir, cv::Point2d target, double* along,
@@ -46,12 +42,12 @@ bool ChordIsClear(const cv::Mat& sk, cv::Point a, cv::Point b) {
   };
   for (size_t i = 0; i < chord.size(); ++i) {
     const cv::Point p = chord[i];
-    if (!near_end(p) && IsSet(sk, p)) return false;
+    if (!near_end(p) && IsSetPixel(sk, p)) return false;
     if (i + 1 < chord.size()) {
       const cv::Point q = chord[i + 1];
       if (p.x != q.x && p.y != q.y) {
         const cv::Point c1(p.x, q.y), c2(q.x, p.y);
-        if (!near_end(c1) && !near_end(c2) && IsSet(sk, c1) && IsSet(sk, c2)) return false;
+        if (!near_end(c1) && !near_end(c2) && IsSetPixel(sk, c1) && IsSetPixel(sk, c2)) return false;
       }
     }
   }
@@ -72,14 +68,14 @@ bool Reach(const cv::Mat& sk, const SkeletonGraph& g, const EndInfo& e, double r
   };
   for (size_t i = 1; i < ray.size(); ++i) {
     const cv::Point p = ray[i];
-    if (IsSet(sk, p) && !own(p)) {
+    if (IsSetPixel(sk, p) && !own(p)) {
       *hit = p;
       return true;
     }
     const cv::Point q = ray[i - 1];
     if (p.x != q.x && p.y != q.y) {
       const cv::Point c1(q.x, p.y), c2(p.x, q.y);
-      if (IsSet(sk, c1) && IsSet(sk, c2) && !own(c1) && !own(c2)) {
+      if (IsSetPixel(sk, c1) && IsSetPixel(sk, c2) && !own(c1) && !own(c2)) {
         *hit = c1;
         return true;
       }

@@ -11,7 +11,7 @@
 #include <string_view>
 #include <vector>
 
-#include <opencv2/core/types.hpp>
+#include <opencv2/core.hpp>
 
 namespace bsls::interpretation {
 
@@ -29,6 +29,17 @@ int DirectionCode(int dx, int dy);
 
 // The step of a code.
 inline cv::Point CodeStep(int code) { return {kCodeDx[code & 7], kCodeDy[code & 7]}; }
+
+// True when p lies inside `image` (CV_8UC1) and is non-zero there.
+inline bool IsSetPixel(const cv::Mat& image, cv::Point p) {
+  return p.x >= 0 && p.y >= 0 && p.x < image.cols && p.y < image.rows && image.at<uchar>(p) != 0;
+}
+
+// Degrees a direction leans from the vertical image axis (0 = straight up or down).
+double LeanFromVerticalDeg(cv::Point2d direction);
+
+// Degrees between two directions (0..180); the vectors need not be unit length.
+double AngleBetweenDeg(cv::Point2d a, cv::Point2d b);
 
 // Thesis eq. 5.4: difference code d_i of consecutive codes, in -3..4 (4 = reversal).
 int DifferenceCode(int code, int next_code);
