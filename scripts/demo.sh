@@ -22,5 +22,6 @@ for side in left right; do
     -o "$out/face_${side}.png" --truth "$out/face_${side}_truth.json"
   "$bsls" process "$out/face_${side}.png" --side "$side" \
     --junctions "$out/face_${side}_junctions.json" --overlay "$out/face_${side}_overlay.png"
+  "$bsls" evaluate "$out/face_${side}_junctions.json" "$out/face_${side}_truth.json"
 done
 echo "demo: results in $out"

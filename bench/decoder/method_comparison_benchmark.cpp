@@ -16,7 +16,7 @@
 #include "bsls/decoder/decoder.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
-#include "bsls/testing/label_evaluation.h"
+#include "bsls/simulator/evaluation.h"
 
 namespace {
 
@@ -49,19 +49,13 @@ void BM_Method(benchmark::State& state) {
     r = bsls::decoder::Decode(frame.image, Side::kLeft, params);
     ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
   }
-  std::vector<bsls::testing::PointLabel> truth, decoded;
-  for (const auto& j : frame.truth.junctions)
-    if (j.visible) truth.push_back({j.p, j.v, {j.image.x(), j.image.y()}});
+  std::vector<bsls::simulator::PointLabel> decoded;
   for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
-  const auto score = bsls::testing::ScoreLabels(truth, decoded, 2.5);
-  std::vector<bsls::testing::LinePoints> truth_lines, decoded_lines;
-  for (const auto& line : frame.truth.lines) {
-    bsls::testing::LinePoints l{line.p, {}};
-    for (const auto& p : line.points) l.points.emplace_back(p.x(), p.y());
-    truth_lines.push_back(std::move(l));
-  }
+  const auto score =
+      bsls::simulator::ScoreLabels(bsls::simulator::VisibleJunctions(frame.truth), decoded, 2.5);
+  std::vector<bsls::simulator::LinePoints> decoded_lines;
   for (const auto& line : r.lines) decoded_lines.push_back({line.p, line.points});
-  const auto lines = bsls::testing::ScoreLines(truth_lines, decoded_lines);
+  const auto lines = bsls::simulator::ScoreLines(bsls::simulator::TruthLines(frame.truth), decoded_lines);
   std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
   state.counters["recall"] = score.Recall();
   state.counters["wrong"] = score.Wrong();

@@ -42,6 +42,8 @@ class CommandError : public std::runtime_error {
 void AddProcessCommand(CLI::App& app);
 // Adds `bsls simulate` to the application.
 void AddSimulateCommand(CLI::App& app);
+// Adds `bsls evaluate` to the application.
+void AddEvaluateCommand(CLI::App& app);
 
 }  // namespace bsls::cli
 

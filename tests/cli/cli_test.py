@@ -104,6 +104,21 @@ class CliTest(unittest.TestCase):
         self.assertGreater(os.path.getsize(overlay), 10000)
         self.assertIn("junctions", r.stdout)
 
+    def test_evaluate_scores_the_decode_against_the_truth(self):
+        out = self.path("e.json")
+        self.assertEqual(run("process", self.frame, "--side", "left", "--junctions", out).returncode,
+                         EXIT_OK)
+        r = run("evaluate", out, self.truth, "--json")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        score = json.loads(r.stdout)
+        self.assertGreaterEqual(score["recall"], 0.95)
+        self.assertEqual(score["wrong_p"], 0)
+        self.assertEqual(score["wrong_q"], 0)
+        self.assertLessEqual(score["line_rms_px"], 0.15)
+        r = run("evaluate", out, self.frame)  # a PNG is no truth file
+        self.assertEqual(r.returncode, EXIT_INPUT)
+        self.assertIn("not valid JSON", r.stderr)
+
     def test_json_summary_for_scripts(self):
         r = run("process", self.frame, "--side", "left", "--junctions", self.path("s.json"), "--json")
         self.assertEqual(r.returncode, EXIT_OK, r.stderr)

@@ -8,7 +8,7 @@
 #include "bsls/decoder/decode_output.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
-#include "bsls/testing/label_evaluation.h"
+#include "bsls/simulator/evaluation.h"
 
 namespace bsls::decoder {
 namespace {
@@ -32,35 +32,28 @@ simulator::Frame RenderFrame(SurfaceKind kind, Side side, std::uint32_t seed) {
 }
 
 struct Evaluation {
-  testing::LabelScore inner;  // junctions clear of the image border
-  testing::LabelScore all;    // every lit and visible junction
+  simulator::LabelScore inner;  // junctions clear of the image border
+  simulator::LabelScore all;    // every lit and visible junction
   double line_rms = 0.0;      // px, decoded line points against the true crossings
   int line_points = 0;
 };
 
 Evaluation Evaluate(const simulator::Frame& frame, const DecodeResult& r) {
-  std::vector<testing::PointLabel> truth_all, truth_inner, decoded;
+  const std::vector<simulator::PointLabel> truth_all = simulator::VisibleJunctions(frame.truth);
+  std::vector<simulator::PointLabel> truth_inner, decoded;
   const double w = frame.image.cols, h = frame.image.rows;
-  for (const auto& j : frame.truth.junctions) {
-    if (!j.visible) continue;
-    const testing::PointLabel l{j.p, j.v, {j.image.x(), j.image.y()}};
-    truth_all.push_back(l);
-    if (j.image.x() >= kBorderMargin && j.image.y() >= kBorderMargin &&
-        j.image.x() <= w - 1 - kBorderMargin && j.image.y() <= h - 1 - kBorderMargin)
+  for (const simulator::PointLabel& l : truth_all)
+    if (l.position.x >= kBorderMargin && l.position.y >= kBorderMargin &&
+        l.position.x <= w - 1 - kBorderMargin && l.position.y <= h - 1 - kBorderMargin)
       truth_inner.push_back(l);
-  }
   for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
   Evaluation e;
-  e.all = testing::ScoreLabels(truth_all, decoded, kMatchReach);
-  e.inner = testing::ScoreLabels(truth_inner, decoded, kMatchReach);
-  std::vector<testing::LinePoints> truth_lines, decoded_lines;
-  for (const auto& line : frame.truth.lines) {
-    testing::LinePoints l{line.p, {}};
-    for (const auto& p : line.points) l.points.emplace_back(p.x(), p.y());
-    truth_lines.push_back(std::move(l));
-  }
+  e.all = simulator::ScoreLabels(truth_all, decoded, kMatchReach);
+  e.inner = simulator::ScoreLabels(truth_inner, decoded, kMatchReach);
+  std::vector<simulator::LinePoints> decoded_lines;
   for (const DecodedLine& line : r.lines) decoded_lines.push_back({line.p, line.points});
-  const testing::LineScore lines = testing::ScoreLines(truth_lines, decoded_lines);
+  const simulator::LineScore lines =
+      simulator::ScoreLines(simulator::TruthLines(frame.truth), decoded_lines);
   e.line_rms = lines.rms;
   e.line_points = lines.points;
   return e;

@@ -7,14 +7,14 @@
 
 #include <cstdlib>
 
-#include "bsls/testing/label_evaluation.h"
+#include "bsls/simulator/evaluation.h"
 #include "bsls/testing/synthetic_brick.h"
 
 namespace bsls::interpretation {
 namespace {
 
 using testing::DrawSyntheticBrick;
-using testing::PointLabel;
+using simulator::PointLabel;
 using testing::SyntheticBrick;
 using testing::SyntheticBrickParams;
 
@@ -32,10 +32,10 @@ std::vector<PointLabel> Decoded(const InterpretationResult& r) {
   return out;
 }
 
-testing::LabelScore InterpretAndScore(const SyntheticBrick& b, InterpretationResult* result = nullptr) {
+simulator::LabelScore InterpretAndScore(const SyntheticBrick& b, InterpretationResult* result = nullptr) {
   InterpretationResult r = Interpret(b.skeleton, b.params.side, b.params.spec);
   EXPECT_TRUE(r.ok) << r.error;
-  const auto score = testing::ScoreLabels(TruthOf(b), Decoded(r), kMatchReach);
+  const auto score = simulator::ScoreLabels(TruthOf(b), Decoded(r), kMatchReach);
   if (result) *result = std::move(r);
   return score;
 }

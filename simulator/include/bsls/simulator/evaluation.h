@@ -1,17 +1,22 @@
-// Test fixture: scores decoded junction labels against ground truth.
+// Scores a decode against the simulator's ground truth: which lit and visible
+// junctions were found, with which labels, and how far the decoded line
+// centres lie from the true ones. Used by the tests, the benchmarks and
+// `bsls evaluate`.
 //
 // Positions are image pixels. q of the decoder is relative (one even offset
 // per image, contracts section 2): the offset is taken from the majority of
 // matched junctions and every junction off that offset counts as wrong.
-#ifndef BSLS_TESTING_LABEL_EVALUATION_H_
-#define BSLS_TESTING_LABEL_EVALUATION_H_
+#ifndef BSLS_SIMULATOR_EVALUATION_H_
+#define BSLS_SIMULATOR_EVALUATION_H_
 
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
-namespace bsls::testing {
+#include "bsls/simulator/ground_truth.h"
+
+namespace bsls::simulator {
 
 struct PointLabel {
   int p = 0;
@@ -50,11 +55,17 @@ struct LineScore {
 // Scores decoded line points against the true crossings of the same row.
 LineScore ScoreLines(const std::vector<LinePoints>& truth, const std::vector<LinePoints>& decoded);
 
+// The lit and visible junctions of a ground truth, labelled with their slide row v.
+std::vector<PointLabel> VisibleJunctions(const GroundTruth& truth);
+
+// The true centre lines of a ground truth.
+std::vector<LinePoints> TruthLines(const GroundTruth& truth);
+
 // Matches each truth junction to the nearest decoded one within `reach` px
 // (each decoded junction used once) and scores the labels.
 LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
                        const std::vector<PointLabel>& decoded, double reach);
 
-}  // namespace bsls::testing
+}  // namespace bsls::simulator
 
-#endif  // BSLS_TESTING_LABEL_EVALUATION_H_
+#endif  // BSLS_SIMULATOR_EVALUATION_H_

@@ -1,11 +1,11 @@
-#include "bsls/testing/label_evaluation.h"
+#include "bsls/simulator/evaluation.h"
 
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
 
-namespace bsls::testing {
+namespace bsls::simulator {
 
 std::string LabelScore::Summary() const {
   std::ostringstream s;
@@ -80,6 +80,23 @@ LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
   return score;
 }
 
+std::vector<PointLabel> VisibleJunctions(const GroundTruth& truth) {
+  std::vector<PointLabel> out;
+  for (const TruthJunction& j : truth.junctions)
+    if (j.visible) out.push_back({j.p, j.v, {j.image.x(), j.image.y()}});
+  return out;
+}
+
+std::vector<LinePoints> TruthLines(const GroundTruth& truth) {
+  std::vector<LinePoints> out;
+  for (const TruthLine& line : truth.lines) {
+    LinePoints l{line.p, {}};
+    for (const auto& p : line.points) l.points.emplace_back(p.x(), p.y());
+    out.push_back(std::move(l));
+  }
+  return out;
+}
+
 LineScore ScoreLines(const std::vector<LinePoints>& truth, const std::vector<LinePoints>& decoded) {
   std::map<int, std::multimap<long, double>> rows;
   for (const LinePoints& line : truth)
@@ -101,4 +118,4 @@ LineScore ScoreLines(const std::vector<LinePoints>& truth, const std::vector<Lin
   return score;
 }
 
-}  // namespace bsls::testing
+}  // namespace bsls::simulator

@@ -1,0 +1,91 @@
+// bsls evaluate: scores a decode (contracts section 5 JSON) against the
+// ground truth `bsls simulate --truth` wrote for the same frame.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "bsls/io/frame_file.h"
+#include "bsls/simulator/evaluation.h"
+#include "command.h"
+
+namespace bsls::cli {
+namespace {
+
+struct EvaluateOptions {
+  std::string junctions;
+  std::string truth;
+  double reach = 2.5;
+  bool json = false;
+};
+
+nlohmann::json ReadJson(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw io::InputError(path + ": cannot be opened");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& e) {
+    // The parser's own message quotes the bytes it read, which may be binary.
+    throw io::InputError(path + ": not valid JSON (error at byte " + std::to_string(e.byte) + ")");
+  }
+}
+
+// Junctions and lines of a decode or a truth file; `row_key` is "q" or "v".
+void ReadLabels(const std::string& path, const char* row_key,
+                std::vector<simulator::PointLabel>* junctions,
+                std::vector<simulator::LinePoints>* lines) {
+  const nlohmann::json j = ReadJson(path);
+  try {
+    for (const auto& k : j.at("junctions"))
+      junctions->push_back({k.at("p").get<int>(), k.at(row_key).get<int>(),
+                            {k.at("x").get<double>(), k.at("y").get<double>()}});
+    for (const auto& l : j.at("lines")) {
+      simulator::LinePoints line{l.at("p").get<int>(), {}};
+      for (const auto& pt : l.at("points")) line.points.emplace_back(pt.at(0).get<double>(), pt.at(1).get<double>());
+      lines->push_back(std::move(line));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw io::InputError(path + ": not a " + (row_key[0] == 'q' ? "junctions" : "truth") +
+                         " file: " + e.what());
+  }
+}
+
+void RunEvaluate(const EvaluateOptions& o) {
+  std::vector<simulator::PointLabel> decoded, truth;
+  std::vector<simulator::LinePoints> decoded_lines, truth_lines;
+  ReadLabels(o.junctions, "q", &decoded, &decoded_lines);
+  ReadLabels(o.truth, "v", &truth, &truth_lines);
+  const simulator::LabelScore score = simulator::ScoreLabels(truth, decoded, o.reach);
+  const simulator::LineScore lines = simulator::ScoreLines(truth_lines, decoded_lines);
+  if (o.json) {
+    const nlohmann::json out = {{"truth", score.truth},       {"found", score.found},
+                                {"recall", score.Recall()},   {"wrong_p", score.wrong_p},
+                                {"wrong_q", score.wrong_v},   {"unmatched", score.unmatched},
+                                {"q_offset", score.v_offset}, {"junction_rms_px", score.position_rms},
+                                {"line_points", lines.points}, {"line_rms_px", lines.rms}};
+    std::cout << out.dump() << "\n";
+    return;
+  }
+  std::printf("junctions: %d of %d found (%.1f %%), %d wrong p, %d wrong q, %d not in the truth, "
+              "position RMS %.3f px\nlines: %d points, centre RMS %.3f px\n",
+              score.found, score.truth, 100.0 * score.Recall(), score.wrong_p, score.wrong_v,
+              score.unmatched, score.position_rms, lines.points, lines.rms);
+}
+
+}  // namespace
+
+void AddEvaluateCommand(CLI::App& app) {
+  auto opts = std::make_shared<EvaluateOptions>();
+  CLI::App* cmd = app.add_subcommand(
+      "evaluate", "Score decoded junctions and lines against a simulated frame's ground truth");
+  cmd->add_option("JUNCTIONS", opts->junctions, "Output of bsls process (contracts JSON)")->required();
+  cmd->add_option("TRUTH", opts->truth, "Ground truth written by bsls simulate --truth")->required();
+  cmd->add_option("--reach", opts->reach, "Largest distance (px) of a match (default 2.5)")
+      ->check(CLI::Range(0.1, 50.0));
+  cmd->add_flag("--json", opts->json, "Print the scores as one JSON object");
+  cmd->callback([opts] { RunEvaluate(*opts); });
+}
+
+}  // namespace bsls::cli
