@@ -86,6 +86,17 @@ std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s)
   return c[0];
 }
 
+// The rows of `rows` within `radius` of `centre` and farther than `exclude`
+// from it, as (row - centre, x) pairs for the fits above.
+std::vector<std::pair<double, double>> RowsNear(const std::map<int, double>& rows, double centre,
+                                                int radius, double exclude) {
+  std::vector<std::pair<double, double>> out;
+  for (auto it = rows.lower_bound(cvFloor(centre) - radius);
+       it != rows.end() && it->first <= centre + radius; ++it)
+    if (std::abs(it->first - centre) > exclude) out.push_back({it->first - centre, it->second});
+  return out;
+}
+
 struct LineCentres {
   std::map<int, double> measured;  // row -> sub-pixel x, outliers removed
   std::map<int, double> skeleton;  // row -> mean x of the line's skeleton pixels
@@ -161,10 +172,7 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
   // neighbours within junction_fit_rows.
   std::vector<int> outliers;
   for (const auto& [y, x] : out.measured) {
-    std::vector<std::pair<double, double>> s;
-    for (auto it = out.measured.lower_bound(y - params.junction_fit_rows);
-         it != out.measured.end() && it->first <= y + params.junction_fit_rows; ++it)
-      if (it->first != y) s.push_back({it->first - y, it->second});
+    const auto s = RowsNear(out.measured, y, params.junction_fit_rows, 0.0);
     if (s.size() < 4) continue;
     const auto fit = FitAtZero(s);
     if (fit && std::abs(x - *fit) > params.max_centre_residual) outliers.push_back(y);
@@ -187,17 +195,11 @@ std::optional<cv::Point2d> RefineJunction(const cv::Mat& grey, const LineCentres
   const double y0 = j.position.y;
   // The line as x(y): sub-pixel centres, or where a steep or crowded line has
   // too few of them, its skeleton (within a pixel of the centre).
-  auto near = [&](const std::map<int, double>& rows, int exclude) {
-    std::vector<std::pair<double, double>> out;  // (y - y0, x)
-    for (auto it = rows.lower_bound(cvFloor(y0) - params.junction_fit_rows);
-         it != rows.end() && it->first <= y0 + params.junction_fit_rows; ++it)
-      if (std::abs(it->first - y0) > exclude) out.push_back({it->first - y0, it->second});
-    return out;
-  };
   double a, b;
-  std::vector<std::pair<double, double>> vertical = near(line.measured, 0);
+  std::vector<std::pair<double, double>> vertical =
+      RowsNear(line.measured, y0, params.junction_fit_rows, 0.0);
   if (vertical.size() < 3 || !FitLine(vertical, &a, &b)) {
-    vertical = near(line.skeleton, 1);
+    vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows, 1.0);
     if (vertical.size() < 3 || !FitLine(vertical, &a, &b)) return std::nullopt;
   }
   double y = y0;
@@ -344,13 +346,9 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       // Rows of a steep stretch are not invented: its fit is not good enough.
       const auto slope = lc.slope.find(y);
       if (slope != lc.slope.end() && slope->second > params.max_fill_slope) continue;
-      std::vector<std::pair<double, double>> s;
-      bool above = false, below = false;
-      for (auto it = lc.measured.lower_bound(y - params.junction_fit_rows);
-           it != lc.measured.end() && it->first <= y + params.junction_fit_rows; ++it) {
-        s.push_back({it->first - y, it->second});
-        (it->first < y ? above : below) = true;
-      }
+      const auto s = RowsNear(lc.measured, y, params.junction_fit_rows, 0.0);
+      const bool above = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first < 0; });
+      const bool below = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first > 0; });
       if (!above || !below || s.size() < 4) continue;
       if (const auto fit = FitAtZero(s)) points[y] = *fit;
     }

@@ -2,23 +2,12 @@
 
 #include <stdexcept>
 
-#include <opencv2/imgproc.hpp>
 
+#include "bsls/extraction/pruning.h"
 #include "bsls/interpretation/junction_detect.h"
 
 namespace bsls::interpretation {
 namespace {
-
-// Thesis 4.4: skeleton pieces too small to be part of the pattern.
-void RemoveSmallComponents(cv::Mat& sk, int min_pixels) {
-  cv::Mat labels, stats, centroids;
-  const int n = cv::connectedComponentsWithStats(sk, labels, stats, centroids, 8, CV_32S);
-  std::vector<char> drop(n, 0);
-  for (int i = 1; i < n; ++i) drop[i] = stats.at<int>(i, cv::CC_STAT_AREA) < min_pixels;
-  for (int y = 0; y < sk.rows; ++y)
-    for (int x = 0; x < sk.cols; ++x)
-      if (drop[labels.at<int>(y, x)]) sk.at<uchar>(y, x) = 0;
-}
 
 // Thesis 5.2.3.1 stage 8: a junction whose window shows fewer than three
 // paths is a degree-2 point with a noisy pixel or two; prune its short spurs.
@@ -75,7 +64,9 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   InterpretationResult result;
   cv::Mat sk;
   cv::compare(skeleton, 0, sk, cv::CMP_NE);
-  RemoveSmallComponents(sk, params.min_component_pixels);
+  // Thesis 4.4: skeleton pieces too small to be part of the pattern.
+  if (params.min_component_pixels > 0)
+    sk = extraction::RemoveSmallComponents(sk, params.min_component_pixels);
   PruneFalseJunctions(sk, side, params);
 
   // Thesis 5.2.1: the reference line first, sealed end to end.
