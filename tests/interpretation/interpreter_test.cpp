@@ -2,10 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-
-#include <cstdlib>
 
 #include "bsls/simulator/evaluation.h"
 #include "bsls/testing/synthetic_brick.h"
@@ -13,8 +12,8 @@
 namespace bsls::interpretation {
 namespace {
 
-using testing::DrawSyntheticBrick;
 using simulator::PointLabel;
+using testing::DrawSyntheticBrick;
 using testing::SyntheticBrick;
 using testing::SyntheticBrickParams;
 
@@ -32,7 +31,8 @@ std::vector<PointLabel> Decoded(const InterpretationResult& r) {
   return out;
 }
 
-simulator::LabelScore InterpretAndScore(const SyntheticBrick& b, InterpretationResult* result = nullptr) {
+simulator::LabelScore InterpretAndScore(const SyntheticBrick& b,
+                                        InterpretationResult* result = nullptr) {
   InterpretationResult r = Interpret(b.skeleton, b.params.side, b.params.spec);
   EXPECT_TRUE(r.ok) << r.error;
   const auto score = simulator::ScoreLabels(TruthOf(b), Decoded(r), kMatchReach);
@@ -60,6 +60,37 @@ TEST_P(CleanBrick, EveryJunctionLabelled) {
 
 INSTANTIATE_TEST_SUITE_P(BothSides, CleanBrick,
                          ::testing::Values(pattern::Side::kLeft, pattern::Side::kRight));
+
+// Segments on the image's first row: their T-junctions' upper strokes are
+// cut off by the edge, leaving corners; the frame around the skeleton lets
+// corner extension (5.2.3.3) give them their stubs back.
+TEST(Interpreter, JunctionsOnTheImageEdgeAreLabelled) {
+  SyntheticBrickParams params;
+  params.tilt = 0.0;
+  const SyntheticBrick full = DrawSyntheticBrick(params);
+  const int top = cvRound(full.Map(0, -15).y) - 1;  // row v = -15 lands on image row 1
+  SyntheticBrick b = full;
+  b.skeleton = full.skeleton.rowRange(top, full.skeleton.rows).clone();
+  b.junctions.clear();
+  int on_edge = 0;
+  for (auto j : full.junctions) {
+    j.position.y -= top;
+    if (j.position.y < 0.5) continue;
+    on_edge += j.position.y < 2;
+    b.junctions.push_back(j);
+  }
+  ASSERT_GE(on_edge, 10);
+  const auto score = InterpretAndScore(b);
+  EXPECT_EQ(score.found, score.truth) << score.Summary();
+  EXPECT_EQ(score.Wrong(), 0) << score.Summary();
+
+  InterpretationParams no_frame;
+  no_frame.frame_margin = 0;
+  const InterpretationResult bare = Interpret(b.skeleton, params.side, params.spec, no_frame);
+  ASSERT_TRUE(bare.ok) << bare.error;
+  const auto without = simulator::ScoreLabels(TruthOf(b), Decoded(bare), kMatchReach);
+  EXPECT_LT(without.found, score.found) << "the edge should cost junctions without the frame";
+}
 
 TEST(Interpreter, NoReferenceLineIsReportedNotGuessed) {
   cv::Mat empty = cv::Mat::zeros(256, 256, CV_8UC1);
@@ -147,7 +178,8 @@ TEST_P(Table55, RepairRestoresEveryJunctionWithItsLabel) {
   InterpretationResult r;
   const auto score = InterpretAndScore(b, &r);
   std::string classes;
-  for (const auto& [cls, n] : r.loop_classes) classes += std::string(ToString(cls)) + "=" + std::to_string(n) + " ";
+  for (const auto& [cls, n] : r.loop_classes)
+    classes += std::string(ToString(cls)) + "=" + std::to_string(n) + " ";
   EXPECT_GE(r.loop_classes[c.expected_class], 1) << c.name << ": " << classes;
   EXPECT_FALSE(r.repairs.empty()) << c.name;
   EXPECT_EQ(score.found, score.truth) << c.name << ": " << score.Summary();

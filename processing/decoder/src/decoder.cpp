@@ -4,11 +4,10 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <optional>
 #include <set>
 #include <stdexcept>
-
-#include <opencv2/imgproc.hpp>
 
 namespace bsls::decoder {
 namespace {
@@ -64,14 +63,10 @@ bool FitLine(const std::vector<std::pair<double, double>>& s, double* a, double*
   return true;
 }
 
-// Least-squares x = c0 + c1 t + c2 t^2 through (t, x) samples (a line when
-// there are fewer than five); returns the value at t = 0, or nullopt.
-std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s) {
-  if (s.size() < 5) {
-    double a, b;
-    if (!FitLine(s, &a, &b)) return std::nullopt;
-    return a;
-  }
+// Least-squares x = c0 + c1 t + c2 t^2 through (t, x) samples; false when
+// there are fewer than five or they do not fix a parabola.
+bool FitParabola(const std::vector<std::pair<double, double>>& s, cv::Vec3d* c) {
+  if (s.size() < 5) return false;
   cv::Matx33d ata = cv::Matx33d::zeros();
   cv::Vec3d atb(0, 0, 0);
   for (const auto& [t, x] : s) {
@@ -81,9 +76,17 @@ std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s)
       for (int k = 0; k < 3; ++k) ata(i, k) += row[i] * row[k];
     }
   }
+  return cv::solve(ata, atb, *c, cv::DECOMP_CHOLESKY);
+}
+
+// The value at t = 0 of a parabola through (t, x) samples (a line when there
+// are fewer than five), or nullopt.
+std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s) {
   cv::Vec3d c;
-  if (!cv::solve(ata, atb, c, cv::DECOMP_CHOLESKY)) return std::nullopt;
-  return c[0];
+  if (FitParabola(s, &c)) return c[0];
+  double a, b;
+  if (!FitLine(s, &a, &b)) return std::nullopt;
+  return a;
 }
 
 // The rows of `rows` within `radius` of `centre` and farther than `exclude`
@@ -228,16 +231,31 @@ std::optional<cv::Point2d> RefineJunction(const cv::Mat& grey, const LineCentres
         *out = (c + e * (a2 - a) - e * b2 * y0) / den;
         return std::abs(*out - y0) <= params.junction_clearance + 1.0;
       };
-      // A line may fold at its junction (the lips): then the branches above
-      // and below meet the segment each on its own, and the junction lies
-      // between the two meeting points.
       std::vector<std::pair<double, double>> upper, lower;
       for (const auto& v : vertical) (v.first < 0 ? upper : lower).push_back(v);
       double au, bu, al, bl, yu, yl, ya;
-      if (upper.size() >= 2 && lower.size() >= 2 && FitLine(upper, &au, &bu) &&
-          FitLine(lower, &al, &bl) && meet(au, bu, &yu) && meet(al, bl, &yl)) {
-        const double xu = au + bu * (yu - y0), xl = al + bl * (yl - y0);
-        return cv::Point2d(0.5 * (xu + xl), 0.5 * (yu + yl));
+      const bool branches = upper.size() >= 2 && lower.size() >= 2 && FitLine(upper, &au, &bu) &&
+                            FitLine(lower, &al, &bl);
+      // A line folding at its junction (nose, lips): the branches above and
+      // below meet the segment each on its own, and the junction lies between
+      // the two meeting points.
+      if (branches && std::abs(bu - bl) > params.fold_slope_change) {
+        if (meet(au, bu, &yu) && meet(al, bl, &yl)) {
+          const double xu = au + bu * (yu - y0), xl = al + bl * (yl - y0);
+          return cv::Point2d(0.5 * (xu + xl), 0.5 * (yu + yl));
+        }
+      } else if (cv::Vec3d k; branches && FitParabola(vertical, &k)) {
+        // A line curving smoothly through it: its centres on both sides as a
+        // parabola x = k0 + k1 t + k2 t^2 (t = y - y0), which meets the segment
+        // where e k2 t^2 + (e k1 - 1) t + c + e (k0 - a) - y0 = 0; the root
+        // nearer t = 0, in the form that stays exact as e k2 -> 0.
+        const double qa = e * k[2], qb = e * k[1] - 1.0, qc = c + e * (k[0] - a) - y0;
+        const double disc = qb * qb - 4 * qa * qc;
+        if (disc >= 0) {
+          const double t = 2 * qc / (-qb + std::copysign(std::sqrt(disc), -qb));
+          if (std::abs(t) <= params.junction_clearance + 1.0)
+            return cv::Point2d(k[0] + k[1] * t + k[2] * t * t, y0 + t);
+        }
       }
       if (meet(a, b, &ya)) y = ya;
     }
@@ -255,9 +273,11 @@ bool DecodeParams::IsValid(std::string* error) const {
     if (error) *error = why;
     return false;
   };
-  if (junction_fit_rows < 2 || junction_fit_rows > 50) return fail("junction_fit_rows must lie in 2..50");
+  if (junction_fit_rows < 2 || junction_fit_rows > 50)
+    return fail("junction_fit_rows must lie in 2..50");
   if (segment_fit_columns < 2) return fail("segment_fit_columns must be at least 2");
   if (!(max_fill_slope >= 0)) return fail("max_fill_slope must not be negative");
+  if (!(fold_slope_change > 0)) return fail("fold_slope_change must be positive");
   if (junction_clearance < 0 || junction_clearance >= junction_fit_rows)
     return fail("junction_clearance must lie in 0..junction_fit_rows-1");
   if (min_dynamic_range < 0 || max_saturated_fraction <= 0 || max_saturated_fraction > 1)
@@ -285,13 +305,13 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   }
 
   auto t = Clock::now();
-  const extraction::ExtractionResult features = extraction::ExtractFeatures(grey, params.extraction);
+  const extraction::ExtractionResult features =
+      extraction::ExtractFeatures(grey, params.extraction);
   result.times.extraction_ms = MsSince(t);
 
   t = Clock::now();
-  const interpretation::InterpretationResult interp =
-      interpretation::Interpret(features.skeleton, side, params.spec, params.interpretation,
-                                features.mask);
+  const interpretation::InterpretationResult interp = interpretation::Interpret(
+      features.skeleton, side, params.spec, params.interpretation, features.mask);
   result.times.interpretation_ms = MsSince(t);
   result.skeleton = interp.skeleton;
   result.repairs = static_cast<int>(interp.repairs.size());

@@ -46,8 +46,11 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
 }  // namespace
 
 bool CornerParams::IsValid(std::string* error) const {
-  if (leg < 2 || stub < 1 || leg_tolerance_deg <= 0 || leg_tolerance_deg >= 45) {
-    if (error) *error = "corner params: leg >= 2, stub >= 1, tolerance in (0, 45) degrees";
+  if (leg < 2 || stub < 1 || leg_tolerance_deg <= 0 || leg_tolerance_deg >= 45 ||
+      min_free_segment < 1) {
+    if (error)
+      *error =
+          "corner params: leg >= 2, stub >= 1, min_free_segment >= 1, tolerance in (0, 45) degrees";
     return false;
   }
   return true;
@@ -56,8 +59,10 @@ bool CornerParams::IsValid(std::string* error) const {
 // Thesis 5.2.3.3: extending a degree-2 point to degree 3.
 std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerParams& params,
                                      cv::Mat& skeleton, const cv::Mat& stripe_mask) {
-  if (!stripe_mask.empty() && (stripe_mask.type() != CV_8UC1 || stripe_mask.size() != skeleton.size()))
-    throw std::invalid_argument("ExtendCorners: stripe mask must be CV_8UC1 of the skeleton's size");
+  if (!stripe_mask.empty() &&
+      (stripe_mask.type() != CV_8UC1 || stripe_mask.size() != skeleton.size()))
+    throw std::invalid_argument(
+        "ExtendCorners: stripe mask must be CV_8UC1 of the skeleton's size");
   std::vector<cv::Point> corners;
   // A corner may also be a small cluster of pixels (a node with two branches).
   for (const SkeletonNode& node : graph.nodes()) {
@@ -65,17 +70,22 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     const cv::Point2d d0 = graph.Departure(node.rotation[0]);
     const cv::Point2d d1 = graph.Departure(node.rotation[1]);
     cv::Point2d line_dir;  // from the corner along the line
-    if (LeanFromVerticalDeg(d0) <= params.leg_tolerance_deg && LeanFromVerticalDeg(d1) >= 90 - params.leg_tolerance_deg)
+    if (LeanFromVerticalDeg(d0) <= params.leg_tolerance_deg &&
+        LeanFromVerticalDeg(d1) >= 90 - params.leg_tolerance_deg)
       line_dir = d0;
-    else if (LeanFromVerticalDeg(d1) <= params.leg_tolerance_deg && LeanFromVerticalDeg(d0) >= 90 - params.leg_tolerance_deg)
+    else if (LeanFromVerticalDeg(d1) <= params.leg_tolerance_deg &&
+             LeanFromVerticalDeg(d0) >= 90 - params.leg_tolerance_deg)
       line_dir = d1;
     else
       continue;
     // The segment must end on a line (a junction), not run off along an outline.
     const int segment = line_dir == d0 ? node.rotation[1] : node.rotation[0];
-    if (graph.nodes()[graph.Target(segment)].kind != NodeKind::kJunction) continue;
+    if (graph.nodes()[graph.Target(segment)].kind != NodeKind::kJunction &&
+        (stripe_mask.empty() || graph.Length(segment) < params.min_free_segment))
+      continue;
     const cv::Point corner(cvRound(node.centre.x), cvRound(node.centre.y));
-    if (AddStub(corner, -line_dir, node.pixels, params, skeleton, stripe_mask)) corners.push_back(corner);
+    if (AddStub(corner, -line_dir, node.pixels, params, skeleton, stripe_mask))
+      corners.push_back(corner);
   }
   for (const SkeletonEdge& edge : graph.edges()) {
     const std::vector<cv::Point>& px = edge.pixels;
@@ -117,13 +127,28 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
         if (LeanFromVerticalDeg(d) < 90 - params.leg_tolerance_deg) return true;
       }
       const int end = step > 0 ? edge.to : edge.from;
-      return graph.nodes()[end].kind == NodeKind::kJunction;
+      if (graph.nodes()[end].kind == NodeKind::kJunction) return true;
+      // A free end (the partner line too faint to see): a segment long enough
+      // not to be a hook, when the mask will vouch for the line going on.
+      return !stripe_mask.empty() && (step > 0 ? n - 1 - i : i) >= params.min_free_segment;
     };
     for (const Corner& c : found) {
       // The segment must end on a line, not run off along an outline.
       if (!segment_ends_on_line(c.index, c.segment_after ? 1 : -1)) continue;
-      const cv::Point corner = px[c.index];
-      if (AddStub(corner, c.vertical, {corner}, params, skeleton, stripe_mask)) corners.push_back(corner);
+      // A rounded corner passes the leg test a few pixels before its apex:
+      // the corner is the pixel farthest from the chord across the bend.
+      const int lo = std::max(0, c.index - params.leg), hi = std::min(n - 1, c.index + params.leg);
+      const cv::Point2d chord(px[hi] - px[lo]);
+      int apex = c.index;
+      double farthest = -1;
+      for (int k = lo; k <= hi; ++k) {
+        const cv::Point2d r(px[k] - px[lo]);
+        const double d = std::abs(chord.x * r.y - chord.y * r.x);
+        if (d > farthest) farthest = d, apex = k;
+      }
+      const cv::Point corner = px[apex];
+      if (AddStub(corner, c.vertical, {corner}, params, skeleton, stripe_mask))
+        corners.push_back(corner);
     }
   }
   return corners;

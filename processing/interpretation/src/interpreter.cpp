@@ -1,7 +1,7 @@
 #include "bsls/interpretation/interpreter.h"
 
+#include <opencv2/core.hpp>
 #include <stdexcept>
-
 
 #include "bsls/extraction/pruning.h"
 #include "bsls/interpretation/junction_detect.h"
@@ -35,14 +35,43 @@ int PruneFalseJunctions(cv::Mat& sk, pattern::Side side, const InterpretationPar
   return pruned;
 }
 
+// Moves every point of `r` from the framed skeleton's coordinates into the
+// image's (`image` is where the image lies in the frame); pixels that lie in
+// the frame (stubs beyond the image's edge) are dropped.
+void ToImageFrame(const cv::Rect& image, InterpretationResult* r) {
+  const cv::Point o = image.tl();
+  const cv::Rect inside(0, 0, image.width, image.height);
+  auto move_all = [&](std::vector<cv::Point>& pts) {
+    std::vector<cv::Point> kept;
+    kept.reserve(pts.size());
+    for (const cv::Point& p : pts)
+      if (inside.contains(p - o)) kept.push_back(p - o);
+    pts = std::move(kept);
+  };
+  move_all(r->reference.pixels);
+  r->reference.overlap -= o;
+  for (auto& [from, to] : r->reference.fills) from -= o, to -= o;
+  for (Repair& repair : r->repairs) repair.from -= o, repair.to -= o;
+  for (cv::Point& c : r->corners) c -= o;
+  for (LabelledJunction& j : r->labelling.junctions) {
+    j.position -= cv::Point2d(o);
+    move_all(j.segment);
+  }
+  for (LabelledLine& line : r->labelling.lines) move_all(line.pixels);
+}
+
 }  // namespace
 
 bool InterpretationParams::IsValid(std::string* error) const {
-  if (!graph.IsValid(error) || !junction.IsValid(error) || !corners.IsValid(error) || !reference.IsValid(error) ||
-      !repair.IsValid(error) || !labelling.IsValid(error))
+  if (!graph.IsValid(error) || !junction.IsValid(error) || !corners.IsValid(error) ||
+      !reference.IsValid(error) || !repair.IsValid(error) || !labelling.IsValid(error))
     return false;
   if (max_repair_rounds < 0 || max_repair_rounds > 100) {
     if (error) *error = "max_repair_rounds must lie in 0..100";
+    return false;
+  }
+  if (frame_margin < 0 || frame_margin > 64) {
+    if (error) *error = "frame_margin must lie in 0..64";
     return false;
   }
   if (min_component_pixels < 0) {
@@ -62,8 +91,24 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   if (!spec.IsValid(&why)) throw std::invalid_argument("Interpret: pattern: " + why);
 
   InterpretationResult result;
-  cv::Mat sk;
+  // The skeleton inside an empty frame, so that a corner at the image's edge
+  // can take the stub the edge cut off (5.2.3.3); everything is shifted back
+  // into image coordinates at the end.
+  const int m = params.frame_margin;
+  cv::Mat sk, mask;
   cv::compare(skeleton, 0, sk, cv::CMP_NE);
+  cv::copyMakeBorder(sk, sk, m, m, m, m, cv::BORDER_CONSTANT, 0);
+  if (!stripe_mask.empty()) {
+    if (stripe_mask.type() != CV_8UC1 || stripe_mask.size() != skeleton.size())
+      throw std::invalid_argument("Interpret: stripe mask must be CV_8UC1 of the skeleton's size");
+    // Stripes run on beyond the image's edge.
+    cv::copyMakeBorder(stripe_mask, mask, m, m, m, m, cv::BORDER_REPLICATE);
+  }
+  const cv::Rect image(m, m, skeleton.cols, skeleton.rows);
+  auto finish = [&](InterpretationResult& r) {
+    r.skeleton = r.skeleton.empty() ? cv::Mat() : r.skeleton(image).clone();
+    ToImageFrame(image, &r);
+  };
   // Thesis 4.4: skeleton pieces too small to be part of the pattern.
   if (params.min_component_pixels > 0)
     sk = extraction::RemoveSmallComponents(sk, params.min_component_pixels);
@@ -73,12 +118,12 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   if (!TraceReferenceLine(sk, side, params.reference, &result.reference, &why)) {
     result.error = "reference line not found: " + why;
     result.skeleton = sk;
+    finish(result);
     return result;
   }
 
   // Thesis 5.2.3.3: corners become junctions with a one-stroke stub.
-  result.corners =
-      ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, stripe_mask);
+  result.corners = ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, mask);
 
   // Thesis 5.2.3 and 5.1.4: trace boundary and loops, correct, retrace.
   for (int round = 0; params.enable_repair && round < params.max_repair_rounds; ++round) {
@@ -103,9 +148,11 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   if (!LabelNetwork(network, loops, result.reference, spec, params.labelling, &result.labelling,
                     &why)) {
     result.error = "reference line not found: " + why;
+    finish(result);
     return result;
   }
   result.ok = true;
+  finish(result);
   return result;
 }
 

@@ -36,10 +36,14 @@ struct DecodeParams {
   int junction_fit_rows = 7;   // rows each side of a junction fitted to place it
   int segment_fit_columns = 50;  // columns of a segment measured to place its junction
   int junction_clearance = 3;  // px each side of a junction where the other stroke biases centres
+  // px: a line centre further from its neighbours' fit is dropped.
   double max_centre_residual = 0.35;
   // Rows skipped beside a segment are refilled from the line's fit only where
   // the line is steeper than this (|dx/dy|) nowhere near.
-  double max_fill_slope = 0.5;  // px: a line centre further from its neighbours' fit is dropped
+  double max_fill_slope = 0.5;
+  // A line whose slope (dx/dy) above and below a junction differs by more
+  // folds there; otherwise it is fitted as one smooth curve through it.
+  double fold_slope_change = 0.5;
   // A frame whose 1st-99th percentile range is narrower (grey levels) is blank.
   double min_dynamic_range = 16.0;
   // A frame with a larger fraction of pixels at 254-255 is saturated.

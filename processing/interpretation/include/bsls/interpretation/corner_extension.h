@@ -21,9 +21,13 @@ namespace bsls::interpretation {
 
 struct CornerParams {
   int leg = 5;                   // px of each leg used to measure its direction
-  double leg_tolerance_deg = 30; // how far a leg may lean from vertical / horizontal
+  double leg_tolerance_deg = 40; // how far a leg may lean from vertical / horizontal
   int stub = 3;                  // px added along the line beyond the corner (a shorter
                                  // stub melts into the corner's pixel cluster)
+  // px: a segment whose far end is free (its partner line unseen) still makes
+  // a corner when at least this long and the stripe mask shows the line going
+  // on; shorter ones are hooks at line ends.
+  int min_free_segment = 15;
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;

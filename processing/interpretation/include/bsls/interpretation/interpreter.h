@@ -29,6 +29,9 @@ struct InterpretationParams {
   int max_repair_rounds = 8;    // thesis 5.1.4.7: retrace after each correction
   int min_component_pixels = 6; // smaller skeleton pieces are noise (thesis 4.4)
   bool enable_repair = true;    // off: label what is there, seal nothing
+  // px of empty frame put around the skeleton while interpreting, so that a
+  // corner cut by the image's edge can still be extended (at least the stub).
+  int frame_margin = 4;
 
   // True when every part is usable; otherwise says which and why.
   bool IsValid(std::string* error) const;
