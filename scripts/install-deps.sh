@@ -13,6 +13,7 @@ packages=(
   libeigen3-dev
   # files, command line, logging
   nlohmann-json3-dev libcli11-dev libspdlog-dev libyaml-cpp-dev
+  libssl-dev                        # SHA-256 of manifests and frames
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   python3
