@@ -8,6 +8,7 @@
 #include <functional>
 #include <set>
 #include <sstream>
+#include <string>
 
 #include "pinhole_refinement.h"
 #include "point_set_geometry.h"
@@ -148,6 +149,23 @@ int LargestComponent(const Eigen::Vector3d& v) {
   return index;
 }
 
+// True when the settings FitWithRejection takes are usable (the same for
+// every model); otherwise says why, naming the floor distance's field.
+bool RejectionIsValid(double outlier_sigma, int rounds, double min_distance,
+                      const std::string& distance_field, std::string* error) {
+  auto fail = [error](const std::string& why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!std::isfinite(outlier_sigma)) return fail("outlier_sigma must be finite");
+  if (outlier_sigma > 0.0 && outlier_sigma < 1.0)
+    return fail("outlier_sigma must be >= 1 (or <= 0 to disable rejection)");
+  if (rounds < 0) return fail("rejection_rounds must be >= 0");
+  if (!(min_distance >= 0.0) || !std::isfinite(min_distance))
+    return fail(distance_field + " must be finite and >= 0");
+  return true;
+}
+
 }  // namespace
 
 std::optional<Eigen::Vector3d> LightPlane::Intersect(const geometry::Ray& ray) const {
@@ -159,17 +177,8 @@ std::optional<Eigen::Vector3d> LightPlane::Intersect(const geometry::Ray& ray) c
 }
 
 bool StripeFitParams::IsValid(std::string* error) const {
-  auto fail = [error](const char* why) {
-    if (error) *error = why;
-    return false;
-  };
-  if (!std::isfinite(outlier_sigma)) return fail("outlier_sigma must be finite");
-  if (outlier_sigma > 0.0 && outlier_sigma < 1.0)
-    return fail("outlier_sigma must be >= 1 (or <= 0 to disable rejection)");
-  if (rejection_rounds < 0) return fail("rejection_rounds must be >= 0");
-  if (!(min_outlier_distance_mm >= 0.0) || !std::isfinite(min_outlier_distance_mm))
-    return fail("min_outlier_distance_mm must be finite and >= 0");
-  return true;
+  return RejectionIsValid(outlier_sigma, rejection_rounds, min_outlier_distance_mm,
+                          "min_outlier_distance_mm", error);
 }
 
 LightPlane ParallelPlaneModel::PlaneOfLine(double e) const {
@@ -329,17 +338,13 @@ Eigen::Vector2d SlideOfJunction(pattern::Side side, int p, int q) {
 }
 
 bool ProjectorMatrixParams::IsValid(std::string* error) const {
-  auto fail = [error](const char* why) {
-    if (error) *error = why;
+  if (!RejectionIsValid(outlier_sigma, rejection_rounds, min_outlier_distance_d,
+                        "min_outlier_distance_d", error))
     return false;
-  };
-  if (!std::isfinite(outlier_sigma)) return fail("outlier_sigma must be finite");
-  if (outlier_sigma > 0.0 && outlier_sigma < 1.0)
-    return fail("outlier_sigma must be >= 1 (or <= 0 to disable rejection)");
-  if (rejection_rounds < 0) return fail("rejection_rounds must be >= 0");
-  if (!(min_outlier_distance_d >= 0.0) || !std::isfinite(min_outlier_distance_d))
-    return fail("min_outlier_distance_d must be finite and >= 0");
-  if (max_iterations < 1) return fail("max_iterations must be >= 1");
+  if (max_iterations < 1) {
+    if (error) *error = "max_iterations must be >= 1";
+    return false;
+  }
   return true;
 }
 

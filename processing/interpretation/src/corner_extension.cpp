@@ -64,6 +64,14 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     throw std::invalid_argument(
         "ExtendCorners: stripe mask must be CV_8UC1 of the skeleton's size");
   std::vector<cv::Point> corners;
+  // A corner's segment must end on a line (a junction), not run off along an
+  // outline; a free end (the partner line too faint to see) counts for a
+  // segment long enough not to be a hook, when the mask will vouch for the
+  // line going on.
+  auto segment_counts = [&](NodeKind end, int length) {
+    return end == NodeKind::kJunction ||
+           (!stripe_mask.empty() && length >= params.min_free_segment);
+  };
   // A corner may also be a small cluster of pixels (a node with two branches).
   for (const SkeletonNode& node : graph.nodes()) {
     if (node.kind != NodeKind::kJunction || node.rotation.size() != 2) continue;
@@ -78,11 +86,8 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
       line_dir = d1;
     else
       continue;
-    // The segment must end on a line (a junction), not run off along an outline.
     const int segment = line_dir == d0 ? node.rotation[1] : node.rotation[0];
-    if (graph.nodes()[graph.Target(segment)].kind != NodeKind::kJunction &&
-        (stripe_mask.empty() || graph.Length(segment) < params.min_free_segment))
-      continue;
+    if (!segment_counts(graph.nodes()[graph.Target(segment)].kind, graph.Length(segment))) continue;
     const cv::Point corner(cvRound(node.centre.x), cvRound(node.centre.y));
     if (AddStub(corner, -line_dir, node.pixels, params, skeleton, stripe_mask))
       corners.push_back(corner);
@@ -120,20 +125,16 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
       }
     }
     // True when the chain, walked from index i in direction step, leaves the
-    // horizontal (turns into a line) before it ends, or ends at a junction.
+    // horizontal (turns into a line) before it ends, or its end counts.
     auto segment_ends_on_line = [&](int i, int step) {
       for (int k = i + step * params.leg; k >= 0 && k < n; k += step) {
         const cv::Point2d d(px[k] - px[k - step * params.leg]);
         if (LeanFromVerticalDeg(d) < 90 - params.leg_tolerance_deg) return true;
       }
       const int end = step > 0 ? edge.to : edge.from;
-      if (graph.nodes()[end].kind == NodeKind::kJunction) return true;
-      // A free end (the partner line too faint to see): a segment long enough
-      // not to be a hook, when the mask will vouch for the line going on.
-      return !stripe_mask.empty() && (step > 0 ? n - 1 - i : i) >= params.min_free_segment;
+      return segment_counts(graph.nodes()[end].kind, step > 0 ? n - 1 - i : i);
     };
     for (const Corner& c : found) {
-      // The segment must end on a line, not run off along an outline.
       if (!segment_ends_on_line(c.index, c.segment_after ? 1 : -1)) continue;
       // A rounded corner passes the leg test a few pixels before its apex:
       // the corner is the pixel farthest from the chord across the bend.

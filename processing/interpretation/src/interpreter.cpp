@@ -105,8 +105,9 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
     cv::copyMakeBorder(stripe_mask, mask, m, m, m, m, cv::BORDER_REPLICATE);
   }
   const cv::Rect image(m, m, skeleton.cols, skeleton.rows);
+  // The skeleton as it stands and every point, in image coordinates.
   auto finish = [&](InterpretationResult& r) {
-    r.skeleton = r.skeleton.empty() ? cv::Mat() : r.skeleton(image).clone();
+    r.skeleton = sk(image).clone();
     ToImageFrame(image, &r);
   };
   // Thesis 4.4: skeleton pieces too small to be part of the pattern.
@@ -117,7 +118,6 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   // Thesis 5.2.1: the reference line first, sealed end to end.
   if (!TraceReferenceLine(sk, side, params.reference, &result.reference, &why)) {
     result.error = "reference line not found: " + why;
-    result.skeleton = sk;
     finish(result);
     return result;
   }
@@ -144,7 +144,6 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
     for (const LoopRecord& l : loops) ++result.loop_classes[l.cls];
   for (const LoopRecord& l : loops)
     if (l.cls == LoopClass::kBoundary) result.boundary.push_back(l);
-  result.skeleton = sk;
   if (!LabelNetwork(network, loops, result.reference, spec, params.labelling, &result.labelling,
                     &why)) {
     result.error = "reference line not found: " + why;
