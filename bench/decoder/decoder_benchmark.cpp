@@ -1,7 +1,14 @@
 // Decode of one simulated face frame at 512x512 and 2048x2048, against a
 // baseline measured in the same run on the same frame: cv::GaussianBlur
 // (5x5, sigma 1) followed by cv::Canny. Counters: median_ms of the decode,
-// baseline_ms, and ratio = median decode / median baseline (goal at 512: <= 4).
+// baseline_ms, ratio = median decode / median baseline (goal at 512: <= 4),
+// and the median time of each stage (extraction_ms, interpretation_ms,
+// subpixel_ms, from DecodeResult::times).
+//
+// BM_Decode runs with OpenCV's default thread count (the decoder's parallel
+// stages use cv::parallel_for_); BM_DecodeSingleThread sets
+// cv::setNumThreads(1) for both the baseline and the decode, so its ratio
+// compares single-threaded code with single-threaded OpenCV.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -57,32 +64,50 @@ void BM_GaussianBlurCanny(benchmark::State& state) {
   state.counters["median_ms"] = Median(ms);
 }
 
-void BM_Decode(benchmark::State& state) {
+// Decodes the face frame of side state.range(0) with `threads` OpenCV
+// threads (0: leave OpenCV's default) and reports the counters above.
+void DecodeWithThreads(benchmark::State& state, int threads) {
   const cv::Mat& frame = FaceFrame(static_cast<int>(state.range(0)));
+  const int default_threads = cv::getNumThreads();
+  if (threads > 0) cv::setNumThreads(threads);
   // The baseline, measured in this run on this frame.
   std::vector<double> base;
   for (int i = 0; i < 30; ++i) base.push_back(BaselineOnce(frame));
-  std::vector<double> ms;
+  std::vector<double> ms, extraction, interpretation, subpixel;
   int junctions = 0;
   for (auto _ : state) {
     const auto t = Clock::now();
     const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame, bsls::pattern::Side::kLeft);
     ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+    extraction.push_back(r.times.extraction_ms);
+    interpretation.push_back(r.times.interpretation_ms);
+    subpixel.push_back(r.times.subpixel_ms);
     junctions = static_cast<int>(r.junctions.size());
     benchmark::DoNotOptimize(junctions);
   }
+  cv::setNumThreads(default_threads);
   const double median = Median(ms), baseline = Median(base);
   state.counters["median_ms"] = median;
   state.counters["baseline_ms"] = baseline;
   state.counters["ratio"] = median / baseline;
+  state.counters["extraction_ms"] = Median(extraction);
+  state.counters["interpretation_ms"] = Median(interpretation);
+  state.counters["subpixel_ms"] = Median(subpixel);
+  state.counters["threads"] = threads > 0 ? threads : default_threads;
   state.counters["junctions"] = junctions;
   state.counters["pixels"] = static_cast<double>(frame.total());
 }
+
+void BM_Decode(benchmark::State& state) { DecodeWithThreads(state, 0); }
+
+void BM_DecodeSingleThread(benchmark::State& state) { DecodeWithThreads(state, 1); }
 
 }  // namespace
 
 BENCHMARK(BM_GaussianBlurCanny)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Decode)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_Decode)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_DecodeSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_DecodeSingleThread)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
 
 BENCHMARK_MAIN();

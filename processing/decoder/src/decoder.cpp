@@ -3,10 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <optional>
-#include <set>
 #include <stdexcept>
 
 namespace bsls::decoder {
@@ -64,19 +64,45 @@ bool FitLine(const std::vector<std::pair<double, double>>& s, double* a, double*
 }
 
 // Least-squares x = c0 + c1 t + c2 t^2 through (t, x) samples; false when
-// there are fewer than five or they do not fix a parabola.
+// there are fewer than five or they do not fix a parabola. The normal
+// equations are solved by Cholesky's method (as cv::solve's DECOMP_CHOLESKY),
+// written out for 3 x 3.
 bool FitParabola(const std::vector<std::pair<double, double>>& s, cv::Vec3d* c) {
   if (s.size() < 5) return false;
-  cv::Matx33d ata = cv::Matx33d::zeros();
-  cv::Vec3d atb(0, 0, 0);
+  double m[5] = {0, 0, 0, 0, 0};  // sums of t^0 .. t^4
+  double r[3] = {0, 0, 0};        // sums of x, t x, t^2 x
   for (const auto& [t, x] : s) {
-    const cv::Vec3d row(1.0, t, t * t);
-    for (int i = 0; i < 3; ++i) {
-      atb[i] += row[i] * x;
-      for (int k = 0; k < 3; ++k) ata(i, k) += row[i] * row[k];
-    }
+    const double t2 = t * t;
+    m[0] += 1.0;
+    m[1] += t;
+    m[2] += t2;
+    m[3] += t * t2;
+    m[4] += t2 * t2;
+    r[0] += x;
+    r[1] += t * x;
+    r[2] += t2 * x;
   }
-  return cv::solve(ata, atb, *c, cv::DECOMP_CHOLESKY);
+  constexpr double kMin = std::numeric_limits<double>::epsilon();
+  // A = L L^T with A = [m0 m1 m2; m1 m2 m3; m2 m3 m4].
+  double d0 = m[0];
+  if (d0 < kMin) return false;
+  const double l00 = std::sqrt(d0);
+  const double l10 = m[1] / l00, l20 = m[2] / l00;
+  const double d1 = m[2] - l10 * l10;
+  if (d1 < kMin) return false;
+  const double l11 = std::sqrt(d1);
+  const double l21 = (m[3] - l20 * l10) / l11;
+  const double d2 = m[4] - l20 * l20 - l21 * l21;
+  if (d2 < kMin) return false;
+  const double l22 = std::sqrt(d2);
+  // L y = r, then L^T c = y.
+  const double y0 = r[0] / l00;
+  const double y1 = (r[1] - l10 * y0) / l11;
+  const double y2 = (r[2] - l20 * y0 - l21 * y1) / l22;
+  (*c)[2] = y2 / l22;
+  (*c)[1] = (y1 - l21 * (*c)[2]) / l11;
+  (*c)[0] = (y0 - l10 * (*c)[1] - l20 * (*c)[2]) / l00;
+  return true;
 }
 
 // The value at t = 0 of a parabola through (t, x) samples (a line when there
@@ -89,73 +115,116 @@ std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s)
   return a;
 }
 
+// Values by image row over a range of rows, each row holding one value or
+// none (a line's rows: dense, so look-ups need no search).
+class RowValues {
+ public:
+  // Rows first .. first + count - 1, all empty.
+  void Reset(int first, int count) {
+    first_ = first;
+    values_.assign(static_cast<size_t>(std::max(count, 0)), kEmpty);
+  }
+  int First() const { return first_; }
+  int End() const { return first_ + static_cast<int>(values_.size()); }  // one past the last row
+  bool Has(int y) const { return y >= first_ && y < End() && !std::isnan(values_[Slot(y)]); }
+  double At(int y) const { return values_[Slot(y)]; }  // Has(y) must hold
+  void Set(int y, double v) { values_[Slot(y)] = v; }  // y within the range
+  void Erase(int y) { values_[Slot(y)] = kEmpty; }
+
+ private:
+  static constexpr double kEmpty = std::numeric_limits<double>::quiet_NaN();
+  size_t Slot(int y) const { return static_cast<size_t>(y - first_); }
+
+  int first_ = 0;
+  std::vector<double> values_;
+};
+
 // The rows of `rows` within `radius` of `centre` and farther than `exclude`
-// from it, as (row - centre, x) pairs for the fits above.
-std::vector<std::pair<double, double>> RowsNear(const std::map<int, double>& rows, double centre,
-                                                int radius, double exclude) {
+// from it, in order, as (row - centre, x) pairs for the fits above.
+std::vector<std::pair<double, double>> RowsNear(const RowValues& rows, double centre, int radius,
+                                                double exclude) {
   std::vector<std::pair<double, double>> out;
-  for (auto it = rows.lower_bound(cvFloor(centre) - radius);
-       it != rows.end() && it->first <= centre + radius; ++it)
-    if (std::abs(it->first - centre) > exclude) out.push_back({it->first - centre, it->second});
+  const int from = std::max(rows.First(), cvFloor(centre) - radius);
+  for (int y = from; y < rows.End() && y <= centre + radius; ++y)
+    if (rows.Has(y) && std::abs(y - centre) > exclude) out.push_back({y - centre, rows.At(y)});
   return out;
 }
 
 struct LineCentres {
-  std::map<int, double> measured;  // row -> sub-pixel x, outliers removed
-  std::map<int, double> skeleton;  // row -> mean x of the line's skeleton pixels
-  std::map<int, double> slope;     // row -> |dx/dy| of the skeleton there
-  std::set<int> skipped;           // rows crossed but not measured (beside a segment)
+  RowValues measured;         // row -> sub-pixel x, outliers removed
+  RowValues skeleton;         // row -> mean x of the line's skeleton pixels
+  RowValues slope;            // row -> |dx/dy| of the skeleton there (rows the skeleton crosses)
+  std::vector<char> skipped;  // by row from measured.First(): crossed but not measured
+  std::vector<cv::Point2d> points;  // the decoded centres: measured, skipped rows refilled
 };
 
 // True when the skeleton has a segment leaving the line near (x, y): a set
 // pixel 2-4 columns to either side within `clearance` rows that is not part of
 // the line itself.
-bool SegmentNearby(const cv::Mat& skeleton, const std::set<std::pair<int, int>>& own, int x, int y,
-                   int clearance) {
+bool SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<int, int>>& own, int x,
+                   int y, int clearance) {
   for (int dy = -clearance; dy <= clearance; ++dy) {
     const int yy = y + dy;
     if (yy < 0 || yy >= skeleton.rows) continue;
     const uchar* row = skeleton.ptr<uchar>(yy);
     for (int k = 2; k <= 4; ++k)
       for (int xx : {x - k, x + k})
-        if (xx >= 0 && xx < skeleton.cols && row[xx] && !own.count({xx, yy})) return true;
+        if (xx >= 0 && xx < skeleton.cols && row[xx] &&
+            !std::binary_search(own.begin(), own.end(), std::make_pair(xx, yy)))
+          return true;
   }
   return false;
 }
 
 // |dx/dy| of a line's skeleton over three rows each side of row y (0 when unknown).
-double LocalSlope(const std::map<int, double>& skeleton, int y) {
-  const auto a = skeleton.lower_bound(y - 3);
-  const auto b = skeleton.upper_bound(y + 3);
-  if (a == skeleton.end() || b == skeleton.begin()) return 0.0;
-  const auto last = std::prev(b);
-  if (last->first <= a->first) return 0.0;
-  return std::abs((last->second - a->second) / (last->first - a->first));
+double LocalSlope(const RowValues& skeleton, int y) {
+  int a = y - 3, last = y + 3;
+  while (a <= y + 3 && !skeleton.Has(a)) ++a;
+  while (last >= a && !skeleton.Has(last)) --last;
+  if (a > y + 3 || last <= a) return 0.0;
+  return std::abs((skeleton.At(last) - skeleton.At(a)) / (last - a));
 }
 
 // Sub-pixel centres of one labelled line, one per row its skeleton crosses.
 // Rows beside a segment are skipped (the segment's light biases them), and a
-// centre far from the fit of its neighbours is dropped as an outlier.
+// centre far from the fit of its neighbours is dropped as an outlier; skipped
+// rows are refilled from the fit of their neighbours where the line is not
+// steep and measured rows lie on both sides.
 LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
                         const interpretation::LabelledLine& line, const DecodeParams& params) {
-  std::map<int, std::pair<int, int>> span;  // row -> (min x, max x)
-  std::set<std::pair<int, int>> own;
-  for (const cv::Point& p : line.pixels) {
-    own.insert({p.x, p.y});
-    auto [it, fresh] = span.try_emplace(p.y, p.x, p.x);
-    if (!fresh) {
-      it->second.first = std::min(it->second.first, p.x);
-      it->second.second = std::max(it->second.second, p.x);
+  // The line's pixels as sorted (x, y) for look-ups, and each row's span.
+  std::vector<std::pair<int, int>> own;
+  own.reserve(line.pixels.size());
+  for (const cv::Point& p : line.pixels) own.emplace_back(p.x, p.y);
+  std::sort(own.begin(), own.end());
+  std::vector<std::pair<int, std::pair<int, int>>> span;  // (row, (min x, max x)), by row
+  {
+    std::vector<std::pair<int, int>> by_row;  // (y, x)
+    by_row.reserve(own.size());
+    for (const auto& [x, y] : own) by_row.emplace_back(y, x);
+    std::sort(by_row.begin(), by_row.end());
+    for (const auto& [y, x] : by_row) {
+      if (!span.empty() && span.back().first == y)
+        span.back().second.second = x;  // sorted: the largest x comes last
+      else
+        span.push_back({y, {x, x}});
     }
   }
   LineCentres out;
+  const int first = span.empty() ? 0 : span.front().first;
+  const int count = span.empty() ? 0 : span.back().first - first + 1;
+  out.measured.Reset(first, count);
+  out.skeleton.Reset(first, count);
+  out.slope.Reset(first, count);
+  out.skipped.assign(static_cast<size_t>(count), 0);
+  auto skip = [&](int y) { out.skipped[static_cast<size_t>(y - first)] = 1; };
   for (const auto& [y, range] : span)
-    if (range.second - range.first <= 2) out.skeleton[y] = 0.5 * (range.first + range.second);
+    if (range.second - range.first <= 2) out.skeleton.Set(y, 0.5 * (range.first + range.second));
   for (const auto& [y, range] : span) {
     const auto [lo, hi] = range;
     // A steep line's row profile is wide, so a segment biases more rows of it.
     const double slope = LocalSlope(out.skeleton, y);
-    out.slope[y] = slope;
+    out.slope.Set(y, slope);
     const int clearance =
         params.junction_clearance +
         static_cast<int>(std::lround(2.0 * params.junction_clearance *
@@ -163,61 +232,116 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
     const int x = (lo + hi) / 2;
     // A row where the skeleton runs sideways is a segment, not the line.
     if (hi - lo > 2 || SegmentNearby(skeleton, own, x, y, clearance)) {
-      out.skipped.insert(y);
+      skip(y);
       continue;
     }
     if (auto cx = extraction::StripeCentreInRow(grey, y, 0.5 * (lo + hi), params.centre))
-      out.measured[y] = *cx;
+      out.measured.Set(y, *cx);
     else
-      out.skipped.insert(y);
+      skip(y);
   }
   // Outliers: more than max_centre_residual from the line through the
   // neighbours within junction_fit_rows.
   std::vector<int> outliers;
-  for (const auto& [y, x] : out.measured) {
+  for (int y = first; y < first + count; ++y) {
+    if (!out.measured.Has(y)) continue;
     const auto s = RowsNear(out.measured, y, params.junction_fit_rows, 0.0);
     if (s.size() < 4) continue;
     const auto fit = FitAtZero(s);
-    if (fit && std::abs(x - *fit) > params.max_centre_residual) outliers.push_back(y);
+    if (fit && std::abs(out.measured.At(y) - *fit) > params.max_centre_residual)
+      outliers.push_back(y);
   }
   for (int y : outliers) {
-    out.measured.erase(y);
-    out.skipped.insert(y);
+    out.measured.Erase(y);
+    skip(y);
+  }
+  // The decoded points: measured centres, and the skipped rows filled from
+  // the line's own fit where measured rows lie on both sides.
+  for (int y = first; y < first + count; ++y) {
+    if (out.measured.Has(y)) {
+      out.points.emplace_back(out.measured.At(y), y);
+      continue;
+    }
+    if (!out.skipped[static_cast<size_t>(y - first)]) continue;
+    // Rows of a steep stretch are not invented: its fit is not good enough.
+    if (out.slope.Has(y) && out.slope.At(y) > params.max_fill_slope) continue;
+    const auto s = RowsNear(out.measured, y, params.junction_fit_rows, 0.0);
+    const bool above = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first < 0; });
+    const bool below = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first > 0; });
+    if (!above || !below || s.size() < 4) continue;
+    if (const auto fit = FitAtZero(s)) out.points.emplace_back(*fit, y);
   }
   return out;
 }
 
-// The junction where the line's centre curve meets the segment's: the line's
-// measured centres near the junction fitted as x(y), the segment's centres
-// measured column by column along its skeleton and fitted as y(x). An
-// interpolated junction, or one whose segment cannot be measured, is placed on
-// the line's fit at its row. nullopt when the line has too few centres near it.
-std::optional<cv::Point2d> RefineJunction(const cv::Mat& grey, const LineCentres& line,
-                                          const interpretation::LabelledJunction& j,
-                                          const DecodeParams& params) {
+// What placing a junction needs besides its segment's centres: the line
+// near the junction as x = a + b (y - y0) through `vertical` ((y - y0, x)
+// pairs), and the segment's skeleton pixels whose column centres are fitted.
+struct JunctionPlan {
+  bool ok = false;  // false: the line has too few centres near the junction
+  double a = 0.0, b = 0.0;
+  std::vector<std::pair<double, double>> vertical;
+  std::vector<cv::Point> columns;  // (column, approximate row) of each centre to measure
+};
+
+// The first step of RefineJunction: the line's fit and the segment columns
+// to measure (the segment's ends skipped, where the lines' light biases it).
+JunctionPlan PlanJunction(const LineCentres& line, const interpretation::LabelledJunction& j,
+                          const DecodeParams& params) {
   const double y0 = j.position.y;
+  JunctionPlan plan;
   // The line as x(y): sub-pixel centres, or where a steep or crowded line has
   // too few of them, its skeleton (within a pixel of the centre).
-  double a, b;
-  std::vector<std::pair<double, double>> vertical =
-      RowsNear(line.measured, y0, params.junction_fit_rows, 0.0);
-  if (vertical.size() < 3 || !FitLine(vertical, &a, &b)) {
-    vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows, 1.0);
-    if (vertical.size() < 3 || !FitLine(vertical, &a, &b)) return std::nullopt;
+  plan.vertical = RowsNear(line.measured, y0, params.junction_fit_rows, 0.0);
+  if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) {
+    plan.vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows, 1.0);
+    if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) return plan;
   }
+  plan.ok = true;
+  if (j.interpolated || j.segment.empty()) return plan;
+  const int n = static_cast<int>(j.segment.size());
+  for (int i = 0; i < n - 2 && static_cast<int>(plan.columns.size()) < params.segment_fit_columns;
+       ++i) {
+    const cv::Point& s = j.segment[i];
+    if (std::abs(s.x - plan.a) <= params.junction_clearance) continue;
+    plan.columns.push_back(s);
+  }
+  return plan;
+}
+
+// Sub-pixel centres of segment columns, measured once each: `keys` sorted
+// (x, then y), `centres` the StripeCentreInColumn answer for each.
+struct ColumnCentres {
+  std::vector<std::pair<int, int>> keys;
+  std::vector<std::optional<double>> centres;
+
+  const std::optional<double>& At(cv::Point p) const {
+    const auto it = std::lower_bound(keys.begin(), keys.end(), std::make_pair(p.x, p.y));
+    return centres[static_cast<size_t>(it - keys.begin())];
+  }
+};
+
+// The junction where the line's centre curve meets the segment's: the line's
+// measured centres near the junction fitted as x(y), the segment's centres
+// measured column by column along its skeleton (plan.columns, from `columns`)
+// and fitted as y(x). An interpolated junction, or one whose segment cannot be
+// measured, is placed on the line's fit at its row. nullopt when the line has
+// too few centres near it.
+std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const ColumnCentres& columns,
+                                          const interpretation::LabelledJunction& j,
+                                          const DecodeParams& params) {
+  if (!plan.ok) return std::nullopt;
+  const double y0 = j.position.y;
+  const double a = plan.a, b = plan.b;
+  const std::vector<std::pair<double, double>>& vertical = plan.vertical;
   double y = y0;
-  if (!j.interpolated && !j.segment.empty()) {
+  if (!plan.columns.empty()) {
     // The segment as y(x): centres column by column along its skeleton, or the
-    // skeleton itself; its ends are skipped, where the lines' light biases it.
+    // skeleton itself.
     std::vector<std::pair<double, double>> measured, skeleton;  // (x - a, y)
-    const int n = static_cast<int>(j.segment.size());
-    for (int i = 0; i < n - 2 && static_cast<int>(skeleton.size()) < params.segment_fit_columns;
-         ++i) {
-      const cv::Point& s = j.segment[i];
-      if (std::abs(s.x - a) <= params.junction_clearance) continue;
+    for (const cv::Point& s : plan.columns) {
       skeleton.push_back({s.x - a, static_cast<double>(s.y)});
-      if (auto cy = extraction::StripeCentreInColumn(grey, s.x, s.y, params.centre))
-        measured.push_back({s.x - a, *cy});
+      if (const std::optional<double>& cy = columns.At(s)) measured.push_back({s.x - a, *cy});
     }
     double c, e;
     const bool fitted = (measured.size() >= 2 && FitLine(measured, &c, &e)) ||
@@ -325,8 +449,6 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
 
   t = Clock::now();
   const int q_offset = params.q_offset.value_or(0);
-  std::map<int, std::vector<const interpretation::LabelledJunction*>> junctions_of_line;
-  for (const auto& j : interp.labelling.junctions) junctions_of_line[j.p].push_back(&j);
   // Lines, then junctions, are measured independently of each other: in
   // parallel (cv::parallel_for_, OpenCV's thread pool).
   const auto& lines = interp.labelling.lines;
@@ -339,8 +461,27 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);
   for (const auto& j : interp.labelling.junctions) centres.try_emplace(j.p);  // read-only below
 
-  // Junctions: where the line's centre meets its segment's centre.
+  // Junctions: where the line's centre meets its segment's centre. A segment
+  // is seen from both its junctions over nearly the same columns: the
+  // columns are gathered first and each is measured once.
   const auto& junctions = interp.labelling.junctions;
+  std::vector<JunctionPlan> plans(junctions.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i)
+      plans[i] = PlanJunction(centres.at(junctions[i].p), junctions[i], params);
+  });
+  ColumnCentres columns;
+  for (const JunctionPlan& plan : plans)
+    for (const cv::Point& c : plan.columns) columns.keys.emplace_back(c.x, c.y);
+  std::sort(columns.keys.begin(), columns.keys.end());
+  columns.keys.erase(std::unique(columns.keys.begin(), columns.keys.end()), columns.keys.end());
+  columns.centres.resize(columns.keys.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const auto [x, y] = columns.keys[i];
+      columns.centres[i] = extraction::StripeCentreInColumn(grey, x, y, params.centre);
+    }
+  });
   result.junctions.resize(junctions.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
@@ -351,28 +492,15 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       d.kind = j.kind;
       d.interpolated = j.interpolated;
       d.position = j.position;
-      if (auto refined = RefineJunction(grey, centres.at(j.p), j, params)) d.position = *refined;
+      if (auto refined = RefineJunction(plans[i], columns, j, params)) d.position = *refined;
     }
   });
 
-  // Lines: measured centres, and the skipped rows filled from the line's own
-  // fit where measured rows lie on both sides.
+  // Lines: their decoded points (MeasureLine).
   for (const interpretation::LabelledLine& line : interp.labelling.lines) {
     DecodedLine out;
     out.p = line.p;
-    const LineCentres& lc = centres[line.p];
-    std::map<int, double> points = lc.measured;
-    for (int y : lc.skipped) {
-      // Rows of a steep stretch are not invented: its fit is not good enough.
-      const auto slope = lc.slope.find(y);
-      if (slope != lc.slope.end() && slope->second > params.max_fill_slope) continue;
-      const auto s = RowsNear(lc.measured, y, params.junction_fit_rows, 0.0);
-      const bool above = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first < 0; });
-      const bool below = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first > 0; });
-      if (!above || !below || s.size() < 4) continue;
-      if (const auto fit = FitAtZero(s)) points[y] = *fit;
-    }
-    for (const auto& [y, x] : points) out.points.emplace_back(x, y);
+    out.points = centres[line.p].points;
     if (!out.points.empty()) result.lines.push_back(std::move(out));
   }
   result.times.subpixel_ms = MsSince(t);

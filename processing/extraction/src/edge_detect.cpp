@@ -8,6 +8,7 @@
 
 #include "hysteresis.h"
 #include "input_checks.h"
+#include "neighbourhood.h"
 
 namespace bsls::extraction {
 namespace {
@@ -254,23 +255,31 @@ namespace internal {
 
 cv::Mat KeepComponentsTouching(const cv::Mat& weak, const cv::Mat& strong) {
   assert(weak.size() == strong.size() && weak.type() == CV_8UC1 && strong.type() == CV_8UC1);
-  cv::Mat labels;
-  const int count = cv::connectedComponents(weak != 0, labels, 8, CV_32S);
-  std::vector<unsigned char> keep(static_cast<size_t>(count), 0);
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* lr = labels.ptr<int>(y);
+  // Flood fill from every strong pixel of `weak` (marked 2 when reached);
+  // the pixels reached are the components touching a strong pixel.
+  PaddedBinary img(weak);
+  const std::ptrdiff_t s = static_cast<std::ptrdiff_t>(img.Stride());
+  const std::ptrdiff_t offsets[8] = {-s - 1, -s, -s + 1, -1, 1, s - 1, s, s + 1};
+  std::vector<size_t> stack;
+  for (int y = 0; y < strong.rows; ++y) {
     const unsigned char* sr = strong.ptr<unsigned char>(y);
-    for (int x = 0; x < labels.cols; ++x)
-      if (sr[x]) keep[static_cast<size_t>(lr[x])] = 255;
+    for (int x = 0; x < strong.cols; ++x) {
+      if (!sr[x] || img.data[img.Index(x, y)] != 1) continue;
+      stack.assign(1, img.Index(x, y));
+      img.data[stack.back()] = 2;
+      while (!stack.empty()) {
+        const size_t i = stack.back();
+        stack.pop_back();
+        for (std::ptrdiff_t o : offsets) {
+          const size_t q = static_cast<size_t>(static_cast<std::ptrdiff_t>(i) + o);
+          if (img.data[q] != 1) continue;
+          img.data[q] = 2;
+          stack.push_back(q);
+        }
+      }
+    }
   }
-  keep[0] = 0;  // label 0 is the background of `weak`
-  cv::Mat out(weak.size(), CV_8UC1);
-  for (int y = 0; y < labels.rows; ++y) {
-    const int* lr = labels.ptr<int>(y);
-    unsigned char* orow = out.ptr<unsigned char>(y);
-    for (int x = 0; x < labels.cols; ++x) orow[x] = keep[static_cast<size_t>(lr[x])];
-  }
-  return out;
+  return img.ToMatWhere(2);
 }
 
 }  // namespace internal

@@ -1,6 +1,8 @@
 #include "bsls/extraction/feature_extraction.h"
 
 #include "input_checks.h"
+#include "neighbourhood.h"
+#include "skeleton_in_place.h"
 
 namespace bsls::extraction {
 namespace {
@@ -29,18 +31,21 @@ ExtractionResult ExtractFeatures(const cv::Mat& grey, const ExtractionParams& pa
   RequireGrey8(grey, "ExtractFeatures");
   RequireValid(params, "ExtractFeatures");
   ExtractionResult result;
-  result.smoothed = Enhance(grey, params.enhance);
   if (params.method == ExtractionMethod::kModern) {
+    // The skeleton stages one after the other on one padded buffer.
     result.mask = DetectStripes(grey, params.stripe);
-    cv::Mat skeleton =
-        MakeOnePixelWide(ZhangSuenThin(result.mask, params.zhang_suen), params.t_junctions);
-    if (params.recentre) skeleton = RecentreOnRidge(skeleton, grey, params.recentre_params);
-    skeleton = PruneSpurs(skeleton, params.spurs);
-    skeleton = RemoveSmallComponents(skeleton, params.min_component_pixels);
-    result.skeleton = MakeOnePixelWide(skeleton, params.t_junctions);
+    internal::PaddedBinary skeleton(result.mask);
+    internal::ZhangSuenThinInPlace(&skeleton, params.zhang_suen);
+    internal::MakeOnePixelWideInPlace(&skeleton, params.t_junctions);
+    if (params.recentre) internal::RecentreOnRidgeInPlace(&skeleton, grey, params.recentre_params);
+    internal::PruneSpursInPlace(&skeleton, params.spurs);
+    internal::RemoveSmallComponentsInPlace(&skeleton, params.min_component_pixels);
+    internal::MakeOnePixelWideInPlace(&skeleton, params.t_junctions);
+    result.skeleton = skeleton.ToMat();
     return result;
   }
   // Thesis Figure 4.2: enhancement, edge detection, line thinning, pruning.
+  result.smoothed = Enhance(grey, params.enhance);
   result.mask = CannyEdges(result.smoothed, params.canny);
   cv::Mat skeleton = LineFollowingThin(result.mask, params.line_following);
   skeleton = ApplyPruningWindows(skeleton, params.pruning_windows);

@@ -1,6 +1,7 @@
 #include "bsls/extraction/pruning.h"
 
 #include <algorithm>
+#include <bit>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <utility>
@@ -9,6 +10,7 @@
 #include "bsls/extraction/thinning.h"
 #include "input_checks.h"
 #include "neighbourhood.h"
+#include "skeleton_in_place.h"
 
 namespace bsls::extraction {
 namespace {
@@ -71,7 +73,7 @@ std::optional<Branch> TraceEndBranch(const PaddedBinary& img, size_t start, int 
   }
 }
 
-int DegreeOf(const PaddedBinary& img, size_t i) { return img.NeighboursOf(i).Count(); }
+int DegreeOf(const PaddedBinary& img, size_t i) { return std::popcount(img.CodeOf(i)); }
 
 }  // namespace
 
@@ -126,13 +128,28 @@ cv::Mat ApplyPruningWindows(const cv::Mat& skeleton, const PruningWindowParams& 
 cv::Mat PruneSpurs(const cv::Mat& skeleton, const SpurPruneParams& params) {
   RequireGrey8(skeleton, "PruneSpurs", "skeleton");
   RequireValid(params, "PruneSpurs");
-  cv::Mat current = skeleton != 0;
+  PaddedBinary img(skeleton);
+  internal::PruneSpursInPlace(&img, params);
+  return img.ToMat();
+}
+
+cv::Mat RemoveSmallComponents(const cv::Mat& binary, int min_pixels) {
+  RequireGrey8(binary, "RemoveSmallComponents", "binary image");
+  if (min_pixels < 1) throw std::invalid_argument("RemoveSmallComponents: min_pixels must be >= 1");
+  PaddedBinary img(binary);
+  internal::RemoveSmallComponentsInPlace(&img, min_pixels);
+  return img.ToMat();
+}
+
+namespace internal {
+
+// Passes of tracing end branches and removing the short ones, shortest first.
+void PruneSpursInPlace(PaddedBinary* img, const SpurPruneParams& params) {
   for (int pass = 0; pass < params.max_passes; ++pass) {
-    PaddedBinary img(current);
     std::vector<Branch> spurs;
-    for (size_t i : img.SetIndices()) {
-      if (DegreeOf(img, i) != 1) continue;
-      std::optional<Branch> b = TraceEndBranch(img, i, params.max_spur_length);
+    for (size_t i : img->SetIndices()) {
+      if (DegreeOf(*img, i) != 1) continue;
+      std::optional<Branch> b = TraceEndBranch(*img, i, params.max_spur_length);
       if (!b || static_cast<int>(b->pixels.size()) >= params.max_spur_length) continue;
       if (!b->junction && params.keep_free_ends) continue;
       spurs.push_back(std::move(*b));
@@ -145,35 +162,49 @@ cv::Mat PruneSpurs(const cv::Mat& skeleton, const SpurPruneParams& params) {
     for (const Branch& b : spurs) {
       // Re-check against the deletions made so far: the branch must be intact
       // and its junction still a junction, else it has become part of a line.
-      if (!std::all_of(b.pixels.begin(), b.pixels.end(), [&](size_t i) { return img.data[i]; }))
+      if (!std::all_of(b.pixels.begin(), b.pixels.end(), [&](size_t i) { return img->data[i]; }))
         continue;
-      if (b.junction && (!img.data[*b.junction] || DegreeOf(img, *b.junction) < 3)) continue;
-      for (size_t i : b.pixels) img.data[i] = 0;
+      if (b.junction && (!img->data[*b.junction] || DegreeOf(*img, *b.junction) < 3)) continue;
+      for (size_t i : b.pixels) img->data[i] = 0;
       changed = true;
     }
-    current = MakeOnePixelWide(img.ToMat());
+    MakeOnePixelWideInPlace(img, TJunctionShape::kCentreKept);
     if (!changed) break;
   }
-  return current;
 }
 
-cv::Mat RemoveSmallComponents(const cv::Mat& binary, int min_pixels) {
-  RequireGrey8(binary, "RemoveSmallComponents", "binary image");
-  if (min_pixels < 1) throw std::invalid_argument("RemoveSmallComponents: min_pixels must be >= 1");
-  cv::Mat labels, stats, centroids;
-  const int count =
-      cv::connectedComponentsWithStats(binary != 0, labels, stats, centroids, 8, CV_32S);
-  std::vector<unsigned char> keep(static_cast<size_t>(count), 0);
-  for (int label = 1; label < count; ++label)
-    keep[static_cast<size_t>(label)] =
-        stats.at<int>(label, cv::CC_STAT_AREA) >= min_pixels ? 255 : 0;
-  cv::Mat out(binary.size(), CV_8UC1);
-  for (int y = 0; y < binary.rows; ++y) {
-    const int* lr = labels.ptr<int>(y);
-    unsigned char* orow = out.ptr<unsigned char>(y);
-    for (int x = 0; x < binary.cols; ++x) orow[x] = keep[static_cast<size_t>(lr[x])];
+// 8-connected flood fill of each component from its first pixel in raster order.
+void RemoveSmallComponentsInPlace(PaddedBinary* img, int min_pixels) {
+  if (min_pixels <= 1) return;
+  const std::ptrdiff_t s = static_cast<std::ptrdiff_t>(img->Stride());
+  const std::ptrdiff_t offsets[8] = {-s - 1, -s, -s + 1, -1, 1, s - 1, s, s + 1};
+  // Flood fill each 8-connected component, marking its pixels 2; a small
+  // one is erased, a large one restored to 1 afterwards.
+  std::vector<size_t> component, stack, kept;
+  for (size_t start : img->SetIndices()) {
+    if (img->data[start] != 1) continue;
+    component.clear();
+    stack.assign(1, start);
+    img->data[start] = 2;
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      component.push_back(i);
+      for (std::ptrdiff_t o : offsets) {
+        const size_t q = static_cast<size_t>(static_cast<std::ptrdiff_t>(i) + o);
+        if (img->data[q] != 1) continue;
+        img->data[q] = 2;
+        stack.push_back(q);
+      }
+    }
+    if (static_cast<int>(component.size()) < min_pixels)
+      for (size_t i : component) img->data[i] = 0;
+    else
+      kept.insert(kept.end(), component.begin(), component.end());
   }
-  return out;
+  for (size_t i : kept) img->data[i] = 1;
 }
+
+}  // namespace internal
 
 }  // namespace bsls::extraction

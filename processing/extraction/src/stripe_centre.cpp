@@ -1,8 +1,10 @@
 #include "bsls/extraction/stripe_centre.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <opencv2/core/hal/intrin.hpp>
 #include <stdexcept>
 #include <vector>
 
@@ -13,83 +15,148 @@ namespace {
 
 using internal::RequireValid;
 
+// Scratch space of n doubles, zeroed: on the stack up to kInline, else on
+// the heap (the profiles of the default parameters fit on the stack).
+class Scratch {
+ public:
+  explicit Scratch(size_t n) : n_(n) {
+    if (n > kInline) heap_.resize(n);
+    std::fill(data(), data() + n, 0.0);
+  }
+  double* data() { return n_ > kInline ? heap_.data() : local_.data(); }
+  std::span<double> span() { return {data(), n_}; }
+
+ private:
+  static constexpr size_t kInline = 256;
+  size_t n_;
+  std::array<double, kInline> local_;
+  std::vector<double> heap_;
+};
+
 double NormalCdf(double u) { return 0.5 * std::erfc(-u / std::numbers::sqrt2); }
 
-double Gauss(double u, double sigma) {
-  const double t = u / sigma;
-  return std::exp(-0.5 * t * t) / (sigma * std::sqrt(2.0 * std::numbers::pi));
+// The 1 px pixel-integrated Gaussian of step 2: weights at offsets -5 .. 5
+// (support ceil(4 sigma) + 1), computed once.
+constexpr int kUnitSupport = 5;
+const std::array<double, 2 * kUnitSupport + 1>& UnitKernel() {
+  static const std::array<double, 2 * kUnitSupport + 1> kernel = [] {
+    std::array<double, 2 * kUnitSupport + 1> k{};
+    for (int i = -kUnitSupport; i <= kUnitSupport; ++i)
+      k[static_cast<size_t>(i + kUnitSupport)] = NormalCdf(i + 0.5) - NormalCdf(i - 0.5);
+    return k;
+  }();
+  return kernel;
 }
 
-double GaussDerivative(double u, double sigma) { return -u / (sigma * sigma) * Gauss(u, sigma); }
+// Values at the integer positions from .. to (inclusive, within 0 .. n-1) of
+// the profile seen as pixels that are boxes of width 1 centred on their index,
+// convolved with a Gaussian of 1 px, into out (n elements, zeroed); indices
+// beyond the ends replicate the end samples. Each value is summed over the
+// kernel in the same order; the interior runs kernel tap by tap over all
+// positions (independent sums, no clamping).
+void SmoothedAtPixels(std::span<const double> p, int from, int to, std::span<double> out) {
+  const auto& kernel = UnitKernel();
+  const int n = static_cast<int>(p.size());
+  const int inner_from = std::max(from, kUnitSupport),
+            inner_to = std::min(to, n - 1 - kUnitSupport);
+  for (int k = -kUnitSupport; k <= kUnitSupport; ++k) {
+    const double w = kernel[static_cast<size_t>(k + kUnitSupport)];
+    const int count = inner_to - inner_from + 1;
+    if (count <= 0) break;
+    double* o = out.data() + inner_from;
+    const double* q = p.data() + (inner_from - k);  // q[i] = p[inner_from + i - k]
+    int i = 0;
+#if CV_SIMD128_64F
+    const cv::v_float64x2 vw = cv::v_setall_f64(w);
+    for (; i + 2 <= count; i += 2) cv::v_store(o + i, cv::v_load(o + i) + cv::v_load(q + i) * vw);
+#endif
+    for (; i < count; ++i) o[i] += q[i] * w;
+  }
+  for (int i = from; i <= to; ++i) {
+    if (i >= inner_from && i <= inner_to) continue;
+    double sum = 0.0;
+    for (int k = -kUnitSupport; k <= kUnitSupport; ++k)
+      sum += p[static_cast<size_t>(std::clamp(i - k, 0, n - 1))] *
+             kernel[static_cast<size_t>(k + kUnitSupport)];
+    out[static_cast<size_t>(i)] = sum;
+  }
+}
 
-// The profile seen as pixels that are boxes of width 1 centred on their
-// index, convolved with a Gaussian of sigma: value and first two
-// derivatives at any continuous position. Indices beyond the ends replicate
-// the end samples.
-class SmoothedProfile {
+// The first two derivatives, at any continuous position, of the profile seen
+// as pixels that are boxes of width 1 centred on their index, convolved with
+// a Gaussian of sigma. Indices beyond the ends replicate the end samples.
+//
+// Both come from the Gaussian and its derivative at the pixel edges,
+// d^k/dx^k at x = sum_j p_j (G^(k-1)(x - j + 1/2) - G^(k-1)(x - j - 1/2)),
+// so one evaluation takes 2 * support + 2 Gaussian values; for sigma >= 1/2
+// they follow from two exp calls by the recurrence
+// G(h - 1) = G(h) exp((2h - 1) / (2 sigma^2)).
+class SmoothedDerivatives {
  public:
-  SmoothedProfile(std::span<const double> p, double sigma) : p_(p), sigma_(sigma) {
-    support_ = static_cast<int>(std::ceil(4.0 * sigma)) + 1;
-  }
+  SmoothedDerivatives(std::span<const double> p, double sigma)
+      : p_(p),
+        a_(0.5 / (sigma * sigma)),
+        norm_(1.0 / (sigma * std::sqrt(2.0 * std::numbers::pi))),
+        support_(static_cast<int>(std::ceil(4.0 * sigma)) + 1),
+        recurrence_(sigma >= 0.5),
+        ratio_step_(std::exp(-2.0 * a_)),
+        g_(static_cast<size_t>(2 * support_ + 2)) {}
 
-  // Values at the integer positions 0 .. n-1 (one kernel for all).
-  std::vector<double> ValuesAtPixels() const {
-    std::vector<double> kernel(static_cast<size_t>(2 * support_ + 1));
-    for (int k = -support_; k <= support_; ++k)
-      kernel[static_cast<size_t>(k + support_)] =
-          NormalCdf((k + 0.5) / sigma_) - NormalCdf((k - 0.5) / sigma_);
+  // First (d1) and second (d2) derivative at x.
+  void At(double x, double* d1, double* d2) {
     const int n = static_cast<int>(p_.size());
-    std::vector<double> out(p_.size(), 0.0);
-    for (int i = 0; i < n; ++i) {
-      double sum = 0.0;
-      for (int k = -support_; k <= support_; ++k)
-        sum += p_[static_cast<size_t>(std::clamp(i - k, 0, n - 1))] *
-               kernel[static_cast<size_t>(k + support_)];
-      out[static_cast<size_t>(i)] = sum;
+    const int first = static_cast<int>(std::lround(x)) - support_;
+    const int edges = 2 * support_ + 2;
+    // g_[m] = G(h_m), h_m = x - first + 1/2 - m: the edge between pixels
+    // first + m - 1 and first + m.
+    const double h0 = (x - first) + 0.5;
+    double* g = g_.data();
+    if (recurrence_) {
+      double gm = norm_ * std::exp(-a_ * h0 * h0);
+      double ratio = std::exp(a_ * (2.0 * h0 - 1.0));
+      for (int m = 0; m < edges; ++m) {
+        g[m] = gm;
+        gm *= ratio;
+        ratio *= ratio_step_;
+      }
+    } else {
+      for (int m = 0; m < edges; ++m) {
+        const double h = h0 - m;
+        g[m] = norm_ * std::exp(-a_ * h * h);
+      }
     }
-    return out;
-  }
-  double D1(double x) const {
-    return Sum(x, [this](double u) { return Gauss(u + 0.5, sigma_) - Gauss(u - 0.5, sigma_); });
-  }
-  double D2(double x) const {
-    return Sum(x, [this](double u) {
-      return GaussDerivative(u + 0.5, sigma_) - GaussDerivative(u - 0.5, sigma_);
-    });
+    // G'(h) = -h / sigma^2 G(h) = -2 a h G(h).
+    double s1 = 0.0, s2 = 0.0;
+    for (int m = 0; m <= 2 * support_; ++m) {
+      const double pj = p_[static_cast<size_t>(std::clamp(first + m, 0, n - 1))];
+      const double g0 = g[m], g1 = g[m + 1];
+      const double h = h0 - m;
+      s1 += pj * (g0 - g1);
+      s2 += pj * (h * g0 - (h - 1.0) * g1);
+    }
+    *d1 = s1;
+    *d2 = -2.0 * a_ * s2;
   }
 
  private:
-  template <typename Weight>
-  double Sum(double x, Weight weight) const {
-    const int n = static_cast<int>(p_.size());
-    const int centre = static_cast<int>(std::lround(x));
-    double sum = 0.0;
-    for (int j = centre - support_; j <= centre + support_; ++j)
-      sum += p_[static_cast<size_t>(std::clamp(j, 0, n - 1))] * weight(x - j);
-    return sum;
-  }
-
   std::span<const double> p_;
-  double sigma_;
+  double a_;     // 1 / (2 sigma^2)
+  double norm_;  // 1 / (sigma sqrt(2 pi))
   int support_;
+  bool recurrence_;
+  double ratio_step_;  // exp(-1 / sigma^2)
+  Scratch g_;          // Gaussian at the pixel edges
 };
 
-// Binomial weights C(2r, k) / 4^r, k = 0 .. 2r.
-std::vector<double> BinomialWeights(int radius) {
-  std::vector<double> w{1.0};
-  for (int i = 0; i < 2 * radius; ++i) {
-    std::vector<double> next(w.size() + 1, 0.0);
-    for (size_t k = 0; k < w.size(); ++k) {
-      next[k] += 0.5 * w[k];
-      next[k + 1] += 0.5 * w[k];
-    }
-    w = std::move(next);
+// Binomial weights C(2r, k) / 4^r, k = 0 .. 2r (r <= 4).
+std::array<double, 9> BinomialWeights(int radius) {
+  std::array<double, 9> w{};
+  w[0] = 1.0;
+  for (size_t i = 0; i < static_cast<size_t>(2 * radius); ++i) {
+    for (size_t k = i + 1; k >= 1; --k) w[k] = 0.5 * w[k] + 0.5 * w[k - 1];
+    w[0] *= 0.5;
   }
   return w;
-}
-
-double PixelAt(const cv::Mat& image, int y, int x) {
-  return image.depth() == CV_8U ? image.at<unsigned char>(y, x) : image.at<float>(y, x);
 }
 
 void RequireImage(const cv::Mat& image, const char* function) {
@@ -107,68 +174,72 @@ int ProfileReach(const StripeCentreParams& p) {
          static_cast<int>(std::ceil(4.0 * max_sigma)) + 2;
 }
 
+// MeasureStripeProfile (stripe_centre.h) without the parameter check.
+std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile, double approximate,
+                                                const StripeCentreParams& params);
+
 // Measures across a stripe: `across` is the coordinate along the profile,
-// `along` the fixed row (column); at(along, across) reads the image.
-template <typename At>
-std::optional<double> MeasureAcross(int along, int along_size, int across_size, double approximate,
-                                    const StripeCentreParams& params, At at) {
+// `along` the fixed row (column) and `row_major` says which is the image row.
+template <typename Pixel>
+std::optional<double> MeasureAcross(const cv::Mat& image, bool row_major, int along,
+                                    double approximate, const StripeCentreParams& params) {
+  const int along_size = row_major ? image.rows : image.cols;
+  const int across_size = row_major ? image.cols : image.rows;
   if (!(approximate >= 0.0 && approximate <= across_size - 1)) return std::nullopt;
   const int reach = ProfileReach(params);
   const int centre = static_cast<int>(std::lround(approximate));
   const int lo = std::max(0, centre - reach);
   const int hi = std::min(across_size - 1, centre + reach);
-  const std::vector<double> weights = BinomialWeights(params.along_radius);
-  std::vector<double> profile(static_cast<size_t>(hi - lo + 1), 0.0);
-  double total = 0.0;
-  for (int k = -params.along_radius; k <= params.along_radius; ++k) {
-    const int a = along + k;
-    if (a < 0 || a >= along_size) continue;  // renormalised below
-    const double w = weights[static_cast<size_t>(k + params.along_radius)];
-    total += w;
-    for (int i = lo; i <= hi; ++i) profile[static_cast<size_t>(i - lo)] += w * at(a, i);
+  const std::array<double, 9> weights = BinomialWeights(params.along_radius);
+  Scratch buffer(static_cast<size_t>(hi - lo + 1));
+  const std::span<double> profile = buffer.span();
+  const int first = std::max(0, along - params.along_radius);
+  const int last = std::min(along_size - 1, along + params.along_radius);
+  double total = 0.0;  // < 1 where the rows (columns) run out at the border
+  for (int a = first; a <= last; ++a)
+    total += weights[static_cast<size_t>(a - along + params.along_radius)];
+  if (row_major) {
+    for (int a = first; a <= last; ++a) {
+      const double w = weights[static_cast<size_t>(a - along + params.along_radius)];
+      const Pixel* row = image.ptr<Pixel>(a);
+      for (int i = lo; i <= hi; ++i) profile[static_cast<size_t>(i - lo)] += w * row[i];
+    }
+  } else {
+    for (int i = lo; i <= hi; ++i) {
+      const Pixel* row = image.ptr<Pixel>(i);
+      double& v = profile[static_cast<size_t>(i - lo)];
+      for (int a = first; a <= last; ++a)
+        v += weights[static_cast<size_t>(a - along + params.along_radius)] * row[a];
+    }
   }
-  for (double& v : profile) v /= total;
-  const auto m = MeasureStripeProfile(profile, approximate - lo, params);
+  if (total != 1.0)
+    for (double& v : profile) v /= total;
+  const auto m = MeasureProfile(profile, approximate - lo, params);
   if (!m) return std::nullopt;
   return m->centre + lo;
 }
 
-}  // namespace
-
-bool StripeCentreParams::IsValid(std::string* error) const {
-  auto fail = [error](const char* why) {
-    if (error) *error = why;
-    return false;
-  };
-  if (search_radius < 1 || search_radius > 64) return fail("search_radius must lie in 1..64 px");
-  if (!(max_width > 0.0 && max_width <= 64.0)) return fail("max_width must lie in (0, 64] px");
-  if (!(min_contrast > 0.0)) return fail("min_contrast must be > 0 grey levels");
-  if (along_radius < 0 || along_radius > 4) return fail("along_radius must lie in 0..4");
-  if (!(min_sigma > 0.0 && min_sigma <= 16.0)) return fail("min_sigma must lie in (0, 16] px");
-  if (!(sigma_per_width > 0.0 && sigma_per_width <= 2.0))
-    return fail("sigma_per_width must lie in (0, 2]");
-  if (!(clearance > 0.0)) return fail("clearance must be > 0");
-  return true;
-}
-
-std::optional<StripeMeasurement> MeasureStripeProfile(std::span<const double> profile,
-                                                      double approximate,
-                                                      const StripeCentreParams& params) {
-  RequireValid(params, "MeasureStripeProfile");
+std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile, double approximate,
+                                                const StripeCentreParams& params) {
   const int n = static_cast<int>(profile.size());
   if (n < 3 || !(approximate >= 0.0 && approximate <= n - 1)) return std::nullopt;
 
-  // Peak of the 1 px smoothed profile inside the search range.
-  const std::vector<double> s = SmoothedProfile(profile, 1.0).ValuesAtPixels();
-  auto at = [&s](int i) { return s[static_cast<size_t>(i)]; };
+  // Peak of the 1 px smoothed profile inside the search range; the steps
+  // below read it only within climb + reach of that range.
   const int a = std::max(0, static_cast<int>(std::floor(approximate)) - params.search_radius);
   const int b = std::min(n - 1, static_cast<int>(std::ceil(approximate)) + params.search_radius);
+  const int climb = static_cast<int>(std::ceil(0.5 * params.max_width));
+  const int reach = climb + 6;
+  Scratch smoothed(profile.size());
+  SmoothedAtPixels(profile, std::max(0, a - climb - reach), std::min(n - 1, b + climb + reach),
+                   smoothed.span());
+  const double* s = smoothed.data();
+  auto at = [s](int i) { return s[i]; };
   int peak = a;
   for (int i = a; i <= b; ++i)
     if (at(i) > at(peak)) peak = i;
   // On a wide stripe the top may lie beyond the range: climb to it (the
   // centre itself must still come out within the range, checked below).
-  const int climb = static_cast<int>(std::ceil(0.5 * params.max_width));
   for (int k = 0; k < climb && peak > 0 && at(peak - 1) > at(peak); ++k) --peak;
   for (int k = 0; k < climb && peak < n - 1 && at(peak + 1) > at(peak); ++k) ++peak;
   // The maximum must be a true local maximum, not the slope of something else.
@@ -176,7 +247,6 @@ std::optional<StripeMeasurement> MeasureStripeProfile(std::span<const double> pr
     return std::nullopt;
 
   // Grounds: lowest values before the profile rises again (a neighbour) or the reach ends.
-  const int reach = static_cast<int>(std::ceil(0.5 * params.max_width)) + 6;
   auto ground = [&](int step, int* where) {
     double deepest = at(peak);  // lowest value within the reach
     for (int k = 1; k <= reach; ++k) {
@@ -225,14 +295,15 @@ std::optional<StripeMeasurement> MeasureStripeProfile(std::span<const double> pr
   sigma = std::min(sigma, std::max(params.min_sigma, clear / params.clearance));
 
   // Newton's method on the first derivative of the smoothed profile.
-  const SmoothedProfile smooth(profile, sigma);
+  SmoothedDerivatives smooth(profile, sigma);
   const double reach_from_peak = std::max(2.0, 0.5 * width + 1.0);  // flat tops
   double x = peak;
+  double d1 = 0.0, d2 = 0.0;
   bool converged = false;
   for (int iteration = 0; iteration < 30; ++iteration) {
-    const double d2 = smooth.D2(x);
+    smooth.At(x, &d1, &d2);
     if (!(d2 < 0.0)) return std::nullopt;  // not a maximum
-    const double step = std::clamp(smooth.D1(x) / d2, -0.5, 0.5);
+    const double step = std::clamp(d1 / d2, -0.5, 0.5);
     x -= step;
     if (std::abs(x - peak) > reach_from_peak) return std::nullopt;
     if (std::abs(step) < 1e-5) {
@@ -240,9 +311,36 @@ std::optional<StripeMeasurement> MeasureStripeProfile(std::span<const double> pr
       break;
     }
   }
-  if (!converged || !(smooth.D2(x) < 0.0)) return std::nullopt;
+  if (!converged) return std::nullopt;
+  smooth.At(x, &d1, &d2);
+  if (!(d2 < 0.0)) return std::nullopt;
   if (std::abs(x - approximate) > params.search_radius + 0.5) return std::nullopt;
   return StripeMeasurement{x, width, contrast, sigma};
+}
+
+}  // namespace
+
+bool StripeCentreParams::IsValid(std::string* error) const {
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (search_radius < 1 || search_radius > 64) return fail("search_radius must lie in 1..64 px");
+  if (!(max_width > 0.0 && max_width <= 64.0)) return fail("max_width must lie in (0, 64] px");
+  if (!(min_contrast > 0.0)) return fail("min_contrast must be > 0 grey levels");
+  if (along_radius < 0 || along_radius > 4) return fail("along_radius must lie in 0..4");
+  if (!(min_sigma > 0.0 && min_sigma <= 16.0)) return fail("min_sigma must lie in (0, 16] px");
+  if (!(sigma_per_width > 0.0 && sigma_per_width <= 2.0))
+    return fail("sigma_per_width must lie in (0, 2]");
+  if (!(clearance > 0.0)) return fail("clearance must be > 0");
+  return true;
+}
+
+std::optional<StripeMeasurement> MeasureStripeProfile(std::span<const double> profile,
+                                                      double approximate,
+                                                      const StripeCentreParams& params) {
+  RequireValid(params, "MeasureStripeProfile");
+  return MeasureProfile(profile, approximate, params);
 }
 
 std::optional<double> StripeCentreInRow(const cv::Mat& image, int y, double approximate_x,
@@ -252,8 +350,9 @@ std::optional<double> StripeCentreInRow(const cv::Mat& image, int y, double appr
   if (y < 0 || y >= image.rows)
     throw std::invalid_argument("StripeCentreInRow: row " + std::to_string(y) +
                                 " outside the image");
-  return MeasureAcross(y, image.rows, image.cols, approximate_x, params,
-                       [&image](int row, int col) { return PixelAt(image, row, col); });
+  return image.depth() == CV_8U
+             ? MeasureAcross<unsigned char>(image, true, y, approximate_x, params)
+             : MeasureAcross<float>(image, true, y, approximate_x, params);
 }
 
 std::optional<double> StripeCentreInColumn(const cv::Mat& image, int x, double approximate_y,
@@ -263,8 +362,9 @@ std::optional<double> StripeCentreInColumn(const cv::Mat& image, int x, double a
   if (x < 0 || x >= image.cols)
     throw std::invalid_argument("StripeCentreInColumn: column " + std::to_string(x) +
                                 " outside the image");
-  return MeasureAcross(x, image.cols, image.rows, approximate_y, params,
-                       [&image](int col, int row) { return PixelAt(image, row, col); });
+  return image.depth() == CV_8U
+             ? MeasureAcross<unsigned char>(image, false, x, approximate_y, params)
+             : MeasureAcross<float>(image, false, x, approximate_y, params);
 }
 
 }  // namespace bsls::extraction

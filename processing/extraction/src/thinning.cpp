@@ -1,17 +1,24 @@
 #include "bsls/extraction/thinning.h"
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
 #include <cstdlib>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <vector>
 
+#include "bands.h"
 #include "input_checks.h"
 #include "neighbourhood.h"
+#include "skeleton_in_place.h"
 
 namespace bsls::extraction {
 namespace {
 
+using internal::CodeTable;
+using internal::GaussianBandsInto;
+using internal::MakeCodeTable;
 using internal::Neighbours;
 using internal::PaddedBinary;
 using internal::RequireGrey8;
@@ -340,14 +347,40 @@ class LineFollower {
 // ---------------------------------------------------------------------------
 // Thesis 4.3.2: Zhang-Suen.
 
-// Conditions of eq. 4.18 (step 0) or eq. 4.20 (step 1) for the pixel at index i.
-bool ZhangSuenDeletable(const PaddedBinary& img, size_t i, int step) {
-  const Neighbours n = img.NeighboursOf(i);
+// Conditions of eq. 4.18 (step 0) or eq. 4.20 (step 1) on a neighbourhood.
+bool ZhangSuenDeletable(const Neighbours& n, int step) {
   const int count = n.Count();
   if (count < 2 || count > 6) return false;                                  // (a)
   if (n.Transitions() != 1) return false;                                    // (b)
   if (step == 0) return !(n.p2 && n.p4 && n.p6) && !(n.p4 && n.p6 && n.p8);  // (c), (d)
   return !(n.p2 && n.p4 && n.p8) && !(n.p2 && n.p6 && n.p8);                 // (c'), (d')
+}
+
+// ZhangSuenDeletable for every neighbourhood code, per step.
+const CodeTable& ZhangSuenTable(int step) {
+  static const CodeTable tables[2] = {
+      MakeCodeTable([](const Neighbours& n) { return ZhangSuenDeletable(n, 0); }),
+      MakeCodeTable([](const Neighbours& n) { return ZhangSuenDeletable(n, 1); })};
+  return tables[step];
+}
+
+// Deleting the pixel changes no topology and shortens no line: at least two
+// set neighbours and 8-simple.
+bool Simple(const Neighbours& n) { return n.Count() >= 2 && n.ConnectivityNumber8() == 1; }
+
+// Simple for every neighbourhood code.
+const CodeTable& SimpleTable() {
+  static const CodeTable table = MakeCodeTable(Simple);
+  return table;
+}
+
+// What MakeOnePixelWide deletes: simple pixels, except T-centres (three or
+// four set 4-neighbours) when they are kept.
+const CodeTable& ThinnableTable(TJunctionShape t_junctions) {
+  static const CodeTable keep_centres =
+      MakeCodeTable([](const Neighbours& n) { return Simple(n) && n.p2 + n.p4 + n.p6 + n.p8 < 3; });
+  static const CodeTable notched = MakeCodeTable(Simple);
+  return t_junctions == TJunctionShape::kCentreKept ? keep_centres : notched;
 }
 
 }  // namespace
@@ -383,47 +416,14 @@ cv::Mat ZhangSuenThin(const cv::Mat& binary, const ZhangSuenParams& params) {
   RequireGrey8(binary, "ZhangSuenThin", "binary image");
   RequireValid(params, "ZhangSuenThin");
   PaddedBinary img(binary);
-  std::vector<size_t> live = img.SetIndices();
-  std::vector<size_t> flagged;
-  for (int iteration = 0; iteration < params.max_iterations; ++iteration) {
-    bool changed = false;
-    for (int step = 0; step < 2; ++step) {
-      flagged.clear();
-      for (size_t i : live)
-        if (img.data[i] && ZhangSuenDeletable(img, i, step)) flagged.push_back(i);
-      for (size_t i : flagged) {
-        if (params.preserve_topology) {
-          // Sequential re-check: keep what has become an end point or non-simple.
-          const Neighbours n = img.NeighboursOf(i);
-          if (n.Count() < 2 || n.ConnectivityNumber8() != 1) continue;
-        }
-        img.data[i] = 0;
-        changed = true;
-      }
-    }
-    std::erase_if(live, [&img](size_t i) { return !img.data[i]; });
-    if (!changed) break;
-  }
+  internal::ZhangSuenThinInPlace(&img, params);
   return img.ToMat();
 }
 
 cv::Mat MakeOnePixelWide(const cv::Mat& skeleton, TJunctionShape t_junctions) {
   RequireGrey8(skeleton, "MakeOnePixelWide", "skeleton");
-  const bool keep_t_centres = t_junctions == TJunctionShape::kCentreKept;
   PaddedBinary img(skeleton);
-  std::vector<size_t> live = img.SetIndices();
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (size_t i : live) {
-      if (!img.data[i]) continue;
-      const Neighbours n = img.NeighboursOf(i);
-      if (n.Count() < 2 || n.ConnectivityNumber8() != 1) continue;
-      if (keep_t_centres && n.p2 + n.p4 + n.p6 + n.p8 >= 3) continue;
-      img.data[i] = 0;
-      changed = true;
-    }
-    std::erase_if(live, [&img](size_t i) { return !img.data[i]; });
-  }
+  internal::MakeOnePixelWideInPlace(&img, t_junctions);
   return img.ToMat();
 }
 
@@ -447,82 +447,139 @@ cv::Mat RecentreOnRidge(const cv::Mat& skeleton, const cv::Mat& grey,
   RequireValid(params, "RecentreOnRidge");
   if (grey.size() != skeleton.size())
     throw std::invalid_argument("RecentreOnRidge: skeleton and grey image differ in size");
-  cv::Mat f;
-  grey.convertTo(f, CV_32F);
-  const int half = static_cast<int>(std::ceil(3.0 * params.sigma));
-  cv::GaussianBlur(f, f, cv::Size(2 * half + 1, 2 * half + 1), params.sigma, params.sigma,
-                   cv::BORDER_REPLICATE);
-  cv::Mat s = skeleton != 0;
-  auto at = [&s](int x, int y) {
-    return x >= 0 && y >= 0 && x < s.cols && y < s.rows && s.at<unsigned char>(y, x) != 0;
-  };
+  PaddedBinary img(skeleton);
+  internal::RecentreOnRidgeInPlace(&img, grey, params);
+  return img.ToMat();
+}
+
+namespace internal {
+
+// Thesis 4.3.2: the two sub-iterations of eq. 4.18 - 4.20 over the live pixels,
+// their conditions looked up by neighbourhood code.
+void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params) {
+  std::vector<size_t> live = img->SetIndices();
+  std::vector<size_t> flagged;
+  const CodeTable& simple = SimpleTable();
+  for (int iteration = 0; iteration < params.max_iterations; ++iteration) {
+    bool changed = false;
+    for (int step = 0; step < 2; ++step) {
+      const CodeTable& deletable = ZhangSuenTable(step);
+      flagged.clear();
+      for (size_t i : live)
+        if (img->data[i] && deletable[img->CodeOf(i)]) flagged.push_back(i);
+      for (size_t i : flagged) {
+        // Sequential re-check: keep what has become an end point or non-simple.
+        if (params.preserve_topology && !simple[img->CodeOf(i)]) continue;
+        img->data[i] = 0;
+        changed = true;
+      }
+    }
+    std::erase_if(live, [img](size_t i) { return !img->data[i]; });
+    if (!changed) break;
+  }
+}
+
+// Sweeps in raster order, deleting thinnable pixels, until a sweep deletes none.
+void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions) {
+  const CodeTable& thinnable = ThinnableTable(t_junctions);
+  std::vector<size_t> live = img->SetIndices();
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t i : live) {
+      if (!img->data[i] || !thinnable[img->CodeOf(i)]) continue;
+      img->data[i] = 0;
+      changed = true;
+    }
+    std::erase_if(live, [img](size_t i) { return !img->data[i]; });
+  }
+}
+
+// The passes of RecentreOnRidge on the padded buffer, pixels addressed by
+// buffer index (no division per look-up).
+void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& grey, const RecentreParams& params) {
+  const int rows = img->Rows(), cols = img->Cols();
+  const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(img->Stride());
+  // The 8 neighbours in the order dy = -1 .. 1, dx = -1 .. 1: steps and buffer offsets.
+  constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+  constexpr int kDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+  std::ptrdiff_t around[8];
+  for (int k = 0; k < 8; ++k) around[k] = kDy[k] * stride + kDx[k];
+  auto set = [img](std::ptrdiff_t i) { return img->data[static_cast<size_t>(i)] != 0; };
+  // The smoothed grey image in a buffer laid out like img's (frame unused).
+  cv::Mat smoothed(rows + 2, cols + 2, CV_32F);
+  {
+    cv::Mat inner = smoothed(cv::Rect(1, 1, cols, rows));
+    GaussianBandsInto(grey, params.sigma, static_cast<int>(std::ceil(3.0 * params.sigma)), &inner);
+  }
+  const float* f = smoothed.ptr<float>(0);
   const float min_gain = static_cast<float>(params.min_gain);
   // Near junctions the grey ridge bends towards the branches: keep clear.
-  cv::Mat near_junction = cv::Mat::zeros(s.size(), CV_8UC1);
+  std::vector<std::uint8_t> near_junction(img->data.size(), 0);
   {
-    std::vector<cv::Point> pixels;
-    cv::findNonZero(s, pixels);
-    for (const cv::Point& p : pixels) {
-      int count = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) count += (dx || dy) && at(p.x + dx, p.y + dy);
-      if (count >= 3) near_junction.at<unsigned char>(p) = 255;
+    const int c = params.junction_clearance;
+    for (size_t i : img->SetIndices()) {
+      if (std::popcount(img->CodeOf(i)) < 3) continue;
+      const int x = img->X(i), y = img->Y(i);
+      for (int yy = std::max(0, y - c); yy <= std::min(rows - 1, y + c); ++yy)
+        for (int xx = std::max(0, x - c); xx <= std::min(cols - 1, x + c); ++xx)
+          near_junction[img->Index(xx, yy)] = 1;
     }
-    const int side = 2 * params.junction_clearance + 1;
-    cv::dilate(near_junction, near_junction, cv::Mat::ones(side, side, CV_8U));
   }
+  std::vector<std::uint8_t> moved(img->data.size(), 0);
   for (int pass = 0; pass < params.passes; ++pass) {
-    std::vector<cv::Point> pixels;
-    cv::findNonZero(s, pixels);
-    cv::Mat moved = cv::Mat::zeros(s.size(), CV_8UC1);
+    const std::vector<size_t> pixels = img->SetIndices();
+    std::fill(moved.begin(), moved.end(), 0);
     bool any = false;
-    for (const cv::Point& p : pixels) {
-      if (!at(p.x, p.y) || moved.at<unsigned char>(p) || near_junction.at<unsigned char>(p))
-        continue;
-      cv::Point nb[2];
+    for (size_t pu : pixels) {
+      const std::ptrdiff_t p = static_cast<std::ptrdiff_t>(pu);
+      if (!set(p) || moved[pu] || near_junction[pu]) continue;
+      int nb[2] = {0, 0};  // neighbour numbers (into kDx, kDy, around)
       int count = 0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          if ((dx || dy) && at(p.x + dx, p.y + dy)) {
-            if (count < 2) nb[count] = {p.x + dx, p.y + dy};
-            ++count;
-          }
+      for (int k = 0; k < 8; ++k)
+        if (set(p + around[k])) {
+          if (count < 2) nb[count] = k;
+          ++count;
+        }
       if (count != 2) continue;  // ends and junctions stay
-      cv::Point step;
-      if (std::abs(nb[0].y - nb[1].y) == 2)
-        step = {1, 0};  // neighbours above and below: move across, along x
-      else if (std::abs(nb[0].x - nb[1].x) == 2)
-        step = {0, 1};  // neighbours left and right: move along y
-      else
+      int sx, sy;
+      if (std::abs(kDy[nb[0]] - kDy[nb[1]]) == 2) {
+        sx = 1, sy = 0;  // neighbours above and below: move across, along x
+      } else if (std::abs(kDx[nb[0]] - kDx[nb[1]]) == 2) {
+        sx = 0, sy = 1;  // neighbours left and right: move along y
+      } else {
         continue;  // a corner
-      const float here = f.at<float>(p);
-      std::optional<cv::Point> best;
+      }
+      const int x = img->X(pu), y = img->Y(pu);
+      const float here = f[pu];
+      std::ptrdiff_t best = -1;
       float best_value = here + min_gain;
       for (int sign : {-1, 1}) {
-        const cv::Point q = p + sign * step;
-        if (q.x < 0 || q.y < 0 || q.x >= s.cols || q.y >= s.rows || at(q.x, q.y)) continue;
+        const int dx = sign * sx, dy = sign * sy;  // p -> q
+        if (x + dx < 0 || y + dy < 0 || x + dx >= cols || y + dy >= rows) continue;
+        const std::ptrdiff_t q = p + dy * stride + dx;
+        if (set(q)) continue;
         bool ok = true;
-        for (const cv::Point& n : nb)
-          ok = ok && std::abs(n.x - q.x) <= 1 && std::abs(n.y - q.y) <= 1;
-        for (int dy = -1; dy <= 1 && ok; ++dy)
-          for (int dx = -1; dx <= 1 && ok; ++dx) {
-            const cv::Point r(q.x + dx, q.y + dy);
-            if ((dx || dy) && r != p && r != nb[0] && r != nb[1] && at(r.x, r.y)) ok = false;
-          }
-        if (ok && f.at<float>(q) >= best_value) {
+        for (int k : nb) ok = ok && std::abs(kDx[k] - dx) <= 1 && std::abs(kDy[k] - dy) <= 1;
+        for (std::ptrdiff_t o : around) {
+          const std::ptrdiff_t r = q + o;
+          if (!ok) break;
+          if (r != p && r != p + around[nb[0]] && r != p + around[nb[1]] && set(r)) ok = false;
+        }
+        if (ok && f[q] >= best_value) {
           best = q;
-          best_value = f.at<float>(q);
+          best_value = f[q];
         }
       }
-      if (!best) continue;
-      s.at<unsigned char>(p) = 0;
-      s.at<unsigned char>(*best) = 255;
-      moved.at<unsigned char>(*best) = 255;
+      if (best < 0) continue;
+      img->data[pu] = 0;
+      img->data[static_cast<size_t>(best)] = 1;
+      moved[static_cast<size_t>(best)] = 1;
       any = true;
     }
     if (!any) break;
   }
-  return s;
 }
+
+}  // namespace internal
 
 }  // namespace bsls::extraction

@@ -1,5 +1,6 @@
 #include "bsls/interpretation/interpreter.h"
 
+#include <memory>
 #include <opencv2/core.hpp>
 #include <stdexcept>
 
@@ -125,26 +126,30 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   // Thesis 5.2.3.3: corners become junctions with a one-stroke stub.
   result.corners = ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, mask);
 
-  // Thesis 5.2.3 and 5.1.4: trace boundary and loops, correct, retrace.
-  for (int round = 0; params.enable_repair && round < params.max_repair_rounds; ++round) {
-    const SkeletonGraph graph = SkeletonGraph::Build(sk, params.graph);
-    const JunctionNetwork network(graph, side, params.junction);
-    const std::vector<LoopRecord> loops = TraceLoops(network);
+  // Thesis 5.2.3 and 5.1.4: trace boundary and loops, correct, retrace. The
+  // graph of the last round is the final one: a round without repairs leaves
+  // the skeleton as it was, so it is not built again.
+  std::unique_ptr<SkeletonGraph> graph;
+  std::unique_ptr<JunctionNetwork> network;
+  std::vector<LoopRecord> loops;
+  for (int round = 0;; ++round) {
+    network.reset();  // it refers to the graph
+    graph.reset();    // first, so that the new graph can take over its memory
+    graph = std::make_unique<SkeletonGraph>(SkeletonGraph::Build(sk, params.graph));
+    network = std::make_unique<JunctionNetwork>(*graph, side, params.junction);
+    loops = TraceLoops(*network);
+    if (!params.enable_repair || round == params.max_repair_rounds) break;
     if (round == 0)
       for (const LoopRecord& l : loops) ++result.loop_classes[l.cls];
-    const std::vector<Repair> repairs = RepairRound(network, loops, params.repair, sk);
+    const std::vector<Repair> repairs = RepairRound(*network, loops, params.repair, sk);
     if (repairs.empty()) break;
     result.repairs.insert(result.repairs.end(), repairs.begin(), repairs.end());
   }
-
-  const SkeletonGraph graph = SkeletonGraph::Build(sk, params.graph);
-  const JunctionNetwork network(graph, side, params.junction);
-  const std::vector<LoopRecord> loops = TraceLoops(network);
   if (!params.enable_repair)
     for (const LoopRecord& l : loops) ++result.loop_classes[l.cls];
   for (const LoopRecord& l : loops)
     if (l.cls == LoopClass::kBoundary) result.boundary.push_back(l);
-  if (!LabelNetwork(network, loops, result.reference, spec, params.labelling, &result.labelling,
+  if (!LabelNetwork(*network, loops, result.reference, spec, params.labelling, &result.labelling,
                     &why)) {
     result.error = "reference line not found: " + why;
     finish(result);

@@ -38,7 +38,11 @@ LoopRecord TraceLoop(const JunctionNetwork& network, const std::vector<int>& fac
   std::vector<cv::Point> pixels;
   for (int i = 0; i < static_cast<int>(face.size()); ++i) {
     const int h = face[i];
-    for (const cv::Point& p : g.Pixels(h)) pixels.push_back(p);
+    const std::vector<cv::Point>& chain = g.edges()[SkeletonGraph::EdgeOf(h)].pixels;
+    if (h & 1)  // walked backwards
+      pixels.insert(pixels.end(), chain.rbegin(), chain.rend());
+    else
+      pixels.insert(pixels.end(), chain.begin(), chain.end());
     const int node = g.Target(h);
     const SkeletonNode& n = g.nodes()[node];
     const NodeRole& role = network.role(node);

@@ -1,7 +1,11 @@
 #include "bsls/interpretation/skeleton_graph.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <numeric>
 #include <set>
 #include <stdexcept>
@@ -84,18 +88,27 @@ std::vector<std::vector<int>> SkeletonGraph::Faces() const {
 
 double SkeletonGraph::SignedArea2(const std::vector<int>& face) const {
   // Shoelace over node centres and chain pixels, with y flipped so that
-  // anticlockwise on screen is positive.
-  std::vector<cv::Point2d> poly;
-  for (int h : face) {
-    poly.push_back(nodes_[Origin(h)].centre);
-    for (const cv::Point& p : Pixels(h)) poly.emplace_back(p.x, p.y);
-  }
+  // anticlockwise on screen is positive; the polygon is walked on the fly.
+  bool started = false;
+  cv::Point2d first, prev;
   double a = 0.0;
-  for (size_t i = 0; i < poly.size(); ++i) {
-    const cv::Point2d& p = poly[i];
-    const cv::Point2d& q = poly[(i + 1) % poly.size()];
-    a += p.x * (-q.y) - q.x * (-p.y);
+  auto add = [&](const cv::Point2d& q) {
+    if (started)
+      a += prev.x * (-q.y) - q.x * (-prev.y);
+    else
+      first = q;
+    started = true;
+    prev = q;
+  };
+  for (int h : face) {
+    add(nodes_[Origin(h)].centre);
+    const std::vector<cv::Point>& px = edges_[EdgeOf(h)].pixels;
+    if (h & 1)
+      for (auto it = px.rbegin(); it != px.rend(); ++it) add(cv::Point2d(it->x, it->y));
+    else
+      for (const cv::Point& p : px) add(cv::Point2d(p.x, p.y));
   }
+  if (started) add(first);  // closes the polygon (last to first)
   return a;
 }
 
@@ -110,38 +123,72 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
   g.size_ = skeleton.size();
   const int rows = skeleton.rows, cols = skeleton.cols;
 
-  // Binary image with a one-pixel frame so neighbour look-ups need no bounds checks.
-  cv::Mat bin = cv::Mat::zeros(rows + 2, cols + 2, CV_8UC1);
+  // Binary image (0 / 1) and degrees with a one-pixel frame, so that
+  // neighbour look-ups need no bounds checks: frame pixels are unset, of
+  // degree 0.
+  const int stride = cols + 2;
+  std::vector<uchar> bin(static_cast<size_t>(stride) * static_cast<size_t>(rows + 2), 0);
   {
-    cv::Mat inner = bin(cv::Rect(1, 1, cols, rows));
-    cv::compare(skeleton, 0, inner, cv::CMP_NE);
-    inner /= 255;
+    cv::Mat inner = cv::Mat(rows + 2, stride, CV_8UC1, bin.data())(cv::Rect(1, 1, cols, rows));
+    cv::min(skeleton, 1, inner);
   }
-  auto set = [&](int x, int y) { return bin.at<uchar>(y + 1, x + 1) != 0; };
-  // Corner pixels of 4-connected steps (an L of three pixels) make their
-  // neighbours look like junctions; the skeleton stays 8-connected without them.
+  auto at = [stride](int x, int y) {
+    return static_cast<size_t>(y + 1) * static_cast<size_t>(stride) + static_cast<size_t>(x + 1);
+  };
+  auto set = [&](int x, int y) { return bin[at(x, y)] != 0; };
+  auto neighbours = [&](size_t i) {  // the number of set 8-neighbours
+    const uchar* up = &bin[i - static_cast<size_t>(stride)];
+    const uchar* here = &bin[i];
+    const uchar* down = &bin[i + static_cast<size_t>(stride)];
+    return up[-1] + up[0] + up[1] + here[-1] + here[1] + down[-1] + down[0] + down[1];
+  };
   // Only the set pixels are visited from here on (a skeleton is sparse).
   std::vector<cv::Point> lit;
-  cv::findNonZero(skeleton, lit);
+  for (int y = 0; y < rows; ++y) {
+    const uchar* row = &bin[at(0, y)];
+    int x = 0;
+    for (; x + 8 <= cols; x += 8) {         // eight pixels (0 / 1 bytes) at a time
+      if (x % 32 == 0 && x + 32 <= cols) {  // skip empty 32-pixel runs
+        std::uint64_t words[4];
+        std::memcpy(words, row + x, 32);
+        if (!(words[0] | words[1] | words[2] | words[3])) {
+          x += 24;  // and 8 by the loop
+          continue;
+        }
+      }
+      std::uint64_t word;
+      std::memcpy(&word, row + x, 8);
+      static_assert(std::endian::native == std::endian::little);
+      while (word) {  // pixel x + k is bit 8k
+        lit.emplace_back(x + std::countr_zero(word) / 8, y);
+        word &= word - 1;
+      }
+    }
+    for (; x < cols; ++x)
+      if (row[x]) lit.emplace_back(x, y);
+  }
+  // Corner pixels of 4-connected steps (an L of three pixels) make their
+  // neighbours look like junctions; the skeleton stays 8-connected without them.
   for (const cv::Point& p : lit) {
-    const int x = p.x, y = p.y;
-    int n = 0;
-    for (int c = 0; c < 8; ++c) n += set(x + kCodeDx[c], y + kCodeDy[c]);
-    if (n != 2) continue;
-    const bool horizontal = set(x - 1, y) || set(x + 1, y);
-    const bool vertical = set(x, y - 1) || set(x, y + 1);
-    if (horizontal && vertical) bin.at<uchar>(y + 1, x + 1) = 0;
+    const size_t i = at(p.x, p.y);
+    if (neighbours(i) != 2) continue;
+    const bool horizontal = bin[i - 1] || bin[i + 1];
+    const bool vertical =
+        bin[i - static_cast<size_t>(stride)] || bin[i + static_cast<size_t>(stride)];
+    if (horizontal && vertical) bin[i] = 0;
   }
   std::erase_if(lit, [&](const cv::Point& p) { return !set(p.x, p.y); });
-  auto degree = [&](int x, int y) {
-    int d = 0;
-    for (int c = 0; c < 8; ++c) d += set(x + kCodeDx[c], y + kCodeDy[c]);
-    return d;
-  };
+  std::vector<uchar> deg(bin.size(), 0);
+  for (const cv::Point& p : lit) deg[at(p.x, p.y)] = static_cast<uchar>(neighbours(at(p.x, p.y)));
+  auto degree = [&](int x, int y) { return deg[at(x, y)]; };
 
-  g.owner_ = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNone));
-  cv::Mat deg(rows, cols, CV_8UC1, cv::Scalar(0));
-  for (const cv::Point& p : lit) deg.at<uchar>(p) = static_cast<uchar>(degree(p.x, p.y));
+  g.owner_.create(rows, cols, CV_32S);
+  int* const owner_data = g.owner_.ptr<int>(0);  // continuous: freshly allocated
+  static_assert(kNone == -1);                    // every byte 0xFF
+  std::memset(owner_data, 0xFF, g.owner_.total() * sizeof(int));
+  auto owner = [&](int x, int y) -> int& {
+    return owner_data[static_cast<size_t>(y) * static_cast<size_t>(cols) + static_cast<size_t>(x)];
+  };
 
   // Junction clusters: 8-connected groups of pixels with three or more neighbours.
   auto new_node = [&](NodeKind kind) {
@@ -149,53 +196,52 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     return static_cast<int>(g.nodes_.size()) - 1;
   };
   for (const cv::Point& p0 : lit) {
-    {
-      const int x = p0.x, y = p0.y;
-      if (deg.at<uchar>(y, x) < 3 || g.owner_.at<int>(y, x) != kNone) continue;
-      const int id = new_node(NodeKind::kJunction);
-      std::vector<cv::Point> stack{{x, y}};
-      g.owner_.at<int>(y, x) = id;
-      while (!stack.empty()) {
-        const cv::Point p = stack.back();
-        stack.pop_back();
-        g.nodes_[id].pixels.push_back(p);
-        for (int c = 0; c < 8; ++c) {
-          const int nx = p.x + kCodeDx[c], ny = p.y + kCodeDy[c];
-          if (!Inside(deg, nx, ny) || deg.at<uchar>(ny, nx) < 3) continue;
-          if (g.owner_.at<int>(ny, nx) != kNone) continue;
-          g.owner_.at<int>(ny, nx) = id;
-          stack.push_back({nx, ny});
-        }
+    const int x = p0.x, y = p0.y;
+    if (degree(x, y) < 3 || owner(x, y) != kNone) continue;
+    const int id = new_node(NodeKind::kJunction);
+    std::vector<cv::Point> stack{{x, y}};
+    owner(x, y) = id;
+    while (!stack.empty()) {
+      const cv::Point p = stack.back();
+      stack.pop_back();
+      g.nodes_[id].pixels.push_back(p);
+      for (int c = 0; c < 8; ++c) {
+        const int nx = p.x + kCodeDx[c], ny = p.y + kCodeDy[c];
+        if (degree(nx, ny) < 3) continue;  // also outside the image
+        if (owner(nx, ny) != kNone) continue;
+        owner(nx, ny) = id;
+        stack.push_back({nx, ny});
       }
     }
   }
   // A two-neighbour pixel whose neighbours all belong to one cluster is part of it.
   for (const cv::Point& p0 : lit) {
-    {
-      const int x = p0.x, y = p0.y;
-      if (deg.at<uchar>(y, x) != 2 || g.owner_.at<int>(y, x) != kNone) continue;
-      int cluster = kNone;
-      bool same = true;
-      for (int c = 0; c < 8 && same; ++c) {
-        const int nx = x + kCodeDx[c], ny = y + kCodeDy[c];
-        if (!Inside(deg, nx, ny) || !set(nx, ny)) continue;
-        const int o = g.owner_.at<int>(ny, nx);
-        if (o < 0 || g.nodes_[o].kind != NodeKind::kJunction) same = false;
-        else if (cluster == kNone) cluster = o;
-        else if (cluster != o) same = false;
-      }
-      if (same && cluster != kNone) {
-        g.owner_.at<int>(y, x) = cluster;
-        g.nodes_[cluster].pixels.push_back({x, y});
-      }
+    const int x = p0.x, y = p0.y;
+    if (degree(x, y) != 2 || owner(x, y) != kNone) continue;
+    int cluster = kNone;
+    bool same = true;
+    for (int c = 0; c < 8 && same; ++c) {
+      const int nx = x + kCodeDx[c], ny = y + kCodeDy[c];
+      if (!set(nx, ny)) continue;
+      const int o = owner(nx, ny);
+      if (o < 0 || g.nodes_[o].kind != NodeKind::kJunction)
+        same = false;
+      else if (cluster == kNone)
+        cluster = o;
+      else if (cluster != o)
+        same = false;
+    }
+    if (same && cluster != kNone) {
+      owner(x, y) = cluster;
+      g.nodes_[cluster].pixels.push_back({x, y});
     }
   }
   // Line ends.
   for (const cv::Point& p : lit)
-    if (deg.at<uchar>(p) == 1 && g.owner_.at<int>(p) == kNone) {
+    if (degree(p.x, p.y) == 1 && owner(p.x, p.y) == kNone) {
       const int id = new_node(NodeKind::kEnd);
       g.nodes_[id].pixels.push_back(p);
-      g.owner_.at<int>(p) = id;
+      owner(p.x, p.y) = id;
     }
 
   // Chains between nodes.
@@ -206,33 +252,33 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     const int id = static_cast<int>(g.edges_.size());
     cv::Point prev = start, cur = first;
     while (true) {
-      const int o = g.owner_.at<int>(cur);
+      const int o = owner(cur.x, cur.y);
       if (o >= 0) {
         edge.to = o;
         break;
       }
-      g.owner_.at<int>(cur) = EncodeEdge(id);
+      owner(cur.x, cur.y) = EncodeEdge(id);
       edge.pixels.push_back(cur);
       cv::Point next(-1, -1);
       // Prefer stepping onto a node pixel (other than the one we came from at
       // the very start) so chains stop at their junction.
       for (int c = 0; c < 8; ++c) {
         const int nx = cur.x + kCodeDx[c], ny = cur.y + kCodeDy[c];
-        if (!Inside(deg, nx, ny) || !set(nx, ny) || cv::Point(nx, ny) == prev) continue;
-        const int owner = g.owner_.at<int>(ny, nx);
-        if (owner >= 0) {
-          if (edge.pixels.size() == 1 && owner == node && cv::Point(nx, ny) != start) continue;
+        if (!set(nx, ny) || cv::Point(nx, ny) == prev) continue;
+        const int o2 = owner(nx, ny);
+        if (o2 >= 0) {
+          if (edge.pixels.size() == 1 && o2 == node && cv::Point(nx, ny) != start) continue;
           next = {nx, ny};
           break;
         }
-        if (owner == kNone) next = {nx, ny};
+        if (o2 == kNone) next = {nx, ny};
       }
       if (next.x < 0) {
         // Dead end inside a chain (cannot happen on a thin skeleton): close at an end node.
         const int end = new_node(NodeKind::kEnd);
         edge.pixels.pop_back();
         g.nodes_[end].pixels.push_back(cur);
-        g.owner_.at<int>(cur) = end;
+        owner(cur.x, cur.y) = end;
         edge.to = end;
         break;
       }
@@ -242,12 +288,13 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     g.edges_.push_back(std::move(edge));
   };
   for (int n = 0; n < static_cast<int>(g.nodes_.size()); ++n) {
-    const std::vector<cv::Point> pixels = g.nodes_[n].pixels;
-    for (const cv::Point& p : pixels) {
+    // By index: tracing may add nodes (moving nodes_), never pixels of node n.
+    for (size_t k = 0; k < g.nodes_[n].pixels.size(); ++k) {
+      const cv::Point p = g.nodes_[n].pixels[k];
       for (int c = 0; c < 8; ++c) {
         const int nx = p.x + kCodeDx[c], ny = p.y + kCodeDy[c];
-        if (!Inside(deg, nx, ny) || !set(nx, ny)) continue;
-        const int o = g.owner_.at<int>(ny, nx);
+        if (!set(nx, ny)) continue;
+        const int o = owner(nx, ny);
         if (o == kNone) {
           trace_from(n, p, {nx, ny});
         } else if (o >= 0 && o != n) {
@@ -264,18 +311,16 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
   }
   // Closed chains without any node get an anchor.
   for (const cv::Point& p0 : lit) {
-    {
-      const int x = p0.x, y = p0.y;
-      if (g.owner_.at<int>(y, x) != kNone || deg.at<uchar>(y, x) == 0) continue;
-      const int id = new_node(NodeKind::kAnchor);
-      g.nodes_[id].pixels.push_back({x, y});
-      g.owner_.at<int>(y, x) = id;
-      for (int c = 0; c < 8; ++c) {
-        const int nx = x + kCodeDx[c], ny = y + kCodeDy[c];
-        if (Inside(deg, nx, ny) && set(nx, ny) && g.owner_.at<int>(ny, nx) == kNone) {
-          trace_from(id, {x, y}, {nx, ny});
-          break;
-        }
+    const int x = p0.x, y = p0.y;
+    if (owner(x, y) != kNone || degree(x, y) == 0) continue;
+    const int id = new_node(NodeKind::kAnchor);
+    g.nodes_[id].pixels.push_back({x, y});
+    owner(x, y) = id;
+    for (int c = 0; c < 8; ++c) {
+      const int nx = x + kCodeDx[c], ny = y + kCodeDy[c];
+      if (set(nx, ny) && owner(nx, ny) == kNone) {
+        trace_from(id, {x, y}, {nx, ny});
+        break;
       }
     }
   }

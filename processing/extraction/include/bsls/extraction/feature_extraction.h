@@ -2,11 +2,12 @@
 // in, one-pixel-wide skeleton of the stripes out, for the tracing of
 // chapter 5.
 //
-//  kModern (default): smoothed = Enhance(grey, enhance) (for the sub-pixel
-//    centre detector, stripe_centre.h); mask = DetectStripes(grey, stripe);
-//    skeleton = Zhang-Suen (4.3.2) -> MakeOnePixelWide -> RecentreOnRidge
-//    (on the grey input) -> PruneSpurs -> RemoveSmallComponents ->
-//    MakeOnePixelWide.
+//  kModern (default): mask = DetectStripes(grey, stripe); skeleton =
+//    Zhang-Suen (4.3.2) -> MakeOnePixelWide -> RecentreOnRidge (on the grey
+//    input) -> PruneSpurs -> RemoveSmallComponents -> MakeOnePixelWide.
+//    smoothed is left empty: nothing in this chain (nor the decoder's
+//    sub-pixel centres, which read the grey frame) uses it; call Enhance
+//    for it.
 //  kThesis: smoothed = Enhance(grey, enhance) (Gaussian or Davies, 4.1);
 //    mask = CannyEdges(smoothed, canny) with the two-peak thresholds (4.2.3);
 //    skeleton = LineFollowingThin (4.3.1) -> ApplyPruningWindows (4.4) ->
@@ -16,7 +17,8 @@
 //
 // Images: input CV_8UC1 grey (x = column, y = row, origin at the centre of
 // the top-left pixel). Outputs are new images of the input's size:
-// smoothed CV_8UC1, mask and skeleton CV_8UC1 0/255. The skeleton is
+// smoothed CV_8UC1 (kThesis; empty for kModern), mask and skeleton CV_8UC1
+// 0/255. The skeleton is
 // 8-connected and strictly one pixel wide (MakeOnePixelWide): plain line
 // pixels have exactly 2 set 8-neighbours, line ends 1. With the default
 // t_junctions = kCentreKept a T-junction is a cluster of 4 pixels with 3 or 4
@@ -27,7 +29,9 @@
 // Errors: empty or non-CV_8UC1 input (e.g. CV_8UC3, CV_16U) and invalid
 // parameters throw std::invalid_argument("<Function>: <reason>").
 //
-// Thread-safety: pure function of its arguments.
+// Thread-safety: pure function of its arguments. The Hessian stripe mask and
+// the Gaussian smoothing of RecentreOnRidge run band by band on OpenCV's
+// thread pool (cv::parallel_for_; cv::setNumThreads(1) makes them serial).
 #ifndef BSLS_EXTRACTION_FEATURE_EXTRACTION_H_
 #define BSLS_EXTRACTION_FEATURE_EXTRACTION_H_
 
@@ -49,7 +53,7 @@ enum class ExtractionMethod {
 
 struct ExtractionParams {
   ExtractionMethod method = ExtractionMethod::kModern;
-  EnhanceParams enhance;  // both: the `smoothed` output; kThesis: the input of Canny
+  EnhanceParams enhance;  // kThesis: the `smoothed` output, the input of Canny
   TJunctionShape t_junctions = TJunctionShape::kCentreKept;  // both: skeleton junction shape
   // kModern.
   StripeDetectParams stripe;
@@ -68,7 +72,7 @@ struct ExtractionParams {
 };
 
 struct ExtractionResult {
-  cv::Mat smoothed;  // CV_8UC1, the enhanced grey frame
+  cv::Mat smoothed;  // CV_8UC1, the enhanced grey frame (kThesis; empty for kModern)
   cv::Mat mask;      // CV_8UC1 0/255: stripe pixels (kModern) or Canny edges (kThesis)
   cv::Mat skeleton;  // CV_8UC1 0/255, one pixel wide, 8-connected
 };

@@ -43,7 +43,10 @@
 // Errors: empty or non-CV_8UC1 input and invalid parameters throw
 // std::invalid_argument("<Function>: <reason>").
 //
-// Thread-safety: pure functions of their arguments.
+// Thread-safety: pure functions of their arguments. kHessianRidge runs band
+// by band (64 rows) on OpenCV's thread pool (cv::parallel_for_); every band
+// reads the rows around it, so the result does not depend on the number of
+// threads (cv::setNumThreads(1) makes it serial).
 #ifndef BSLS_EXTRACTION_STRIPE_DETECT_H_
 #define BSLS_EXTRACTION_STRIPE_DETECT_H_
 

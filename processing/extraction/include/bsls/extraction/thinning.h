@@ -14,7 +14,8 @@
 // Errors: empty or non-CV_8UC1 input and invalid parameters throw
 // std::invalid_argument("<Function>: <reason>").
 //
-// Thread-safety: pure functions of their arguments.
+// Thread-safety: pure functions of their arguments. RecentreOnRidge smooths
+// the grey image band by band on OpenCV's thread pool (cv::parallel_for_).
 #ifndef BSLS_EXTRACTION_THINNING_H_
 #define BSLS_EXTRACTION_THINNING_H_
 

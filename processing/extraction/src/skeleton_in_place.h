@@ -1,0 +1,34 @@
+// The thinning and pruning stages working in place on one PaddedBinary, so
+// that the modern chain (feature_extraction.cpp) runs them back to back
+// without converting to and from cv::Mat in between (not installed). Each
+// does exactly what the public function of the same name does; the public
+// functions are these wrapped in conversions.
+#ifndef BSLS_EXTRACTION_SRC_SKELETON_IN_PLACE_H_
+#define BSLS_EXTRACTION_SRC_SKELETON_IN_PLACE_H_
+
+#include <opencv2/core.hpp>
+
+#include "bsls/extraction/pruning.h"
+#include "bsls/extraction/thinning.h"
+#include "neighbourhood.h"
+
+namespace bsls::extraction::internal {
+
+// ZhangSuenThin (thinning.h) on *img.
+void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params);
+
+// MakeOnePixelWide (thinning.h) on *img.
+void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions);
+
+// RecentreOnRidge (thinning.h) on *img; grey is CV_8UC1 of the image's size.
+void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& grey, const RecentreParams& params);
+
+// PruneSpurs (pruning.h) on *img.
+void PruneSpursInPlace(PaddedBinary* img, const SpurPruneParams& params);
+
+// RemoveSmallComponents (pruning.h) on *img; min_pixels >= 1.
+void RemoveSmallComponentsInPlace(PaddedBinary* img, int min_pixels);
+
+}  // namespace bsls::extraction::internal
+
+#endif  // BSLS_EXTRACTION_SRC_SKELETON_IN_PLACE_H_
