@@ -86,17 +86,30 @@ double AlbedoField::At(const Eigen::Vector3d& world) const {
     const AlbedoPatch& p = prepared.patch;
     const double dx = world.x() - p.centre_xy_mm.x();
     const double dy = world.y() - p.centre_xy_mm.y();
-    // Coordinates in the ellipse's own axes, normalised by the semi-axes.
-    const double ex = (prepared.cos_r * dx + prepared.sin_r * dy) / p.semi_axis_x_mm;
-    const double ey = (-prepared.sin_r * dx + prepared.cos_r * dy) / p.semi_axis_y_mm;
-    const double r = std::hypot(ex, ey);
-    // Signed distance to the ellipse, to first order: (r - 1) / |grad r|.
-    double signed_distance = -std::min(p.semi_axis_x_mm, p.semi_axis_y_mm);
-    if (r > 1e-12) {
-      const double gx = ex / p.semi_axis_x_mm;
-      const double gy = ey / p.semi_axis_y_mm;
-      const double gradient = std::hypot(gx, gy) / r;
-      signed_distance = (r - 1.0) / gradient;
+    // Coordinates in the patch's own axes (mm).
+    const double ax = prepared.cos_r * dx + prepared.sin_r * dy;
+    const double ay = -prepared.sin_r * dx + prepared.cos_r * dy;
+    double signed_distance = 0.0;
+    if (p.shape == PatchShape::kRectangle) {
+      // Exact signed distance to the rectangle's outline; nothing to paint
+      // beyond half the soft edge (most patches of a target, most of the time).
+      const double qx = std::abs(ax) - p.semi_axis_x_mm;
+      const double qy = std::abs(ay) - p.semi_axis_y_mm;
+      if (qx >= p.edge_mm / 2.0 || qy >= p.edge_mm / 2.0) continue;
+      signed_distance =
+          std::hypot(std::max(qx, 0.0), std::max(qy, 0.0)) + std::min(std::max(qx, qy), 0.0);
+    } else {
+      // Normalised by the semi-axes; signed distance to first order: (r - 1) / |grad r|.
+      const double ex = ax / p.semi_axis_x_mm;
+      const double ey = ay / p.semi_axis_y_mm;
+      const double r = std::hypot(ex, ey);
+      signed_distance = -std::min(p.semi_axis_x_mm, p.semi_axis_y_mm);
+      if (r > 1e-12) {
+        const double gx = ex / p.semi_axis_x_mm;
+        const double gy = ey / p.semi_axis_y_mm;
+        const double gradient = std::hypot(gx, gy) / r;
+        signed_distance = (r - 1.0) / gradient;
+      }
     }
     const double inside = 1.0 - SmoothStep(-p.edge_mm / 2.0, p.edge_mm / 2.0, signed_distance);
     albedo += inside * (p.albedo - albedo);

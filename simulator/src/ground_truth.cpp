@@ -11,22 +11,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-nlohmann::json DeviceJson(const geometry::PinholeModel& model) {
-  const geometry::Intrinsics& in = model.intrinsics();
-  const geometry::Pose& pose = model.pose();
-  nlohmann::json rotation = nlohmann::json::array();
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) rotation.push_back(pose.rotation(r, c));
-  return {{"fx", in.fx},
-          {"fy", in.fy},
-          {"cx", in.cx},
-          {"cy", in.cy},
-          {"k1", in.k1},
-          {"k2", in.k2},
-          {"rotation", rotation},
-          {"translation", {pose.translation.x(), pose.translation.y(), pose.translation.z()}}};
-}
-
 nlohmann::json JunctionJson(const TruthJunction& j, bool with_in_image) {
   nlohmann::json out = {{"x", j.image.x()},
                         {"y", j.image.y()},
@@ -161,6 +145,22 @@ std::vector<TruthLine> TraceLines(const Scene& scene, const PixelMaps& maps,
 }
 
 }  // namespace
+
+nlohmann::json DeviceJson(const geometry::PinholeModel& model) {
+  const geometry::Intrinsics& in = model.intrinsics();
+  const geometry::Pose& pose = model.pose();
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) rotation.push_back(pose.rotation(r, c));
+  return {{"fx", in.fx},
+          {"fy", in.fy},
+          {"cx", in.cx},
+          {"cy", in.cy},
+          {"k1", in.k1},
+          {"k2", in.k2},
+          {"rotation", rotation},
+          {"translation", {pose.translation.x(), pose.translation.y(), pose.translation.z()}}};
+}
 
 bool TruthParams::IsValid(std::string* error) const {
   auto ok = [](double value) { return value > 0.0 && std::isfinite(value); };

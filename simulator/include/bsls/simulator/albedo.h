@@ -4,7 +4,8 @@
 // "poor contrast level from different skin colour and any hair on the face").
 //
 // Frame and units: world frame of contracts section 3, millimetres. Patches are
-// ellipses in the xy plane painted along z onto whatever surface lies there.
+// ellipses or rectangles (the squares of the calibration target, thesis 6.1)
+// in the xy plane painted along z onto whatever surface lies there.
 // Albedo is a fraction of light reflected, in [0, 1].
 //
 // Thread-safety: AlbedoField is immutable; At() may be called concurrently.
@@ -18,14 +19,21 @@
 
 namespace bsls::simulator {
 
-// A dark (or bright) elliptical patch.
+// Outline of an AlbedoPatch.
+enum class PatchShape {
+  kEllipse,    // semi-axes as given
+  kRectangle,  // sides 2 x semi_axis_x_mm by 2 x semi_axis_y_mm
+};
+
+// A dark (or bright) elliptical or rectangular patch.
 struct AlbedoPatch {
   Eigen::Vector2d centre_xy_mm{0.0, 0.0};  // world x, y of the centre
   double semi_axis_x_mm = 20.0;            // semi-axis along the (rotated) x direction, > 0
   double semi_axis_y_mm = 5.0;             // semi-axis along the (rotated) y direction, > 0
-  double rotation_deg = 0.0;               // ellipse rotation, from +x towards +y
+  double rotation_deg = 0.0;               // patch rotation, from +x towards +y
   double albedo = 0.3;                     // albedo inside the patch, in [0, 1]
-  double edge_mm = 3.0;                    // width of the soft edge (smoothstep), >= 0
+  double edge_mm = 3.0;                    // width of the soft edge (smoothstep), >= 0; 0 = sharp
+  PatchShape shape = PatchShape::kEllipse;
 };
 
 // Parameters of an AlbedoField.

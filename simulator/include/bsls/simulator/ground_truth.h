@@ -119,6 +119,10 @@ GroundTruth ComputeGroundTruth(const Scene& scene, const TruthParams& params = {
 // "junctions" holds the visible ones only. Pixel maps are not included.
 nlohmann::json ToJson(const GroundTruth& truth);
 
+// A camera or projector as the truth files write it: fx, fy, cx, cy, k1, k2,
+// the world-to-device rotation (row-major) and translation.
+nlohmann::json DeviceJson(const geometry::PinholeModel& model);
+
 }  // namespace bsls::simulator
 
 #endif  // BSLS_SIMULATOR_GROUND_TRUTH_H_
