@@ -15,6 +15,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "bsls/calibration/side_calibration.h"
+
 namespace bsls::cli {
 
 enum ExitCode : int {
@@ -44,6 +46,18 @@ void AddProcessCommand(CLI::App& app);
 void AddSimulateCommand(CLI::App& app);
 // Adds `bsls evaluate` to the application.
 void AddEvaluateCommand(CLI::App& app);
+// Adds `bsls calibrate` to the application.
+void AddCalibrateCommand(CLI::App& app);
+// Adds `bsls simulate-calibration` to the application.
+void AddSimulateCalibrationCommand(CLI::App& app);
+// Adds `bsls reconstruct` to the application.
+void AddReconstructCommand(CLI::App& app);
+// Adds `bsls measure` to the application.
+void AddMeasureCommand(CLI::App& app);
+
+// The side calibration in a calibration file; CommandError (exit 3) naming
+// the file and the reason when it cannot be used.
+calibration::SideCalibration LoadCalibrationFile(const std::string& path);
 
 }  // namespace bsls::cli
 

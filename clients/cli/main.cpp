@@ -15,6 +15,10 @@ int main(int argc, char** argv) {
   AddProcessCommand(app);
   AddSimulateCommand(app);
   AddEvaluateCommand(app);
+  AddCalibrateCommand(app);
+  AddSimulateCalibrationCommand(app);
+  AddReconstructCommand(app);
+  AddMeasureCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

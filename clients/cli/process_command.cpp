@@ -1,11 +1,16 @@
-// bsls process: decode one frame into labelled junctions and lines.
+// bsls process: decode one frame into labelled junctions and lines; with a
+// calibration (or the thesis's explicit set-up), also its surface in world
+// millimetres.
 #include <cstdio>
 #include <iostream>
 #include <string>
 
+#include "bsls/calibration/calibration_file.h"
 #include "bsls/decoder/decode_output.h"
 #include "bsls/decoder/decoder.h"
 #include "bsls/io/frame_file.h"
+#include "bsls/io/surface_file.h"
+#include "bsls/reconstruction/side_pipeline.h"
 #include "command.h"
 
 namespace bsls::cli {
@@ -18,50 +23,111 @@ struct ProcessOptions {
   std::string overlay;
   std::string skeleton;
   std::string method = "modern";
+  std::string calibration;
+  std::string surface;
+  std::string plane_model = "perspective";
+  bool geometric_setup = false;
+  bool smooth = false;
+  bool ascii = false;
   bool no_repair = false;
   bool json_summary = false;
 };
 
+}  // namespace
+
+calibration::SideCalibration LoadCalibrationFile(const std::string& path) {
+  try {
+    return calibration::LoadCalibration(path).calibration;
+  } catch (const calibration::CalibrationFileError& e) {
+    throw CommandError(kExitInput, e.what());
+  }
+}
+
+namespace {
+
 void RunProcess(const ProcessOptions& o) {
   const auto side = pattern::ParseSide(o.side);
   if (!side) throw CommandError(kExitUsage, "--side must be left or right, not '" + o.side + "'");
-  decoder::DecodeParams params;
-  params.extraction.method =
+  if (!o.surface.empty() && o.calibration.empty() && !o.geometric_setup)
+    throw CommandError(kExitUsage,
+                       "--surface needs --calibration CAL (or --geometric-setup, the thesis's "
+                       "uncalibrated height formula)");
+  if (!o.calibration.empty() && o.geometric_setup)
+    throw CommandError(kExitUsage, "--calibration and --geometric-setup exclude each other");
+  reconstruction::SidePipelineParams params;
+  params.decode.extraction.method =
       o.method == "thesis" ? extraction::ExtractionMethod::kThesis : extraction::ExtractionMethod::kModern;
-  params.interpretation.enable_repair = !o.no_repair;
+  params.decode.interpretation.enable_repair = !o.no_repair;
+  params.planes = o.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
+                                              : reconstruction::PlaneModelKind::kPerspective;
+  params.reconstruction.smooth_lines = o.smooth;
+  params.reconstruct = !o.surface.empty();
+
+  std::optional<calibration::SideCalibration> cal;
+  reconstruction::SideGeometry geometry;
+  if (!o.calibration.empty()) {
+    cal = LoadCalibrationFile(o.calibration);
+    geometry = &*cal;
+  } else if (o.geometric_setup) {
+    geometry = reconstruction::GeometricSetupParams{};
+  }
 
   io::FrameConversion conversion;
   const cv::Mat frame = io::LoadGreyFrame(o.image, &conversion);
   if (conversion.converted()) std::cerr << "bsls: note: " << o.image << ": " << conversion.Describe() << "\n";
 
-  const decoder::DecodeResult result = decoder::Decode(frame, *side, params);
+  reconstruction::SideOutcome outcome;
+  try {
+    outcome = reconstruction::ProcessSide(frame, *side, geometry, params);
+  } catch (const std::invalid_argument& e) {
+    throw CommandError(kExitInput, o.image + " with " + o.calibration + ": " + e.what());
+  } catch (const reconstruction::ReconstructionError& e) {
+    throw CommandError(kExitNotProcessed, o.image + ": " + e.what());
+  }
+  const decoder::DecodeResult& result = outcome.decode;
   // The skeleton helps to see why a frame failed, so it is written either way.
   if (!o.skeleton.empty() && !result.skeleton.empty())
     io::WritePngAtomically(o.skeleton, result.skeleton);
   if (!result.ok) throw CommandError(kExitNotProcessed, o.image + ": " + result.error);
+  if (cal && !result.q_absolute)
+    std::cerr << "bsls: note: " << o.image << ": q stays relative: " << outcome.rows_note << "\n";
 
   io::WriteFileAtomically(o.junctions, decoder::ToJson(result).dump(1) + "\n");
   if (!o.overlay.empty()) io::WritePngAtomically(o.overlay, decoder::RenderOverlay(frame, result));
+  if (outcome.surface)
+    io::WriteSurface(o.surface, *outcome.surface,
+                     o.ascii ? io::PlyEncoding::kAscii : io::PlyEncoding::kBinaryLittleEndian);
 
   int interpolated = 0;
   for (const auto& j : result.junctions) interpolated += j.interpolated;
+  const reconstruction::ReconstructionReport& r = outcome.report;
   if (o.json_summary) {
     nlohmann::json s = {{"image", o.image},
                         {"side", o.side},
                         {"junctions", result.junctions.size()},
                         {"interpolated", interpolated},
                         {"lines", result.lines.size()},
+                        {"q_absolute", result.q_absolute},
                         {"repairs", result.repairs},
                         {"label_conflicts", result.label_conflicts},
                         {"time_ms", result.times.total_ms},
                         {"extraction_ms", result.times.extraction_ms},
                         {"interpretation_ms", result.times.interpretation_ms},
                         {"subpixel_ms", result.times.subpixel_ms}};
+    if (outcome.surface)
+      s["surface"] = {{"vertices", r.vertices},         {"triangles", r.triangles},
+                      {"bridged", r.bridged_samples},   {"dropped_samples", r.dropped_samples},
+                      {"junctions", r.junctions},       {"junctions_by_projector", r.junctions_by_projector},
+                      {"time_ms", r.time_ms}};
     std::cout << s.dump() << "\n";
   } else {
-    std::printf("%s (%s): %zu junctions (%d interpolated) on %zu lines, %d repairs, %.1f ms\n",
+    std::printf("%s (%s): %zu junctions (%d interpolated) on %zu lines, %d repairs, q %s, %.1f ms\n",
                 o.image.c_str(), o.side.c_str(), result.junctions.size(), interpolated,
-                result.lines.size(), result.repairs, result.times.total_ms);
+                result.lines.size(), result.repairs, result.q_absolute ? "absolute" : "relative",
+                result.times.total_ms);
+    if (outcome.surface)
+      std::printf("%s: %d vertices (%d bridged), %d triangles, %.1f ms\n", o.surface.c_str(),
+                  r.vertices, r.bridged_samples, r.triangles, r.time_ms);
   }
 }
 
@@ -80,6 +146,18 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--skeleton", opts->skeleton, "Output PNG of the repaired one-pixel skeleton");
   cmd->add_option("--method", opts->method, "Feature extraction: modern (default) or thesis")
       ->check(CLI::IsMember({"modern", "thesis"}));
+  cmd->add_option("--calibration", opts->calibration,
+                  "Calibration of this side (bsls calibrate): absolute q and the surface");
+  cmd->add_option("--surface", opts->surface,
+                  "Output surface in world mm: .ply (binary), .obj or .stl; needs --calibration");
+  cmd->add_option("--plane-model", opts->plane_model,
+                  "Light planes: perspective (thesis 6.2.2, default) or parallel (6.2.1)")
+      ->check(CLI::IsMember({"perspective", "parallel"}));
+  cmd->add_flag("--geometric-setup", opts->geometric_setup,
+                "No calibration: the thesis height formula (eq. 2.1-2.12) from the set-up of "
+                "Tables 2.1/2.2 (a fallback: millimetres only as good as those distances)");
+  cmd->add_flag("--smooth", opts->smooth, "Smooth along each line (thesis eq. 5.32) first");
+  cmd->add_flag("--ascii", opts->ascii, "Write an ASCII PLY instead of binary");
   cmd->add_flag("--no-repair", opts->no_repair, "Label what is seen; seal no discontinuity");
   cmd->add_flag("--json", opts->json_summary, "Print the summary as one JSON object");
   cmd->callback([opts] { RunProcess(*opts); });

@@ -155,6 +155,8 @@ bool CalibrationSessionParams::IsValid(std::string* error) const {
     return Fail(error, "calibration session screen_albedo must lie in (0, 1]");
   if (!std::isfinite(grid_margin_px))
     return Fail(error, "calibration session grid_margin_px must be finite");
+  if (target_origin_rig_mm && !target_origin_rig_mm->allFinite())
+    return Fail(error, "calibration session target_origin_rig_mm must be finite");
   return true;
 }
 
@@ -163,9 +165,46 @@ Eigen::Vector3d TargetSquareCentre(const CalibrationTargetParams& target, int ro
   return {col * target.pitch_mm, -row * target.pitch_mm, z_mm};
 }
 
-AlbedoParams TargetAlbedo(const CalibrationTargetParams& target) {
+Eigen::Vector3d TargetOriginInRig(const CalibrationSessionParams& params) {
+  if (params.target_origin_rig_mm)
+    return {params.target_origin_rig_mm->x(), params.target_origin_rig_mm->y(), 0.0};
+  const CalibrationTargetParams& t = params.target;
+  return {-0.5 * (t.cols - 1) * t.pitch_mm, 0.5 * (t.rows - 1) * t.pitch_mm, 0.0};
+}
+
+Eigen::Vector3d RigToCalibrationWorld(const CalibrationSessionParams& params,
+                                      const Eigen::Vector3d& rig_mm) {
+  return rig_mm - TargetOriginInRig(params);
+}
+
+Eigen::Vector3d CalibrationWorldToRig(const CalibrationSessionParams& params,
+                                      const Eigen::Vector3d& world_mm) {
+  return world_mm + TargetOriginInRig(params);
+}
+
+geometry::PinholeModel RigModelToCalibrationWorld(const CalibrationSessionParams& params,
+                                                  const geometry::PinholeModel& rig_model) {
+  // X_dev = R X_rig + t = R (X_world + o) + t.
+  geometry::Pose pose = rig_model.pose();
+  pose.translation += pose.rotation * TargetOriginInRig(params);
+  return geometry::PinholeModel(rig_model.intrinsics(), pose);
+}
+
+geometry::PinholeModel CalibrationCamera(const CalibrationSessionParams& params,
+                                         pattern::Side side) {
+  return RigModelToCalibrationWorld(params, MakeCamera(params.rig, side));
+}
+
+geometry::PinholeModel CalibrationProjector(const CalibrationSessionParams& params) {
+  return RigModelToCalibrationWorld(params, MakeProjector(params.rig));
+}
+
+AlbedoParams TargetAlbedo(const CalibrationTargetParams& target,
+                          const Eigen::Vector2d& origin_rig_mm) {
   std::string error;
   if (!target.IsValid(&error)) throw std::invalid_argument(error);
+  if (!origin_rig_mm.allFinite())
+    throw std::invalid_argument("TargetAlbedo: the target origin must be finite");
   AlbedoParams albedo;
   albedo.base = target.ground_albedo;
   albedo.variation = target.ground_variation;
@@ -173,7 +212,7 @@ AlbedoParams TargetAlbedo(const CalibrationTargetParams& target) {
     for (int c = 0; c < target.cols; ++c) {
       AlbedoPatch square;
       const Eigen::Vector3d centre = TargetSquareCentre(target, r, c, 0.0);
-      square.centre_xy_mm = centre.head<2>();
+      square.centre_xy_mm = centre.head<2>() + origin_rig_mm;
       square.semi_axis_x_mm = square.semi_axis_y_mm = target.square_mm / 2.0;
       square.rotation_deg = 0.0;
       square.albedo = target.square_albedo;
@@ -189,7 +228,7 @@ Scene CalibrationTargetScene(pattern::Side side, double z_mm,
                              const CalibrationSessionParams& params) {
   // The slide stays dark: TargetRenderParams turns the projector off.
   Scene scene = HorizontalPlaneScene(side, z_mm, pattern::BrickSlideFor(side), params);
-  scene.albedo = AlbedoField(TargetAlbedo(params.target));
+  scene.albedo = AlbedoField(TargetAlbedo(params.target, TargetOriginInRig(params).head<2>()));
   return scene;
 }
 
@@ -249,8 +288,8 @@ CalibrationSession SimulateCalibrationSession(pattern::Side side,
   CalibrationSession session;
   session.side = side;
   session.params = params;
-  session.camera = MakeCamera(params.rig, side);
-  session.projector = MakeProjector(params.rig);
+  session.camera = CalibrationCamera(params, side);
+  session.projector = CalibrationProjector(params);
 
   // Fail before spending time on rendering.
   if (params.grid_margin_px >= 0.0)
@@ -324,23 +363,25 @@ nlohmann::json TruthJson(const CalibrationSession& session) {
     }
     camera_views.push_back({{"image", view.image_name}, {"z_mm", view.z_mm}, {"squares", squares}});
   }
-  return {{"side", std::string(pattern::ToString(session.side))},
-          {"width", params.rig.width},
-          {"height", params.rig.height},
-          {"target",
-           {{"rows", params.target.rows},
-            {"cols", params.target.cols},
-            {"pitch_mm", params.target.pitch_mm},
-            {"square_mm", params.target.square_mm}}},
-          {"pattern",
-           {{"lines", params.pattern.lines},
-            {"rows", params.pattern.rows},
-            {"stroke_width", params.pattern.stroke_width}}},
-          {"camera", DeviceJson(session.camera)},
-          {"projector", DeviceJson(session.projector)},
-          {"camera_views", camera_views},
-          {"screen_views", PlainViewsJson(session.screen_views)},
-          {"reference_views", PlainViewsJson(session.reference_views)}};
+  return {
+      {"side", std::string(pattern::ToString(session.side))},
+      {"width", params.rig.width},
+      {"height", params.rig.height},
+      {"target",
+       {{"rows", params.target.rows},
+        {"cols", params.target.cols},
+        {"pitch_mm", params.target.pitch_mm},
+        {"square_mm", params.target.square_mm}}},
+      {"pattern",
+       {{"lines", params.pattern.lines},
+        {"rows", params.pattern.rows},
+        {"stroke_width", params.pattern.stroke_width}}},
+      {"target_origin_rig_mm", {TargetOriginInRig(params).x(), TargetOriginInRig(params).y(), 0.0}},
+      {"camera", DeviceJson(session.camera)},
+      {"projector", DeviceJson(session.projector)},
+      {"camera_views", camera_views},
+      {"screen_views", PlainViewsJson(session.screen_views)},
+      {"reference_views", PlainViewsJson(session.reference_views)}};
 }
 
 std::filesystem::path WriteCalibrationSession(const CalibrationSession& session,

@@ -217,6 +217,299 @@ class CliTest(unittest.TestCase):
         self.assertEqual(leftovers, [])
 
 
+class CalibrationCliTest(unittest.TestCase):
+    """simulate-calibration and calibrate (docs/calibration.md)."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.TemporaryDirectory()
+        cls.session = os.path.join(cls.dir.name, "left")
+        # One ray per pixel: a quick session, files and figures only.
+        r = run("simulate-calibration", "--side", "left", "-o", cls.session, "--noise", "2",
+                "--seed", "3", "--supersampling", "1")
+        assert r.returncode == 0, r.stderr
+        cls.manifest = os.path.join(cls.session, "session.yaml")
+
+    def path(self, name):
+        return os.path.join(self.dir.name, name)
+
+    def write_manifest(self, name, camera_zs, screen_image="screen_z000.png",
+                       camera_image=None, missing=None):
+        """A manifest in the session folder listing its images; camera views at camera_zs."""
+        lines = ["side: left", "target: {rows: 8, cols: 8, pitch_mm: 6.5, square_mm: 4}",
+                 "camera_views:"]
+        for z in camera_zs:
+            image = camera_image or "target_z%03d.png" % z
+            lines.append("  - {image: %s, z_mm: %d}" % (image, z))
+        lines.append("screen_views:")
+        lines.append("  - {image: %s, z_mm: 0}" % (missing or screen_image))
+        lines.append("  - {image: screen_z060.png, z_mm: 60}")
+        lines.append("pattern: {lines: 20, rows: 24}")
+        path = os.path.join(self.session, name)
+        with open(path, "w") as f:
+            f.write("\n".join(lines) + "\n")
+        return path
+
+    def test_simulated_session_lists_every_view(self):
+        names = set(os.listdir(self.session))
+        self.assertIn("truth.json", names)
+        self.assertIn("target_z100.png", names)
+        self.assertIn("cross_z120.png", names)
+        with open(os.path.join(self.session, "truth.json")) as f:
+            truth = json.load(f)
+        self.assertEqual(truth["side"], "left")
+        self.assertEqual(len(truth["target_origin_rig_mm"]), 3)
+
+    def test_calibrate_writes_file_report_and_summary(self):
+        out, report = self.path("cal.yaml"), self.path("report.json")
+        r = run("calibrate", self.manifest, "-o", out, "--report", report)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        with open(out) as f:
+            text = f.read()
+        self.assertIn("format: bsls-calibration\n", text)
+        self.assertIn("format_version: 1\n", text)
+        self.assertIn("side: left\n", text)
+        with open(report) as f:
+            rep = json.load(f)
+        self.assertLess(rep["camera"]["rms_px"], 0.3)
+        self.assertLess(rep["planes"]["perspective_rms_mm"], 0.1)
+        with open(os.path.join(self.session, "truth.json")) as f:
+            truth = json.load(f)
+        rot, t = truth["projector"]["rotation"], truth["projector"]["translation"]
+        centre = [-sum(rot[3 * j + i] * t[j] for j in range(3)) for i in range(3)]
+        distance = sum(c * c for c in centre) ** 0.5
+        self.assertLess(abs(rep["projector"]["matrix_centre_distance_mm"] - distance), 2.0)
+        for line in ("camera: RMS", "light planes: perspective RMS", "projector: centre",
+                     "distance to origin"):
+            self.assertIn(line, r.stdout)
+
+    def test_missing_manifest(self):
+        out = self.path("none.yaml")
+        r = run("calibrate", self.path("no_manifest.yaml"), "-o", out)
+        self.assertEqual(r.returncode, EXIT_INPUT)
+        self.assertIn("no_manifest.yaml", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        self.assertFalse(os.path.exists(out))
+
+    def test_manifest_naming_a_missing_image(self):
+        out = self.path("missing.yaml")
+        manifest = self.write_manifest("m_missing.yaml", [0, 20, 40], missing="gone.png")
+        r = run("calibrate", manifest, "-o", out)
+        self.assertEqual(r.returncode, EXIT_INPUT)
+        self.assertIn("gone.png", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_camera_views_out_of_z_order(self):
+        out = self.path("order.yaml")
+        r = run("calibrate", self.write_manifest("m_order.yaml", [0, 40, 20]), "-o", out)
+        self.assertEqual(r.returncode, EXIT_INPUT)
+        self.assertIn("not in increasing z", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_too_few_camera_views(self):
+        out = self.path("few.yaml")
+        r = run("calibrate", self.write_manifest("m_few.yaml", [0, 50]), "-o", out)
+        self.assertEqual(r.returncode, EXIT_INPUT)
+        self.assertIn("at least 3", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_target_not_found_names_the_view(self):
+        out = self.path("notarget.yaml")
+        manifest = self.write_manifest("m_notarget.yaml", [0, 20, 40],
+                                       camera_image="screen_z030.png")
+        r = run("calibrate", manifest, "-o", out)
+        self.assertEqual(r.returncode, EXIT_NOT_PROCESSED)
+        self.assertIn("screen_z030.png (camera view 1", r.stderr)
+        self.assertIn("target not found", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_unwritable_calibration_leaves_nothing_behind(self):
+        folder = self.path("missing_folder")
+        r = run("calibrate", self.write_manifest("m_ok.yaml", [0, 20, 40]), "-o",
+                os.path.join(folder, "cal.yaml"))
+        self.assertEqual(r.returncode, EXIT_OUTPUT)
+        self.assertIn("missing_folder", r.stderr)
+        self.assertFalse(os.path.exists(folder))
+
+    def test_simulate_calibration_errors(self):
+        self.assertEqual(run("simulate-calibration", "--side", "up", "-o",
+                             self.path("s")).returncode, EXIT_USAGE)
+        self.assertEqual(run("simulate-calibration", "-o", self.path("s")).returncode, EXIT_USAGE)
+        self.assertFalse(os.path.exists(self.path("s")))
+        # A file where the folder should go, and a folder whose parent is missing.
+        blocker = self.path("blocker")
+        with open(blocker, "w") as f:
+            f.write("x")
+        r = run("simulate-calibration", "--side", "left", "-o", blocker, "--supersampling", "1")
+        self.assertEqual(r.returncode, EXIT_OUTPUT, r.stderr)
+        self.assertIn("not a folder", r.stderr)
+        nested = os.path.join(self.path("no_parent"), "session")
+        r = run("simulate-calibration", "--side", "left", "-o", nested, "--supersampling", "1")
+        self.assertEqual(r.returncode, EXIT_OUTPUT, r.stderr)
+        self.assertFalse(os.path.exists(self.path("no_parent")))
+
+
+def read_ascii_ply(path):
+    """Vertex rows (lists of floats) and face count of an ASCII PLY."""
+    with open(path) as f:
+        lines = f.read().splitlines()
+    end = lines.index("end_header")
+    header = lines[:end]
+    vertices = int(next(l for l in header if l.startswith("element vertex")).split()[2])
+    faces = next((int(l.split()[2]) for l in header if l.startswith("element face")), 0)
+    rows = [list(map(float, l.split())) for l in lines[end + 1:end + 1 + vertices]]
+    return header, rows, faces
+
+
+class SurfaceCliTest(unittest.TestCase):
+    """process --calibration --surface and measure, on a calibrated simulated plane."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.TemporaryDirectory()
+        session = os.path.join(cls.dir.name, "left")
+        r = run("simulate-calibration", "--side", "left", "-o", session, "--noise", "2",
+                "--seed", "5", "--supersampling", "1")
+        assert r.returncode == 0, r.stderr
+        cls.calibration = os.path.join(cls.dir.name, "left.yaml")
+        r = run("calibrate", os.path.join(session, "session.yaml"), "-o", cls.calibration)
+        assert r.returncode == 0, r.stderr
+        cls.frame = os.path.join(cls.dir.name, "plane.png")
+        r = run("simulate", "--surface", "plane", "--side", "left", "-o", cls.frame,
+                "--noise", "3", "--seed", "2")
+        assert r.returncode == 0, r.stderr
+        # The right side, for reconstruct: its own session at the same target placement.
+        session = os.path.join(cls.dir.name, "right")
+        r = run("simulate-calibration", "--side", "right", "-o", session, "--noise", "2",
+                "--seed", "6", "--supersampling", "1")
+        assert r.returncode == 0, r.stderr
+        cls.right_calibration = os.path.join(cls.dir.name, "right.yaml")
+        r = run("calibrate", os.path.join(session, "session.yaml"), "-o", cls.right_calibration)
+        assert r.returncode == 0, r.stderr
+        cls.faces = {}
+        for side in ("left", "right"):
+            cls.faces[side] = os.path.join(cls.dir.name, "face_%s.png" % side)
+            r = run("simulate", "--surface", "face", "--side", side, "-o", cls.faces[side],
+                    "--noise", "3", "--seed", "4")
+            assert r.returncode == 0, r.stderr
+        cls.surface = os.path.join(cls.dir.name, "plane.ply")
+        cls.processed = run("process", cls.frame, "--side", "left", "--calibration",
+                            cls.calibration, "--junctions", os.path.join(cls.dir.name, "j.json"),
+                            "--surface", cls.surface, "--ascii", "--json")
+
+    def path(self, name):
+        return os.path.join(self.dir.name, name)
+
+    def test_surface_of_the_base_plane_is_flat_at_zero(self):
+        self.assertEqual(self.processed.returncode, EXIT_OK, self.processed.stderr)
+        summary = json.loads(self.processed.stdout)
+        self.assertTrue(summary["q_absolute"])
+        header, rows, faces = read_ascii_ply(self.surface)
+        self.assertIn("property float uncertainty_mm", header)
+        self.assertGreater(len(rows), 5000)
+        self.assertGreater(faces, 5000)
+        z = [r[2] for r in rows]
+        rms = (sum(v * v for v in z) / len(z)) ** 0.5
+        self.assertLess(rms, 0.1)  # mm; the issue asks 0.25 mm on the ramp and ball
+        self.assertLess(max(abs(v) for v in z), 1.0)
+
+    def test_measure_height_and_area_on_the_plane(self):
+        _, rows, _ = read_ascii_ply(self.surface)
+        xs, ys = [r[0] for r in rows], [r[1] for r in rows]
+        cx, cy = (min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2
+        square = "%f,%f %f,%f %f,%f %f,%f" % (cx - 10, cy - 10, cx + 10, cy - 10,
+                                              cx + 10, cy + 10, cx - 10, cy + 10)
+        report = self.path("m.json")
+        r = run("measure", self.surface, "--height", "%f,%f" % (cx, cy), "--area", square,
+                "--json", report)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertIn("height at", r.stdout)
+        with open(report) as f:
+            rep = json.load(f)
+        self.assertLess(abs(rep["heights"][0]["height_mm"]["value"]), 0.25)
+        self.assertLess(abs(rep["areas"][0]["area_mm2"]["value"] - 400.0), 4.0)  # 1 %
+
+    def test_surface_needs_a_calibration(self):
+        out = self.path("none.ply")
+        r = run("process", self.frame, "--side", "left", "--junctions", self.path("n.json"),
+                "--surface", out)
+        self.assertEqual(r.returncode, EXIT_USAGE)
+        self.assertFalse(os.path.exists(out))
+
+    def test_calibration_of_the_other_side_is_refused(self):
+        out = self.path("wrong.ply")
+        r = run("process", self.frame, "--side", "right", "--calibration", self.calibration,
+                "--junctions", self.path("w.json"), "--surface", out)
+        self.assertEqual(r.returncode, EXIT_INPUT, r.stderr)
+        self.assertIn("left side", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def test_corrupt_calibration_is_named(self):
+        bad = self.path("bad.yaml")
+        with open(self.calibration) as f:
+            text = f.read()
+        with open(bad, "w") as f:
+            f.write(text[:len(text) // 2])
+        out = self.path("bad.ply")
+        r = run("process", self.frame, "--side", "left", "--calibration", bad,
+                "--junctions", self.path("b.json"), "--surface", out)
+        self.assertEqual(r.returncode, EXIT_INPUT, r.stderr)
+        self.assertIn("bad.yaml", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        self.assertFalse(os.path.exists(out))
+
+    def test_measure_bad_input(self):
+        r = run("measure", self.surface, "--height", "1;2")
+        self.assertEqual(r.returncode, EXIT_USAGE)
+        self.assertIn("is not a point", r.stderr)
+        r = run("measure", self.surface)
+        self.assertEqual(r.returncode, EXIT_USAGE)
+        r = run("measure", self.surface, "--height", "5000,5000")
+        self.assertEqual(r.returncode, EXIT_NOT_PROCESSED)
+        self.assertIn("outside the surface", r.stderr)
+        r = run("measure", self.path("missing.ply"), "--height", "0,0")
+        self.assertEqual(r.returncode, EXIT_INPUT)
+        self.assertIn("missing.ply", r.stderr)
+
+    def reconstruct(self, out, *extra, left_cal=None, right_cal=None):
+        return run("reconstruct", "--left", self.faces["left"], "--right", self.faces["right"],
+                   "--calibration-left", left_cal or self.calibration,
+                   "--calibration-right", right_cal or self.right_calibration, "-o", out, *extra)
+
+    def test_reconstruct_joins_both_sides_of_the_face(self):
+        out, report = self.path("face.ply"), self.path("face.json")
+        r = self.reconstruct(out, "--report", report, "--ascii")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertIn("shared world frame", r.stdout)
+        with open(report) as f:
+            rep = json.load(f)
+        self.assertEqual(rep["join"]["method"], "shared-frame")
+        self.assertTrue(rep["left"]["q_absolute"] and rep["right"]["q_absolute"])
+        self.assertLess(rep["join"]["seam_rms_mm"], 0.3)
+        _, rows, faces = read_ascii_ply(out)
+        self.assertEqual(len(rows), rep["vertices"])
+        self.assertGreater(faces, 15000)
+        # Both halves of the face: surface on either side of the reference line.
+        middle = [r[0] for r in rows if int(r[7]) == 0]
+        self.assertGreater(len(middle), 100)
+        x0 = sum(middle) / len(middle)
+        self.assertLess(min(r[0] for r in rows), x0 - 40)
+        self.assertGreater(max(r[0] for r in rows), x0 + 40)
+
+    def test_reconstruct_by_features_agrees_with_the_shared_frame(self):
+        out = self.path("face_features.ply")
+        r = self.reconstruct(out, "--join", "features")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertIn("features + ICP", r.stdout)
+
+    def test_reconstruct_refuses_swapped_calibrations(self):
+        out = self.path("swapped.ply")
+        r = self.reconstruct(out, left_cal=self.right_calibration, right_cal=self.calibration)
+        self.assertEqual(r.returncode, EXIT_INPUT, r.stderr)
+        self.assertIn("right side", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+
 if __name__ == "__main__":
     BSLS = sys.argv.pop(1)
     unittest.main(verbosity=2)

@@ -97,7 +97,7 @@ TEST(CalibrationTarget, AlbedoPaintsSquaresWhereTheContractsPutThem) {
 TEST(CalibrationTarget, TrueCentresAreOrderedLikeTheImageForBothSides) {
   const CalibrationSessionParams params;
   for (const Side side : {Side::kLeft, Side::kRight}) {
-    const geometry::PinholeModel camera = MakeCamera(params.rig, side);
+    const geometry::PinholeModel camera = CalibrationCamera(params, side);
     const std::vector<Eigen::Vector2d> centres = TrueSquareCentres(camera, params.target, 40.0);
     ASSERT_EQ(centres.size(), 64u);
     for (int r = 0; r < 8; ++r) {
@@ -144,7 +144,7 @@ TEST(CalibrationSession, InvalidParamsNameTheField) {
 }
 
 TEST(CalibrationSession, GridOutOfViewIsRefusedNamingViewAndSquare) {
-  // The left camera loses the grid's right-most column above z = 105 mm.
+  // The left camera loses the centred grid's left-most column above z = 125 mm.
   CalibrationSessionParams params;
   params.camera_z_mm = {0, 140};
   try {
@@ -198,7 +198,7 @@ INSTANTIATE_TEST_SUITE_P(BothSides, SessionDetection, ::testing::Values(Side::kL
 TEST(CalibrationSession, TargetPartlyOutOfFrameGivesAClearError) {
   CalibrationSessionParams params = NoisyParams();
   params.grid_margin_px = -1.0;  // render it anyway
-  const cv::Mat image = RenderTargetView(Side::kLeft, 130.0, params, 3);
+  const cv::Mat image = RenderTargetView(Side::kLeft, 140.0, params, 3);
   const calibration::TargetDetection detection =
       calibration::DetectTarget(image, Geometry(params.target));
   EXPECT_FALSE(detection.ok);
@@ -211,7 +211,7 @@ TEST(CalibrationSession, PaintedOverSquareGivesAClearError) {
   const double z = 50.0;
   cv::Mat image = RenderTargetView(Side::kRight, z, params, 4);
   // Paint square (3, 4) and 0.5 mm around it with the paper's grey.
-  const geometry::PinholeModel camera = MakeCamera(params.rig, Side::kRight);
+  const geometry::PinholeModel camera = CalibrationCamera(params, Side::kRight);
   const Eigen::Vector3d centre = TargetSquareCentre(params.target, 3, 4, z);
   const double half = params.target.square_mm / 2.0 + 0.5;
   std::vector<cv::Point> corners;
@@ -228,6 +228,64 @@ TEST(CalibrationSession, PaintedOverSquareGivesAClearError) {
   EXPECT_FALSE(detection.ok);
   EXPECT_NE(detection.error.find("found 63 of 64 target squares"), std::string::npos)
       << detection.error;
+}
+
+TEST(TargetPlacement, DefaultCentresTheGridUnderTheRig) {
+  const CalibrationSessionParams params;
+  const Eigen::Vector3d origin = TargetOriginInRig(params);
+  const double half_width = 0.5 * (params.target.cols - 1) * params.target.pitch_mm;
+  const double half_height = 0.5 * (params.target.rows - 1) * params.target.pitch_mm;
+  EXPECT_EQ(origin, Eigen::Vector3d(-half_width, half_height, 0.0));
+  // The grid's centre is the rig origin.
+  const Eigen::Vector3d middle =
+      TargetSquareCentre(params.target, params.target.rows - 1, params.target.cols - 1, 0.0) / 2.0;
+  EXPECT_LT(CalibrationWorldToRig(params, middle).norm(), kProjectionTolerancePx);
+}
+
+TEST(TargetPlacement, WorldAndRigFramesDifferByTheOrigin) {
+  CalibrationSessionParams params;
+  params.target_origin_rig_mm = Eigen::Vector2d(-12.0, 30.0);
+  const Eigen::Vector3d rig(5.0, -7.0, 42.0);
+  const Eigen::Vector3d world = RigToCalibrationWorld(params, rig);
+  EXPECT_EQ(world, Eigen::Vector3d(17.0, -37.0, 42.0));
+  EXPECT_LT((CalibrationWorldToRig(params, world) - rig).norm(), 1e-12);
+  // The same point seen by the rig camera and by the world-frame camera.
+  for (const Side side : {Side::kLeft, Side::kRight}) {
+    const auto a = MakeCamera(params.rig, side).Project(rig);
+    const auto b = CalibrationCamera(params, side).Project(world);
+    ASSERT_TRUE(a && b);
+    EXPECT_LT((*a - *b).norm(), kProjectionTolerancePx);
+  }
+  EXPECT_LT((CalibrationProjector(params).Centre() -
+             RigToCalibrationWorld(params, params.rig.projector_centre_mm))
+                .norm(),
+            1e-9);
+  // (0, 0): the calibration world frame is the rig frame.
+  params.target_origin_rig_mm = Eigen::Vector2d::Zero();
+  EXPECT_EQ(RigToCalibrationWorld(params, rig), rig);
+  params.target_origin_rig_mm = Eigen::Vector2d(std::nan(""), 0.0);
+  std::string why;
+  EXPECT_FALSE(params.IsValid(&why));
+  EXPECT_NE(why.find("target_origin_rig_mm"), std::string::npos) << why;
+}
+
+TEST(TargetPlacement, RenderedSquaresLieWhereTheWorldCameraProjectsThem) {
+  // The darkest pixel near the projection of a square's world centre is dark:
+  // the albedo is placed in the rig frame, the truth given in the world frame.
+  CalibrationSessionParams params;
+  params.target_origin_rig_mm = Eigen::Vector2d(-30.0, 10.0);
+  params.render.supersampling = 1;
+  const double z = 20.0;
+  const cv::Mat image = RenderTargetView(Side::kLeft, z, params, 1);
+  const std::vector<Eigen::Vector2d> centres =
+      TrueSquareCentres(CalibrationCamera(params, Side::kLeft), params.target, z);
+  const double paper = image.at<std::uint8_t>(5, 5);
+  for (const Eigen::Vector2d& c : centres) {
+    const int x = static_cast<int>(std::lround(c.x()));
+    const int y = static_cast<int>(std::lround(c.y()));
+    ASSERT_TRUE(x >= 0 && y >= 0 && x < image.cols && y < image.rows);
+    EXPECT_LT(image.at<std::uint8_t>(y, x), 0.3 * paper) << x << ", " << y;
+  }
 }
 
 class SessionFolder : public ::testing::Test {
@@ -311,6 +369,11 @@ TEST_F(SessionFolder, WrittenManifestLoadsAndListsEveryFile) {
   EXPECT_DOUBLE_EQ(square["world"][0].get<double>(), 5 * 6.5);
   EXPECT_DOUBLE_EQ(square["world"][1].get<double>(), -3 * 6.5);
   EXPECT_DOUBLE_EQ(square["world"][2].get<double>(), 50.0);
+  ASSERT_EQ(truth["target_origin_rig_mm"].size(), 3u);
+  EXPECT_DOUBLE_EQ(truth["target_origin_rig_mm"][0].get<double>(), TargetOriginInRig(params).x());
+  EXPECT_DOUBLE_EQ(truth["target_origin_rig_mm"][1].get<double>(), TargetOriginInRig(params).y());
+  EXPECT_DOUBLE_EQ(truth["camera"]["translation"][1].get<double>(),
+                   session.camera.pose().translation.y());
 }
 
 // Screen views: a plane, so the decoder labels its junctions (sanity check

@@ -11,17 +11,28 @@
 // Written as 8-bit grey PNGs, the session manifest of contracts section 4 and
 // a truth JSON (true camera, projector and square centres).
 //
-// Frames and units: world frame of contracts section 3 in millimetres: the
-// target at offset z has square (r, c) centred at (c * pitch, -r * pitch, z),
-// so its origin is the centre of square (0, 0) at z = 0, x along increasing
-// column, y up (decreasing row). Image pixels with the origin at the centre of
-// the top-left pixel. The projector's image is the slide in line pitches d
-// (scene.h).
+// Frames and units: millimetres. Two frames differ by a translation in x, y:
+//   rig frame          the frame of RigParams / ThesisScene (projector above
+//                      the rig origin, cameras mirrored in x = 0);
+//   calibration world  contracts section 3: origin at the centre of target
+//                      square (0, 0) at z = 0, x along increasing column, y
+//                      up (decreasing row); square (r, c) of the view at
+//                      offset z is at (c * pitch, -r * pitch, z).
+// Square (0, 0) lies at rig (x, y) = TargetOriginInRig(params), so a rig point
+// X is the world point X - (origin_x, origin_y, 0) (RigToCalibrationWorld).
+// The session's camera and projector and its truth JSON are given in the
+// calibration world frame, which is what a calibration recovers. Image pixels
+// with the origin at the centre of the top-left pixel. The projector's image
+// is the slide in line pitches d (scene.h).
 //
-// Coverage (default rig): the target lies in the quadrant x >= 0, y <= 0 that
-// the contract fixes, so it covers only the lower-right part of both images,
-// about 85 x 110 px at z = 0; the left camera loses its right-most column
-// above z = 100 mm (hence the default camera z list 0 .. 100 mm).
+// Placement (default rig and target): the grid is centred on the rig's x = y
+// = 0, between the two cameras' views, so one set of target positions serves
+// both sides (one shared world frame) and the grid lies near the middle of
+// both images. With the contract's literal placement (square (0, 0) at the rig
+// origin, target_origin_rig_mm = (0, 0)) the thesis 8 x 8 target covers only
+// the lower-right 85 x 110 px of the 512 x 512 images and the left camera
+// loses it above z = 105 mm; camera distortion fitted on such a patch
+// extrapolates badly over the face (docs/calibration.md).
 //
 // Errors: std::invalid_argument naming the field for invalid params, and
 // naming the view and the square when a camera view does not show the whole
@@ -37,6 +48,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -76,9 +88,13 @@ struct CalibrationSessionParams {
   RigParams rig;  // image size is rig.width x rig.height
   pattern::PatternSpec pattern;
   CalibrationTargetParams target;
+  // Rig-frame (x, y) in mm of the centre of square (0, 0): where the target
+  // was laid on the rig. Unset: the grid centred on the rig's x = y = 0
+  // (TargetOriginInRig). (0, 0) puts the calibration world frame on the rig
+  // frame (the target then lies in the rig's x >= 0, y <= 0 quadrant).
+  std::optional<Eigen::Vector2d> target_origin_rig_mm;
   // Target offsets (mm, >= 0, distinct). The thesis used 15 planes 10 .. 150
-  // mm; with the default rig the left camera sees the whole 8 x 8 grid only
-  // up to about z = 105 mm, so the default is 11 planes 0 .. 100 mm.
+  // mm; the default is 11 planes 0 .. 100 mm, the depth of the face.
   std::vector<double> camera_z_mm = {0, 10, 20, 30, 40, 50, 60, 70, 80, 90, 100};
   // Screen (brick slide) and reference (cross) planes, mm, distinct.
   std::vector<double> screen_z_mm = {0, 30, 60, 90, 120};
@@ -119,24 +135,50 @@ struct CalibrationView {
 struct CalibrationSession {
   pattern::Side side = pattern::Side::kLeft;
   CalibrationSessionParams params;
-  geometry::PinholeModel camera;                 // pixels; as MakeCamera(params.rig, side)
-  geometry::PinholeModel projector;              // slide units d; as MakeProjector(params.rig)
+  // Both in the calibration world frame (CalibrationCamera, CalibrationProjector).
+  geometry::PinholeModel camera;  // pixels; MakeCamera(params.rig, side) moved to the world frame
+  geometry::PinholeModel projector;  // slide units d; MakeProjector(params.rig) moved likewise
   std::vector<CalibrationView> camera_views;     // in params.camera_z_mm order
   std::vector<CalibrationView> screen_views;     // in params.screen_z_mm order
   std::vector<CalibrationView> reference_views;  // in params.reference_z_mm order
 };
 
-// World point (mm) of the centre of square (row, col) with the target at z_mm.
+// World point (mm, calibration world frame) of the centre of square (row,
+// col) with the target at z_mm.
 Eigen::Vector3d TargetSquareCentre(const CalibrationTargetParams& target, int row, int col,
                                    double z_mm);
 
-// The albedo of the target: ground with its variation and one sharp-edged
-// rectangular patch per square (anti-aliased by the renderer's supersampling).
-// Throws std::invalid_argument for invalid params.
-AlbedoParams TargetAlbedo(const CalibrationTargetParams& target);
+// Rig-frame (x, y, 0) of the centre of square (0, 0): params.target_origin_rig_mm,
+// or when unset the grid centred on the rig's x = y = 0:
+// (-(cols - 1) / 2 * pitch, (rows - 1) / 2 * pitch, 0).
+Eigen::Vector3d TargetOriginInRig(const CalibrationSessionParams& params);
+// The calibration world point of a rig-frame point (mm): rig - TargetOriginInRig.
+Eigen::Vector3d RigToCalibrationWorld(const CalibrationSessionParams& params,
+                                      const Eigen::Vector3d& rig_mm);
+// The rig-frame point of a calibration world point (mm); inverse of the above.
+Eigen::Vector3d CalibrationWorldToRig(const CalibrationSessionParams& params,
+                                      const Eigen::Vector3d& world_mm);
+// A device model given in the rig frame, re-expressed in the calibration
+// world frame (same intrinsics, same centre in space).
+geometry::PinholeModel RigModelToCalibrationWorld(const CalibrationSessionParams& params,
+                                                  const geometry::PinholeModel& rig_model);
+// The side's camera / the projector of params.rig in the calibration world
+// frame: what a calibration of the session must recover. Throw
+// std::invalid_argument for invalid params.
+geometry::PinholeModel CalibrationCamera(const CalibrationSessionParams& params,
+                                         pattern::Side side);
+geometry::PinholeModel CalibrationProjector(const CalibrationSessionParams& params);
 
-// The scene of a camera view: the target plane at z_mm seen by the side's
-// camera. Render it with TargetRenderParams. Throws std::invalid_argument.
+// The albedo of the target, in the rig frame with square (0, 0) at rig
+// (x, y) = origin_rig_mm: ground with its variation and one soft-edged
+// rectangular patch per square (anti-aliased by the renderer's
+// supersampling). Throws std::invalid_argument for invalid params.
+AlbedoParams TargetAlbedo(const CalibrationTargetParams& target,
+                          const Eigen::Vector2d& origin_rig_mm = Eigen::Vector2d::Zero());
+
+// The scene (rig frame) of a camera view: the target plane at z_mm, placed
+// at TargetOriginInRig, seen by the side's camera. Render it with
+// TargetRenderParams. Throws std::invalid_argument.
 Scene CalibrationTargetScene(pattern::Side side, double z_mm,
                              const CalibrationSessionParams& params);
 // params.render with the projector off and ambient = target_irradiance.
@@ -148,8 +190,8 @@ Scene CalibrationScreenScene(pattern::Side side, double z_mm, bool cross,
                              const CalibrationSessionParams& params);
 
 // True image points (px, distorted) of every square centre at z_mm,
-// row-major. Throws std::invalid_argument when a centre is not in front of
-// the camera.
+// row-major, for a camera given in the calibration world frame. Throws std::invalid_argument when a
+// centre is not in front of the camera.
 std::vector<Eigen::Vector2d> TrueSquareCentres(const geometry::PinholeModel& camera,
                                                const CalibrationTargetParams& target, double z_mm);
 
@@ -170,8 +212,10 @@ std::string ManifestYaml(const CalibrationSession& session);
 // {"side", "width", "height",
 //  "target": {"rows", "cols", "pitch_mm", "square_mm"},
 //  "pattern": {"lines", "rows", "stroke_width"},
+//  "target_origin_rig_mm": [x, y, 0]  (rig-frame position of square (0, 0)),
 //  "camera":    {"fx", "fy", "cx", "cy", "k1", "k2",            (pixels)
 //                "rotation": [9, row-major, world->device], "translation": [3] (mm)},
+//               in the calibration world frame,
 //  "projector": same layout, focal length and principal point in slide pitches d,
 //  "camera_views": [{"image", "z_mm",
 //                    "squares": [{"row", "col", "x", "y", "world": [x, y, z]}]}],

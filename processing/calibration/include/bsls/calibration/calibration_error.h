@@ -11,14 +11,18 @@
 namespace bsls::calibration {
 
 enum class CalibrationErrorReason {
-  kInvalidParams,  // a Params struct failed IsValid
-  kInvalidInput,   // non-finite coordinates, bad image size, mismatched sizes
-  kTooFewPoints,   // fewer correspondences than the model needs
-  kCoplanar,       // all points in one plane: the non-coplanar methods cannot work
-  kDegenerate,     // the linear solve or the refinement has no unique solution
+  kInvalidParams,    // a Params struct failed IsValid
+  kInvalidInput,     // non-finite coordinates, bad image size, mismatched sizes
+  kTooFewPoints,     // fewer correspondences than the model needs
+  kCoplanar,         // all points in one plane: the non-coplanar methods cannot work
+  kDegenerate,       // the linear solve or the refinement has no unique solution
+  kUnreadableInput,  // a listed file is missing or cannot be read as an image
+  kNotFound,         // the target, the pattern or the cross is not (fully) found in a view
+  kNotConverged,     // an iterative refinement stopped before converging
 };
 
-// Returns "invalid params", "invalid input", "too few points", "coplanar" or "degenerate".
+// Returns "invalid params", "invalid input", "too few points", "coplanar",
+// "degenerate", "unreadable input", "not found" or "not converged".
 constexpr std::string_view ToString(CalibrationErrorReason reason) {
   switch (reason) {
     case CalibrationErrorReason::kInvalidParams:
@@ -31,6 +35,12 @@ constexpr std::string_view ToString(CalibrationErrorReason reason) {
       return "coplanar";
     case CalibrationErrorReason::kDegenerate:
       return "degenerate";
+    case CalibrationErrorReason::kUnreadableInput:
+      return "unreadable input";
+    case CalibrationErrorReason::kNotFound:
+      return "not found";
+    case CalibrationErrorReason::kNotConverged:
+      return "not converged";
   }
   return "unknown";
 }

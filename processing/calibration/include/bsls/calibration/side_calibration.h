@@ -1,0 +1,217 @@
+// The calibration of one side (one camera + its brick slide) from a session
+// manifest (contracts section 4; thesis chapter 6):
+//
+//   1. camera     DetectTarget in every camera view (all or nothing), then
+//                 CalibrateCamera (thesis 6.1, Tsai two-stage).
+//   2. stripes    Decode every screen view with the side's brick slide; every
+//                 labelled line-centre sample is back-projected onto its screen
+//                 z (camera ray ∩ plane z = z_mm): a StripePoint of line p
+//                 (thesis 6.2: "the intersection of the corresponding camera
+//                 rays with the appropriate reference plane").
+//   3. planes     FitParallelPlaneModel (thesis 6.2.1) and
+//                 FitPerspectivePlaneModel (6.2.2) on those points, each with
+//                 the two-pass outlier rejection.
+//   4. rows       When slide-1 (cross) views are given: the cross centre in
+//                 each is slide point (s, t) = (0, 0), which is brick line 0
+//                 and brick row v = 0 (contracts sections 1-2). Back-projected
+//                 onto their screens, the centres lie on the projector ray of
+//                 that slide point (the reference ray). Where the ray meets a
+//                 screen view's plane, its image point is the junction (0, 0):
+//                 the decoded line-0 junction nearest it fixes that view's even
+//                 q offset (decoder::DecodeParams::q_offset).
+//   5. projector  The junctions of the views with known offsets,
+//                 back-projected onto their screens, give FitProjectorMatrix
+//                 (thesis eq. 2.16) in slide units.
+//
+// Frames and units: world millimetres of contracts section 3 (fixed by the
+// target), image pixels with the origin at the centre of the top-left pixel,
+// slide coordinates in line pitches d (bsls/pattern/brick_pattern.h).
+//
+// Errors: every failure throws CalibrationError whose what() names the input
+// (manifest file, view image) and the reason: listed views out of z order or
+// too few, an image that cannot be read or has another size, the target grid
+// not fully found in a camera view (a view is never used in part), a screen
+// view that does not decode, a cross not found, a fit that is degenerate or
+// does not converge.
+//
+// Thread-safety: CalibrateSide is a pure function of its arguments (it reads
+// the listed image files); decoding runs on OpenCV's thread pool.
+#ifndef BSLS_CALIBRATION_SIDE_CALIBRATION_H_
+#define BSLS_CALIBRATION_SIDE_CALIBRATION_H_
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bsls/calibration/calibration_error.h"
+#include "bsls/calibration/camera_calibration.h"
+#include "bsls/calibration/manifest.h"
+#include "bsls/calibration/projector_calibration.h"
+#include "bsls/calibration/reference_cross.h"
+#include "bsls/calibration/target_detect.h"
+#include "bsls/decoder/decoder.h"
+#include "bsls/geometry/pinhole_model.h"
+#include "bsls/pattern/brick_pattern.h"
+
+namespace bsls::calibration {
+
+struct SideCalibrationParams {
+  TargetDetectParams target;       // step 1, per camera view
+  CameraCalibrationParams camera;  // step 1
+  // Step 2. Its spec is replaced by the manifest's pattern and its q_offset
+  // must be unset: the offsets come from the cross views.
+  decoder::DecodeParams decode;
+  StripeFitParams stripes;                  // step 3, both plane models
+  CrossParams cross;                        // step 4
+  ProjectorMatrixParams matrix;             // step 5
+  int min_camera_views = 3;                 // >= 2: Tsai needs depth, 3 leave redundancy
+  int min_screen_views = 2;                 // >= 2: the tilt of the light planes needs depth
+  int stripe_sample_step = 1;               // use every n-th line-centre sample (rows), >= 1
+  bool use_interpolated_junctions = false;  // step 5: also junctions the decoder placed unseen
+  // Step 4: the decoded line-0 junction must lie this close (px) to the image
+  // of the reference ray on a screen, else that view's offset stays unknown.
+  // Line-0 junctions are 2 d apart (about 50 px in the thesis rig).
+  double max_origin_junction_px = 8.0;  // > 0
+  // Step 4: a cross centre further (mm) from the line fitted through all of
+  // them fails the calibration (a cross misread or a screen z misreported).
+  double max_reference_ray_residual_mm = 1.0;  // > 0
+  // Stripe-centre noise estimate: per line and view, a polynomial x(y) of
+  // this degree is fitted to the centres; runs shorter than
+  // min_centre_run samples are skipped.
+  int centre_fit_degree = 3;  // 1..5
+  int min_centre_run = 20;    // > centre_fit_degree + 1
+
+  // True when every part is usable; otherwise names the field and why.
+  bool IsValid(std::string* error) const;
+};
+
+// How one camera view fed step 1.
+struct CameraViewReport {
+  std::filesystem::path image;
+  double z_mm = 0.0;
+  double rms_px = 0.0;             // reprojection error over the view's squares
+  double rms_mm = 0.0;             // on the view's plane
+  double max_grid_residual = 0.0;  // cells, DetectTarget
+};
+
+// How one screen view fed steps 2-5.
+struct ScreenViewReport {
+  std::filesystem::path image;
+  double z_mm = 0.0;
+  int lines = 0;                // labelled lines decoded
+  int stripe_points = 0;        // line-centre samples back-projected
+  int junctions = 0;            // labelled junctions decoded
+  double plane_rms_mm = 0.0;    // perspective model, this view's kept points
+  std::optional<int> q_offset;  // even; added to the decode's relative q (step 4)
+  int matrix_junctions = 0;     // junctions that fed step 5
+};
+
+// A cross view of step 4.
+struct ReferenceViewReport {
+  std::filesystem::path image;
+  double z_mm = 0.0;
+  Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();  // image of slide point (0, 0)
+  Eigen::Vector3d world_mm = Eigen::Vector3d::Zero();   // back-projected onto z_mm
+  double ray_residual_mm = 0.0;                         // distance from the fitted reference ray
+};
+
+// The projector ray of slide point (0, 0) (brick line 0, row 0): a world line.
+struct ReferenceRay {
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();    // on the line, at z = 0
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // unit, towards +z
+  // Where the line meets the plane z = z_mm; nullopt when it is parallel to it.
+  std::optional<Eigen::Vector3d> AtZ(double z_mm) const;
+};
+
+// Where the projector is (thesis Table 6.2: "the values for P0 and the
+// projector axis", projector-to-origin distance).
+struct ProjectorPose {
+  // Perspective plane model: P0 (one point of the pencil axis: the stripes
+  // alone cannot say where on it the projector lies) and the axis direction.
+  Eigen::Vector3d plane_centre_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d plane_axis = Eigen::Vector3d::UnitY();
+  double plane_centre_distance_mm = 0.0;  // |P0|
+  // Projector matrix (when fitted): the full centre and the optical axis
+  // (unit, world, from the projector towards the scene).
+  std::optional<Eigen::Vector3d> matrix_centre_mm;
+  std::optional<Eigen::Vector3d> optical_axis;
+  std::optional<double> matrix_centre_distance_mm;  // |centre|
+  // Angle (deg) between the camera's and the projector's optical axes
+  // (thesis Table 6.3), when the matrix is fitted.
+  std::optional<double> camera_projector_angle_deg;
+};
+
+// What reconstruction needs to attach an uncertainty to its points.
+struct UncertaintySigmas {
+  // Scatter (px, 1 sigma, along image x) of decoded line centres about a
+  // smooth curve per line and view: the stripe-centre noise.
+  double stripe_centre_px = 0.0;
+  // Scatter (px, per axis) of target centres about the camera model.
+  double target_point_px = 0.0;
+  // RMS distance (mm) of screen points from their perspective-model plane.
+  double plane_mm = 0.0;
+};
+
+// Wall-clock time of the steps, milliseconds.
+struct SideCalibrationTimes {
+  double camera_ms = 0.0;     // loading, detection, Tsai
+  double stripes_ms = 0.0;    // loading and decoding the screen views
+  double planes_ms = 0.0;     // both plane models
+  double reference_ms = 0.0;  // crosses, offsets, projector matrix
+  double total_ms = 0.0;
+};
+
+// The calibration of one side. Everything but `diagnostics` goes into the
+// calibration file (calibration_file.h); after loading, the per-point flags
+// (`inlier`) and the linear stages (`dlt`, `tsai`) of the reports are empty.
+struct SideCalibration {
+  pattern::Side side = pattern::Side::kLeft;
+  int width = 0;  // image size, pixels
+  int height = 0;
+  std::string manifest_sha256;
+  pattern::PatternSpec pattern;
+  TargetGeometry target;
+  CameraCalibration camera;                            // pixels
+  ParallelPlaneFit parallel;                           // thesis 6.2.1
+  PerspectivePlaneFit perspective;                     // thesis 6.2.2
+  std::optional<ProjectorMatrixFit> projector_matrix;  // eq. 2.16, slide units d
+  std::optional<ReferenceRay> reference_ray;
+  std::vector<CameraViewReport> camera_views;        // manifest order
+  std::vector<ScreenViewReport> screen_views;        // manifest order
+  std::vector<ReferenceViewReport> reference_views;  // manifest order
+  ProjectorPose projector;
+  UncertaintySigmas sigmas;
+
+  // Not stored in the calibration file.
+  struct Diagnostics {
+    std::vector<StripePoint> stripe_points;      // step 2, in screen-view order
+    std::vector<JunctionPoint> junction_points;  // step 5
+    SideCalibrationTimes times;
+  } diagnostics;
+};
+
+// Contracts section 4: two sides calibrated against the same target positions
+// share one world frame. The files cannot show the positions, but one
+// projector serves both sides, so in a shared frame the two calibrations put
+// it in the same place: true when the targets match, the sides differ and the
+// projector centres (projector matrices when both have one, else the points
+// P0 of the perspective models) and reference rays (when both have one, at
+// z = 0) lie within tolerance_mm of each other; otherwise false with the reason.
+bool SharesWorldFrame(const SideCalibration& left, const SideCalibration& right, std::string* why,
+                      double tolerance_mm = 5.0);
+
+// Thesis chapter 6 for one side: every step above. Throws CalibrationError
+// naming the manifest or the view and the reason.
+SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params = {});
+
+// The projector pose of thesis Table 6.2 from the fitted models (step 5
+// optional). Pure; used by CalibrateSide and after loading a file.
+ProjectorPose PoseOfProjector(const PerspectivePlaneFit& perspective,
+                              const std::optional<ProjectorMatrixFit>& matrix,
+                              const geometry::PinholeModel& camera);
+
+}  // namespace bsls::calibration
+
+#endif  // BSLS_CALIBRATION_SIDE_CALIBRATION_H_

@@ -1,0 +1,473 @@
+#include "bsls/calibration/side_calibration.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include "bsls/io/frame_file.h"
+#include "point_set_geometry.h"
+
+namespace bsls::calibration {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+[[noreturn]] void Throw(CalibrationErrorReason reason, const std::string& message) {
+  throw CalibrationError(reason, message);
+}
+
+std::string Number(double value) {
+  std::ostringstream os;
+  os << value;
+  return os.str();
+}
+
+// "target_z010.png (camera view 2, z = 10 mm)"
+std::string ViewName(const ManifestView& view, const char* kind, size_t index) {
+  return view.image.string() + " (" + kind + " view " + std::to_string(index + 1) +
+         ", z = " + Number(view.z_mm) + " mm)";
+}
+
+bool Fail(std::string* error, const std::string& why) {
+  if (error) *error = why;
+  return false;
+}
+
+// Reads a listed image as 8-bit grey of the session's size (the first image
+// read sets it).
+cv::Mat LoadView(const ManifestView& view, const std::string& name, int* width, int* height) {
+  cv::Mat grey;
+  try {
+    grey = io::LoadGreyFrame(view.image.string());
+  } catch (const io::InputError& e) {
+    Throw(CalibrationErrorReason::kUnreadableInput, "calibration: " + std::string(e.what()));
+  }
+  if (*width == 0) {
+    *width = grey.cols;
+    *height = grey.rows;
+  } else if (grey.cols != *width || grey.rows != *height) {
+    Throw(CalibrationErrorReason::kInvalidInput,
+          "calibration: " + name + " is " + std::to_string(grey.cols) + " x " +
+              std::to_string(grey.rows) + " px, the other views " + std::to_string(*width) + " x " +
+              std::to_string(*height));
+  }
+  return grey;
+}
+
+// The listed views in the order and number the calibration needs.
+void CheckManifest(const Manifest& manifest, const SideCalibrationParams& params) {
+  const std::string file = manifest.path.string();
+  if (static_cast<int>(manifest.camera_views.size()) < params.min_camera_views)
+    Throw(CalibrationErrorReason::kInvalidInput,
+          "calibration: " + file + " lists " + std::to_string(manifest.camera_views.size()) +
+              " camera views; at least " + std::to_string(params.min_camera_views) + " are needed");
+  if (static_cast<int>(manifest.screen_views.size()) < params.min_screen_views)
+    Throw(CalibrationErrorReason::kInvalidInput,
+          "calibration: " + file + " lists " + std::to_string(manifest.screen_views.size()) +
+              " screen views; at least " + std::to_string(params.min_screen_views) + " are needed");
+  // Contracts section 3: the target is moved along +z only, from z = 0.
+  for (size_t i = 0; i < manifest.camera_views.size(); ++i) {
+    const double z = manifest.camera_views[i].z_mm;
+    if (!(z >= 0.0))
+      Throw(CalibrationErrorReason::kInvalidInput,
+            "calibration: " + file + ": camera view " + std::to_string(i + 1) + " has z_mm " +
+                Number(z) + "; the target moves along +z from z = 0 only");
+    if (i > 0 && !(z > manifest.camera_views[i - 1].z_mm))
+      Throw(CalibrationErrorReason::kInvalidInput,
+            "calibration: " + file + ": camera views are not in increasing z (view " +
+                std::to_string(i + 1) + " at " + Number(z) + " mm follows " +
+                Number(manifest.camera_views[i - 1].z_mm) + " mm)");
+  }
+  auto distinct = [&](const std::vector<ManifestView>& views, const char* what) {
+    std::set<double> seen;
+    for (const ManifestView& v : views)
+      if (!seen.insert(v.z_mm).second)
+        Throw(CalibrationErrorReason::kInvalidInput,
+              "calibration: " + file + ": two " + what + " views at z = " + Number(v.z_mm) + " mm");
+  };
+  distinct(manifest.screen_views, "screen");
+  distinct(manifest.reference_views, "reference");
+  std::set<double> screens;
+  for (const ManifestView& v : manifest.screen_views) screens.insert(v.z_mm);
+  if (screens.size() < 2)
+    Throw(CalibrationErrorReason::kInvalidInput,
+          "calibration: " + file + ": screen views need at least two distinct z_mm");
+}
+
+// Pooled scatter (px) of line centres about a polynomial x(y) per run of
+// consecutive rows; 0 when no run is long enough. `sum2` and `dof` accumulate.
+void AccumulateCentreScatter(const std::vector<cv::Point2d>& points, int degree, int min_run,
+                             double* sum2, double* dof) {
+  size_t begin = 0;
+  while (begin < points.size()) {
+    size_t end = begin + 1;
+    while (end < points.size() && points[end].y - points[end - 1].y <= 1.5) ++end;
+    const int n = static_cast<int>(end - begin);
+    if (n >= min_run) {
+      const double y0 = 0.5 * (points[begin].y + points[end - 1].y);
+      const double half = std::max(0.5 * (points[end - 1].y - points[begin].y), 1.0);
+      Eigen::MatrixXd a(n, degree + 1);
+      Eigen::VectorXd b(n);
+      for (int i = 0; i < n; ++i) {
+        const double t = (points[begin + i].y - y0) / half;
+        double power = 1.0;
+        for (int k = 0; k <= degree; ++k, power *= t) a(i, k) = power;
+        b(i) = points[begin + i].x;
+      }
+      const Eigen::VectorXd coef = a.colPivHouseholderQr().solve(b);
+      *sum2 += (a * coef - b).squaredNorm();
+      *dof += n - (degree + 1);
+    }
+    begin = end;
+  }
+}
+
+// Total-least-squares line through points: centroid and unit direction
+// (towards +z).
+ReferenceRay FitRay(const std::vector<Eigen::Vector3d>& points) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : points) centroid += p;
+  centroid /= static_cast<double>(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) scatter += (p - centroid) * (p - centroid).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+  Eigen::Vector3d direction = eig.eigenvectors().col(2).normalized();
+  if (direction.z() < 0.0) direction = -direction;
+  ReferenceRay ray;
+  ray.direction = direction;
+  ray.point_mm = centroid;
+  if (std::abs(direction.z()) > 1e-12) ray.point_mm = *ray.AtZ(0.0);
+  return ray;
+}
+
+double DistanceToLine(const ReferenceRay& ray, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d d = p - ray.point_mm;
+  return (d - d.dot(ray.direction) * ray.direction).norm();
+}
+
+}  // namespace
+
+bool SideCalibrationParams::IsValid(std::string* error) const {
+  std::string why;
+  if (!target.IsValid(&why)) return Fail(error, "target detection: " + why);
+  if (!camera.IsValid(&why)) return Fail(error, "camera: " + why);
+  if (!decode.IsValid(&why)) return Fail(error, "decode: " + why);
+  if (decode.q_offset) return Fail(error, "decode.q_offset must be unset (the crosses set it)");
+  if (!stripes.IsValid(&why)) return Fail(error, "stripes: " + why);
+  if (!cross.IsValid(&why)) return Fail(error, "cross: " + why);
+  if (!matrix.IsValid(&why)) return Fail(error, "matrix: " + why);
+  if (min_camera_views < 2) return Fail(error, "min_camera_views must be at least 2");
+  if (min_screen_views < 2) return Fail(error, "min_screen_views must be at least 2");
+  if (stripe_sample_step < 1) return Fail(error, "stripe_sample_step must be at least 1");
+  if (!(max_origin_junction_px > 0.0))
+    return Fail(error, "max_origin_junction_px must be positive");
+  if (!(max_reference_ray_residual_mm > 0.0))
+    return Fail(error, "max_reference_ray_residual_mm must be positive");
+  if (centre_fit_degree < 1 || centre_fit_degree > 5)
+    return Fail(error, "centre_fit_degree must lie in 1..5");
+  if (min_centre_run <= centre_fit_degree + 1)
+    return Fail(error, "min_centre_run must exceed centre_fit_degree + 1");
+  return true;
+}
+
+std::optional<Eigen::Vector3d> ReferenceRay::AtZ(double z_mm) const {
+  if (std::abs(direction.z()) < 1e-12) return std::nullopt;
+  return point_mm + ((z_mm - point_mm.z()) / direction.z()) * direction;
+}
+
+ProjectorPose PoseOfProjector(const PerspectivePlaneFit& perspective,
+                              const std::optional<ProjectorMatrixFit>& matrix,
+                              const geometry::PinholeModel& camera) {
+  ProjectorPose pose;
+  pose.plane_centre_mm = perspective.model.centre_mm;
+  pose.plane_axis = perspective.model.axis_direction;
+  pose.plane_centre_distance_mm = perspective.model.centre_mm.norm();
+  if (matrix) {
+    const Eigen::Vector3d centre = matrix->model.Centre();
+    // Device z (the viewing direction) in world coordinates.
+    const Eigen::Vector3d axis = matrix->model.pose().rotation.row(2).transpose().normalized();
+    pose.matrix_centre_mm = centre;
+    pose.optical_axis = axis;
+    pose.matrix_centre_distance_mm = centre.norm();
+    const Eigen::Vector3d camera_axis = camera.pose().rotation.row(2).transpose().normalized();
+    pose.camera_projector_angle_deg =
+        std::acos(std::clamp(camera_axis.dot(axis), -1.0, 1.0)) * 180.0 / M_PI;
+  }
+  return pose;
+}
+
+// Thesis chapter 6 (6.1 camera, 6.2 projector) for one side of the rig.
+SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params) {
+  const auto start = Clock::now();
+  const std::string file = manifest.path.string();
+  std::string why;
+  if (!params.IsValid(&why))
+    Throw(CalibrationErrorReason::kInvalidParams, "calibration: parameters: " + why);
+  if (!manifest.target.IsValid(&why))
+    Throw(CalibrationErrorReason::kInvalidInput, "calibration: " + file + ": " + why);
+  if (!manifest.pattern.IsValid(&why))
+    Throw(CalibrationErrorReason::kInvalidInput, "calibration: " + file + ": pattern: " + why);
+  CheckManifest(manifest, params);
+
+  SideCalibration out;
+  out.side = manifest.side;
+  out.manifest_sha256 = manifest.sha256;
+  out.pattern = manifest.pattern;
+  out.target = manifest.target;
+  int width = 0, height = 0;
+
+  // 1. Thesis 6.1: target squares' centres of gravity in every camera view,
+  // then Tsai's two-stage calibration.
+  auto t = Clock::now();
+  std::vector<TargetView> views;
+  for (size_t i = 0; i < manifest.camera_views.size(); ++i) {
+    const ManifestView& view = manifest.camera_views[i];
+    const std::string name = ViewName(view, "camera", i);
+    const cv::Mat grey = LoadView(view, name, &width, &height);
+    const TargetDetection detection = DetectTarget(grey, manifest.target, params.target);
+    if (!detection.ok)
+      Throw(CalibrationErrorReason::kNotFound,
+            "calibration: " + name + ": target not found: " + detection.error);
+    TargetView target_view;
+    for (const TargetSquare& square : detection.squares) {
+      TargetPoint point;
+      point.world_mm = manifest.target.SquareCentre(square.row, square.col, view.z_mm);
+      point.image_px = {square.centre.x, square.centre.y};
+      target_view.points.push_back(point);
+    }
+    views.push_back(std::move(target_view));
+    CameraViewReport report;
+    report.image = view.image;
+    report.z_mm = view.z_mm;
+    report.max_grid_residual = detection.max_grid_residual;
+    out.camera_views.push_back(report);
+  }
+  out.width = width;
+  out.height = height;
+  try {
+    out.camera = CalibrateCamera(views, width, height, params.camera);
+  } catch (const CalibrationError& e) {
+    Throw(e.reason(), "calibration: " + file + ": " + e.what());
+  }
+  if (!out.camera.report.converged)
+    Throw(CalibrationErrorReason::kNotConverged,
+          "calibration: " + file + ": camera calibration did not converge in " +
+              std::to_string(out.camera.report.iterations) + " iterations (RMS " +
+              Number(out.camera.report.rms_px) + " px)");
+  for (size_t i = 0; i < out.camera_views.size(); ++i) {
+    out.camera_views[i].rms_px = out.camera.report.view_rms_px[i];
+    out.camera_views[i].rms_mm = out.camera.report.view_rms_mm[i];
+  }
+  out.sigmas.target_point_px = out.camera.report.residual_sigma_px;
+  out.diagnostics.times.camera_ms = MsSince(t);
+  const geometry::PinholeModel& camera = out.camera.model;
+
+  // 2. Thesis 6.2: decode every screen view; back-project each labelled
+  // line-centre sample onto its screen.
+  t = Clock::now();
+  decoder::DecodeParams decode = params.decode;
+  decode.spec = manifest.pattern;
+  std::vector<decoder::DecodeResult> decoded;
+  std::vector<size_t> view_begin;  // first stripe point of each screen view
+  double centre_sum2 = 0.0, centre_dof = 0.0;
+  for (size_t i = 0; i < manifest.screen_views.size(); ++i) {
+    const ManifestView& view = manifest.screen_views[i];
+    const std::string name = ViewName(view, "screen", i);
+    const cv::Mat grey = LoadView(view, name, &width, &height);
+    decoder::DecodeResult result = decoder::Decode(grey, manifest.side, decode);
+    if (!result.ok)
+      Throw(CalibrationErrorReason::kNotFound,
+            "calibration: " + name + ": the brick pattern could not be decoded: " + result.error);
+    ScreenViewReport report;
+    report.image = view.image;
+    report.z_mm = view.z_mm;
+    report.lines = static_cast<int>(result.lines.size());
+    report.junctions = static_cast<int>(result.junctions.size());
+    view_begin.push_back(out.diagnostics.stripe_points.size());
+    for (const decoder::DecodedLine& line : result.lines) {
+      AccumulateCentreScatter(line.points, params.centre_fit_degree, params.min_centre_run,
+                              &centre_sum2, &centre_dof);
+      for (size_t k = 0; k < line.points.size(); k += params.stripe_sample_step) {
+        const Eigen::Vector2d image(line.points[k].x, line.points[k].y);
+        const auto world = internal::IntersectZPlane(camera.BackProject(image), view.z_mm);
+        if (!world) continue;
+        out.diagnostics.stripe_points.push_back({*world, line.p});
+        ++report.stripe_points;
+      }
+    }
+    out.screen_views.push_back(report);
+    decoded.push_back(std::move(result));
+  }
+  view_begin.push_back(out.diagnostics.stripe_points.size());
+  out.sigmas.stripe_centre_px = centre_dof > 0.0 ? std::sqrt(centre_sum2 / centre_dof) : 0.0;
+  out.diagnostics.times.stripes_ms = MsSince(t);
+
+  // 3. Thesis 6.2.1 and 6.2.2, each with its two-pass outlier rejection.
+  t = Clock::now();
+  try {
+    out.parallel = FitParallelPlaneModel(out.diagnostics.stripe_points, params.stripes);
+    out.perspective = FitPerspectivePlaneModel(out.diagnostics.stripe_points, params.stripes);
+  } catch (const CalibrationError& e) {
+    Throw(e.reason(), "calibration: " + file + ": " + e.what());
+  }
+  out.sigmas.plane_mm = out.perspective.report.rms_mm;
+  for (size_t i = 0; i < out.screen_views.size(); ++i) {
+    double sum2 = 0.0;
+    int count = 0;
+    for (size_t k = view_begin[i]; k < view_begin[i + 1]; ++k) {
+      if (!out.perspective.report.inlier[k]) continue;
+      const StripePoint& point = out.diagnostics.stripe_points[k];
+      const double d = out.perspective.model.PlaneOfLine(point.line).SignedDistance(point.world_mm);
+      sum2 += d * d;
+      ++count;
+    }
+    out.screen_views[i].plane_rms_mm = count > 0 ? std::sqrt(sum2 / count) : 0.0;
+  }
+  out.diagnostics.times.planes_ms = MsSince(t);
+
+  // 4. Slide 1: the cross centre is slide point (0, 0) = brick line 0, row 0.
+  t = Clock::now();
+  for (size_t i = 0; i < manifest.reference_views.size(); ++i) {
+    const ManifestView& view = manifest.reference_views[i];
+    const std::string name = ViewName(view, "reference", i);
+    const cv::Mat grey = LoadView(view, name, &width, &height);
+    std::string cross_why;
+    const auto cross = FindReferenceCross(grey, params.cross, &cross_why);
+    if (!cross)
+      Throw(CalibrationErrorReason::kNotFound,
+            "calibration: " + name + ": reference cross not found: " + cross_why);
+    ReferenceViewReport report;
+    report.image = view.image;
+    report.z_mm = view.z_mm;
+    report.centre_px = {cross->centre.x, cross->centre.y};
+    const auto world = internal::IntersectZPlane(camera.BackProject(report.centre_px), view.z_mm);
+    if (!world)
+      Throw(CalibrationErrorReason::kDegenerate,
+            "calibration: " + name + ": the camera ray of the cross centre misses the screen");
+    report.world_mm = *world;
+    out.reference_views.push_back(report);
+  }
+  if (out.reference_views.size() >= 2) {
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& r : out.reference_views) centres.push_back(r.world_mm);
+    out.reference_ray = FitRay(centres);
+    for (size_t i = 0; i < out.reference_views.size(); ++i) {
+      ReferenceViewReport& r = out.reference_views[i];
+      r.ray_residual_mm = DistanceToLine(*out.reference_ray, r.world_mm);
+      if (r.ray_residual_mm > params.max_reference_ray_residual_mm)
+        Throw(CalibrationErrorReason::kInvalidInput,
+              "calibration: " + ViewName(manifest.reference_views[i], "reference", i) +
+                  ": the cross centre lies " + Number(r.ray_residual_mm) +
+                  " mm off the line through the other cross centres (limit " +
+                  Number(params.max_reference_ray_residual_mm) +
+                  " mm): a misread cross or a wrong z_mm");
+    }
+  }
+  // The q offset of each screen view: image of slide point (0, 0) on its
+  // plane, from the reference ray or a cross view at the same z.
+  for (size_t i = 0; i < out.screen_views.size(); ++i) {
+    ScreenViewReport& report = out.screen_views[i];
+    std::optional<Eigen::Vector3d> origin;
+    if (out.reference_ray) {
+      origin = out.reference_ray->AtZ(report.z_mm);
+    } else {
+      for (const auto& r : out.reference_views)
+        if (r.z_mm == report.z_mm) origin = r.world_mm;
+    }
+    if (!origin) continue;
+    const auto image = camera.Project(*origin);
+    if (!image) continue;
+    const decoder::DecodedJunction* nearest = nullptr;
+    double best = params.max_origin_junction_px;
+    for (const decoder::DecodedJunction& j : decoded[i].junctions) {
+      if (j.p != 0) continue;
+      const double d = std::hypot(j.position.x - image->x(), j.position.y - image->y());
+      if (d <= best) {
+        best = d;
+        nearest = &j;
+      }
+    }
+    // Line-0 junctions sit on even rows only, so the offset is even.
+    if (nearest) report.q_offset = -nearest->q;
+  }
+
+  // 5. Thesis eq. 2.16: the projector matrix from the junctions of the views
+  // whose rows are absolute (decoder::DecodeParams::q_offset added, as the
+  // decoder would).
+  for (size_t i = 0; i < out.screen_views.size(); ++i) {
+    ScreenViewReport& report = out.screen_views[i];
+    if (!report.q_offset) continue;
+    for (const decoder::DecodedJunction& j : decoded[i].junctions) {
+      if (j.interpolated && !params.use_interpolated_junctions) continue;
+      const auto world =
+          internal::IntersectZPlane(camera.BackProject({j.position.x, j.position.y}), report.z_mm);
+      if (!world) continue;
+      out.diagnostics.junction_points.push_back(
+          {*world, SlideOfJunction(manifest.side, j.p, j.q + *report.q_offset)});
+      ++report.matrix_junctions;
+    }
+  }
+  if (!manifest.reference_views.empty()) {
+    if (out.diagnostics.junction_points.empty())
+      Throw(CalibrationErrorReason::kNotFound,
+            "calibration: " + file + ": no screen view's line-0 junction lies within " +
+                Number(params.max_origin_junction_px) +
+                " px of the reference cross centre: the slide rows cannot be fixed");
+    try {
+      out.projector_matrix = FitProjectorMatrix(out.diagnostics.junction_points, params.matrix);
+    } catch (const CalibrationError& e) {
+      Throw(e.reason(), "calibration: " + file + ": " + e.what());
+    }
+    if (!out.projector_matrix->report.converged)
+      Throw(CalibrationErrorReason::kNotConverged,
+            "calibration: " + file + ": projector matrix did not converge in " +
+                std::to_string(out.projector_matrix->report.iterations) + " iterations");
+  }
+  out.projector = PoseOfProjector(out.perspective, out.projector_matrix, camera);
+  out.diagnostics.times.reference_ms = MsSince(t);
+  out.diagnostics.times.total_ms = MsSince(start);
+  return out;
+}
+
+bool SharesWorldFrame(const SideCalibration& left, const SideCalibration& right, std::string* why,
+                      double tolerance_mm) {
+  const auto fail = [why](const std::string& reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  const auto mm = [](double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f mm", v);
+    return std::string(text);
+  };
+  if (left.side == right.side) return fail("both calibrations are of the same side");
+  const TargetGeometry& a = left.target;
+  const TargetGeometry& b = right.target;
+  if (a.rows != b.rows || a.cols != b.cols || a.pitch_mm != b.pitch_mm || a.square_mm != b.square_mm)
+    return fail("the two calibrations used different targets");
+  const bool matrices = left.projector.matrix_centre_mm && right.projector.matrix_centre_mm;
+  const Eigen::Vector3d pa =
+      matrices ? *left.projector.matrix_centre_mm : left.projector.plane_centre_mm;
+  const Eigen::Vector3d pb =
+      matrices ? *right.projector.matrix_centre_mm : right.projector.plane_centre_mm;
+  const double centres = (pa - pb).norm();
+  if (!(centres <= tolerance_mm))
+    return fail("the projector centres of the two calibrations are " + mm(centres) + " apart");
+  if (left.reference_ray && right.reference_ray) {
+    const double rays = (left.reference_ray->point_mm - right.reference_ray->point_mm).norm();
+    if (!(rays <= tolerance_mm))
+      return fail("the reference rays of the two calibrations meet z = 0 " + mm(rays) + " apart");
+  }
+  return true;
+}
+
+}  // namespace bsls::calibration

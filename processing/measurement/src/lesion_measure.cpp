@@ -1,0 +1,392 @@
+#include "bsls/measurement/lesion_measure.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "polygon.h"
+
+namespace bsls::measurement {
+namespace {
+
+// MAD to Gaussian sigma.
+constexpr double kMadToSigma = 1.4826;
+// Robust sigma floor (mm): keeps Huber weights finite on exact data.
+constexpr double kMinRobustSigmaMm = 1e-6;
+// Quadratic terms of the peak window fit, and their count.
+constexpr int kQuadricTerms = 6;
+constexpr int kPlaneTerms = 3;
+constexpr int kCubicTerms = 10;
+// A peak window whose minor/major scatter is below this holds one stripe.
+constexpr double kCollinearRatio = 0.05;
+
+int TermsOf(ReferenceKind kind) {
+  switch (kind) {
+    case ReferenceKind::kPlane:
+      return kPlaneTerms;
+    case ReferenceKind::kQuadric:
+      return kQuadricTerms;
+    case ReferenceKind::kCubic:
+      return kCubicTerms;
+  }
+  return kQuadricTerms;
+}
+
+bool Fail(std::string* error, const std::string& why) {
+  if (error) *error = why;
+  return false;
+}
+
+// Monomials 1, x, y [, x^2, xy, y^2] at offset d.
+Eigen::VectorXd Basis(const Eigen::Vector2d& d, int terms) {
+  Eigen::VectorXd phi(terms);
+  phi[0] = 1.0;
+  phi[1] = d.x();
+  phi[2] = d.y();
+  if (terms >= kQuadricTerms) {
+    phi[3] = d.x() * d.x();
+    phi[4] = d.x() * d.y();
+    phi[5] = d.y() * d.y();
+  }
+  if (terms >= kCubicTerms) {
+    phi[6] = d.x() * d.x() * d.x();
+    phi[7] = d.x() * d.x() * d.y();
+    phi[8] = d.x() * d.y() * d.y();
+    phi[9] = d.y() * d.y() * d.y();
+  }
+  return phi;
+}
+
+double Median(std::vector<double> values) {
+  const auto middle = values.begin() + values.size() / 2;
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// The vertices of the faces meeting the region's bounding box.
+std::vector<int> CandidateVertices(const SurfaceQuery& surface, const Eigen::AlignedBox2d& box) {
+  std::vector<int> vertices;
+  for (int f : surface.FacesIn(box))
+    for (int k = 0; k < 3; ++k) vertices.push_back(surface.mesh().faces[f][k]);
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  return vertices;
+}
+
+}  // namespace
+
+std::string ToString(ReferenceKind kind) {
+  switch (kind) {
+    case ReferenceKind::kPlane:
+      return "plane";
+    case ReferenceKind::kQuadric:
+      return "quadric";
+    case ReferenceKind::kCubic:
+      return "cubic";
+  }
+  return "unknown";
+}
+
+bool LesionMeasureParams::IsValid(std::string* error) const {
+  if (!(ring_width_mm > 0.0 && std::isfinite(ring_width_mm)))
+    return Fail(error, "lesion ring_width_mm must be positive and finite");
+  if (!(level_fraction > 0.0 && level_fraction < 1.0))
+    return Fail(error, "lesion level_fraction must lie in (0, 1)");
+  if (!(peak_fit_radius_mm > 0.0 && std::isfinite(peak_fit_radius_mm)))
+    return Fail(error, "lesion peak_fit_radius_mm must be positive and finite");
+  if (!(huber_k > 0.0 && std::isfinite(huber_k)))
+    return Fail(error, "lesion huber_k must be positive and finite");
+  if (robust_iterations < 1) return Fail(error, "lesion robust_iterations must be at least 1");
+  return true;
+}
+
+double ReferenceSurface::Z(const Eigen::Vector2d& xy) const {
+  return Basis(xy - origin, static_cast<int>(coefficients.size())).dot(coefficients);
+}
+
+Eigen::Vector2d ReferenceSurface::Gradient(const Eigen::Vector2d& xy) const {
+  Eigen::Vector2d g(coefficients[1], coefficients[2]);
+  const Eigen::Vector2d d = xy - origin;
+  if (coefficients.size() >= kQuadricTerms) {
+    g.x() += 2.0 * coefficients[3] * d.x() + coefficients[4] * d.y();
+    g.y() += coefficients[4] * d.x() + 2.0 * coefficients[5] * d.y();
+  }
+  if (coefficients.size() >= kCubicTerms) {
+    g.x() += 3.0 * coefficients[6] * d.x() * d.x() + 2.0 * coefficients[7] * d.x() * d.y() +
+             coefficients[8] * d.y() * d.y();
+    g.y() += coefficients[7] * d.x() * d.x() + 2.0 * coefficients[8] * d.x() * d.y() +
+             3.0 * coefficients[9] * d.y() * d.y();
+  }
+  return g;
+}
+
+double ReferenceSurface::SigmaZ(const Eigen::Vector2d& xy) const {
+  const Eigen::VectorXd phi = Basis(xy - origin, static_cast<int>(coefficients.size()));
+  return std::sqrt(std::max(0.0, phi.dot(covariance * phi)));
+}
+
+ReferenceSurface FitReference(const SurfaceQuery& surface, const Polygon2d& region,
+                              const LesionMeasureParams& params) {
+  std::string why;
+  if (!params.IsValid(&why)) throw MeasurementError(why);
+  internal::CheckPolygon(region, "lesion region");
+  const geometry::SurfaceMesh& mesh = surface.mesh();
+  Eigen::AlignedBox2d box = internal::Bounds(region);
+  const Eigen::Vector2d ring(params.ring_width_mm, params.ring_width_mm);
+  box.extend(box.min() - ring);
+  box.extend(box.max() + ring);
+  std::vector<int> ring_vertices;
+  for (int v : CandidateVertices(surface, box)) {
+    const Eigen::Vector2d xy = mesh.positions[v].head<2>();
+    if (!internal::Contains(region, xy) &&
+        internal::DistanceToBoundary(region, xy) <= params.ring_width_mm)
+      ring_vertices.push_back(v);
+  }
+  const int terms = TermsOf(params.reference);
+  if (static_cast<int>(ring_vertices.size()) < terms)
+    throw MeasurementError("lesion reference: the ring of " + std::to_string(params.ring_width_mm) +
+                           " mm around the region holds " + std::to_string(ring_vertices.size()) +
+                           " surface vertices; a " + ToString(params.reference) +
+                           " needs at least " + std::to_string(terms));
+  ReferenceSurface reference;
+  reference.kind = params.reference;
+  reference.origin = internal::Centroid(region);
+  reference.ring_vertices = static_cast<int>(ring_vertices.size());
+  const int n = static_cast<int>(ring_vertices.size());
+  Eigen::MatrixXd a(n, terms);
+  Eigen::VectorXd z(n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = mesh.positions[ring_vertices[i]];
+    a.row(i) = Basis(p.head<2>() - reference.origin, terms).transpose();
+    z[i] = p.z();
+  }
+  Eigen::VectorXd weights = Eigen::VectorXd::Ones(n);
+  Eigen::VectorXd residual(n);
+  Eigen::MatrixXd normal;
+  double sigma = 0.0;
+  for (int round = 0; round < params.robust_iterations; ++round) {
+    normal = a.transpose() * weights.asDiagonal() * a;
+    const Eigen::LDLT<Eigen::MatrixXd> solver(normal);
+    if (solver.info() != Eigen::Success || solver.rcond() < 1e-14)
+      throw MeasurementError("lesion reference: the ring's vertices do not determine a " +
+                             ToString(params.reference));
+    reference.coefficients = solver.solve(a.transpose() * weights.asDiagonal() * z);
+    residual = z - a * reference.coefficients;
+    std::vector<double> magnitudes(n);
+    for (int i = 0; i < n; ++i) magnitudes[i] = std::abs(residual[i]);
+    sigma = std::max(kMadToSigma * Median(magnitudes), kMinRobustSigmaMm);
+    const double threshold = params.huber_k * sigma;
+    for (int i = 0; i < n; ++i)
+      weights[i] = magnitudes[i] <= threshold ? 1.0 : threshold / magnitudes[i];
+  }
+  const double weight_sum = weights.sum();
+  const double variance =
+      residual.cwiseProduct(residual).dot(weights) / std::max(1.0, weight_sum - terms);
+  reference.residual_rms_mm = std::sqrt(variance);
+  reference.covariance =
+      variance * Eigen::MatrixXd(normal).ldlt().solve(Eigen::MatrixXd::Identity(terms, terms));
+  return reference;
+}
+
+LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& region_in,
+                                const LesionMeasureParams& params) {
+  Polygon2d region = region_in;
+  internal::CheckPolygon(region, "lesion region");
+  if (internal::SignedArea(region) < 0.0) std::reverse(region.begin(), region.end());
+  const geometry::SurfaceMesh& mesh = surface.mesh();
+  const Eigen::AlignedBox2d box = internal::Bounds(region);
+  std::vector<int> inside;
+  for (int v : CandidateVertices(surface, box))
+    if (internal::Contains(region, mesh.positions[v].head<2>())) inside.push_back(v);
+  if (inside.empty())
+    throw MeasurementError("lesion region: no surface vertex lies inside the polygon");
+
+  LesionMeasurement result;
+  result.region_vertices = static_cast<int>(inside.size());
+  result.reference = FitReference(surface, region, params);
+  const ReferenceSurface& reference = result.reference;
+  auto deviation = [&](int v) {
+    return mesh.positions[v].z() - reference.Z(mesh.positions[v].head<2>());
+  };
+
+  // Peak: sign from the extreme vertex, value from a quadratic around it.
+  int extreme = inside.front();
+  for (int v : inside)
+    if (std::abs(deviation(v)) > std::abs(deviation(extreme))) extreme = v;
+  const double sign = deviation(extreme) >= 0.0 ? 1.0 : -1.0;
+  result.cavity = sign < 0.0;
+  const Eigen::Vector2d centre = mesh.positions[extreme].head<2>();
+  std::vector<int> window;
+  for (int v : inside)
+    if ((mesh.positions[v].head<2>() - centre).norm() <= params.peak_fit_radius_mm)
+      window.push_back(v);
+  double peak = sign * deviation(extreme);
+  Eigen::Vector2d peak_xy = centre;
+  double peak_fit_sigma = surface.VertexSigma(extreme);
+  const int n = static_cast<int>(window.size());
+  if (n > kQuadricTerms) {
+    // Principal direction of the window: along the stripe when it holds one.
+    Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+    for (int v : window) {
+      const Eigen::Vector2d d = mesh.positions[v].head<2>() - centre;
+      scatter += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> axes(scatter);
+    const bool one_line = axes.eigenvalues()[0] < kCollinearRatio * axes.eigenvalues()[1];
+    const Eigen::Vector2d along = axes.eigenvectors().col(1);
+    // 2-D quadratic, or 1-D quadratic along the line for a collinear window.
+    const int terms = one_line ? 3 : kQuadricTerms;
+    auto basis = [&](const Eigen::Vector2d& d) {
+      if (!one_line) return Basis(d, kQuadricTerms);
+      const double t = d.dot(along);
+      Eigen::VectorXd phi(3);
+      phi << 1.0, t, t * t;
+      return phi;
+    };
+    Eigen::MatrixXd a(n, terms);
+    Eigen::VectorXd d(n);
+    for (int i = 0; i < n; ++i) {
+      a.row(i) = basis(mesh.positions[window[i]].head<2>() - centre).transpose();
+      d[i] = sign * deviation(window[i]);
+    }
+    const Eigen::MatrixXd normal = a.transpose() * a;
+    const Eigen::LDLT<Eigen::MatrixXd> solver(normal);
+    if (solver.info() == Eigen::Success && solver.rcond() > 1e-14) {
+      const Eigen::VectorXd c = solver.solve(a.transpose() * d);
+      Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+      bool interior = false;
+      if (one_line) {
+        if (c[2] < 0.0) {
+          offset = (-c[1] / (2.0 * c[2])) * along;
+          interior = offset.norm() <= params.peak_fit_radius_mm;
+        }
+      } else {
+        Eigen::Matrix2d hessian;
+        hessian << 2.0 * c[3], c[4], c[4], 2.0 * c[5];
+        if (hessian.determinant() > 0.0 && hessian(0, 0) < 0.0) {
+          offset = hessian.ldlt().solve(-Eigen::Vector2d(c[1], c[2]));
+          interior = offset.norm() <= params.peak_fit_radius_mm;
+        }
+      }
+      if (!interior) {  // no maximum inside: the best fitted vertex
+        double best = -std::numeric_limits<double>::infinity();
+        for (int i = 0; i < n; ++i) {
+          const double value = a.row(i).dot(c);
+          if (value > best) {
+            best = value;
+            offset = mesh.positions[window[i]].head<2>() - centre;
+          }
+        }
+      }
+      const Eigen::VectorXd phi = basis(offset);
+      peak = phi.dot(c);
+      peak_xy = centre + offset;
+      const Eigen::VectorXd r = d - a * c;
+      const double variance = r.squaredNorm() / std::max(1, n - terms);
+      peak_fit_sigma = std::sqrt(std::max(0.0, variance * phi.dot(solver.solve(phi))));
+    }
+  }
+  // Model misfit: the part of the ring's residual that the vertices' noise
+  // does not explain; the reference is assumed to miss by as much inside.
+  double noise_variance = 0.0;
+  for (int v : inside) noise_variance += std::pow(surface.VertexSigma(v), 2);
+  noise_variance /= static_cast<double>(inside.size());
+  const double misfit = std::sqrt(
+      std::max(0.0, reference.residual_rms_mm * reference.residual_rms_mm - noise_variance));
+  result.peak_mm.value = peak;
+  result.peak_mm.uncertainty = std::sqrt(peak_fit_sigma * peak_fit_sigma +
+                                         std::pow(reference.SigmaZ(peak_xy), 2) + misfit * misfit);
+  result.peak_position =
+      Eigen::Vector3d(peak_xy.x(), peak_xy.y(), reference.Z(peak_xy) + sign * peak);
+  result.level_mm = params.level_fraction * peak;
+
+  // Area at the level, volume over the region.
+  double area = 0.0, volume = 0.0;
+  double boundary_ref = 0.0, boundary_length = 0.0, boundary_noise = 0.0;
+  std::vector<double> volume_weight(mesh.positions.size(), 0.0);
+  bool any_face = false;
+  for (int f : surface.FacesIn(box)) {
+    const Eigen::Vector3i& face = mesh.faces[f];
+    std::array<int, 3> ids = {face[0], face[1], face[2]};
+    Polygon2d triangle = {mesh.positions[ids[0]].head<2>(), mesh.positions[ids[1]].head<2>(),
+                          mesh.positions[ids[2]].head<2>()};
+    const double signed_xy = internal::SignedArea(triangle);
+    if (std::abs(signed_xy) < 1e-12) continue;
+    if (signed_xy < 0.0) {
+      std::swap(triangle[1], triangle[2]);
+      std::swap(ids[1], ids[2]);
+    }
+    const std::vector<double> values = {sign * deviation(ids[0]), sign * deviation(ids[1]),
+                                        sign * deviation(ids[2])};
+    const Polygon2d piece = internal::ClipByConvex(region, triangle);
+    const double piece_xy = std::abs(internal::SignedArea(piece));
+    if (piece_xy <= 0.0) continue;
+    any_face = true;
+    const Eigen::Vector3d w =
+        internal::Barycentric(triangle[0], triangle[1], triangle[2], internal::Centroid(piece));
+    volume += piece_xy * (w[0] * values[0] + w[1] * values[1] + w[2] * values[2]);
+    for (int k = 0; k < 3; ++k) volume_weight[ids[k]] += piece_xy * w[k];
+
+    const Polygon2d raised = internal::ClipByLevel(triangle, values, result.level_mm);
+    if (raised.size() >= 3) {
+      const Polygon2d part = internal::ClipByConvex(region, raised);
+      const double part_xy = std::abs(internal::SignedArea(part));
+      if (part_xy > 0.0)
+        area +=
+            part_xy * std::sqrt(1.0 + reference.Gradient(internal::Centroid(part)).squaredNorm());
+    }
+    // The level line through this face: its length over the slope of d says
+    // how much area a shift of the level moves.
+    const double lo = *std::min_element(values.begin(), values.end());
+    const double hi = *std::max_element(values.begin(), values.end());
+    if (lo < result.level_mm && hi > result.level_mm) {
+      std::vector<Eigen::Vector2d> crossings;
+      for (int k = 0; k < 3; ++k) {
+        const double va = values[k] - result.level_mm, vb = values[(k + 1) % 3] - result.level_mm;
+        if ((va >= 0.0) != (vb >= 0.0))
+          crossings.push_back(triangle[k] +
+                              (triangle[(k + 1) % 3] - triangle[k]) * (va / (va - vb)));
+      }
+      if (crossings.size() == 2) {
+        const Eigen::Vector2d middle = 0.5 * (crossings[0] + crossings[1]);
+        if (internal::Contains(region, middle)) {
+          Eigen::Matrix2d e;
+          e.col(0) = triangle[1] - triangle[0];
+          e.col(1) = triangle[2] - triangle[0];
+          const Eigen::Vector2d slope =
+              e.transpose().inverse() *
+              Eigen::Vector2d(values[1] - values[0], values[2] - values[0]);
+          const double per_mm = (crossings[1] - crossings[0]).norm() /
+                                std::max(slope.norm(), 1e-9) *
+                                std::sqrt(1.0 + reference.Gradient(middle).squaredNorm());
+          const double vertex_sigma = (surface.VertexSigma(ids[0]) + surface.VertexSigma(ids[1]) +
+                                       surface.VertexSigma(ids[2])) /
+                                      3.0;
+          boundary_length += per_mm;
+          boundary_ref += per_mm * std::hypot(reference.SigmaZ(middle), misfit);
+          boundary_noise += std::pow(per_mm * vertex_sigma, 2);
+        }
+      }
+    }
+  }
+  if (!any_face) throw MeasurementError("lesion region: no surface lies inside the polygon");
+  result.area_mm2.value = area;
+  result.area_mm2.uncertainty =
+      std::sqrt(boundary_ref * boundary_ref + boundary_noise +
+                std::pow(boundary_length * params.level_fraction * result.peak_mm.uncertainty, 2));
+  double volume_variance = 0.0;
+  for (std::size_t v = 0; v < volume_weight.size(); ++v)
+    if (volume_weight[v] > 0.0)
+      volume_variance += std::pow(volume_weight[v] * surface.VertexSigma(static_cast<int>(v)), 2);
+  const double region_xy = std::abs(internal::SignedArea(region));
+  volume_variance += std::pow(region_xy * reference.SigmaZ(reference.origin), 2);
+  result.volume_mm3.value = volume;
+  result.volume_mm3.uncertainty = std::sqrt(volume_variance);
+  result.region_area_mm2 = SurfaceArea(surface, region);
+  return result;
+}
+
+}  // namespace bsls::measurement

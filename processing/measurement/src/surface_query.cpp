@@ -1,0 +1,154 @@
+#include "bsls/measurement/surface_query.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "polygon.h"
+
+namespace bsls::measurement {
+namespace {
+
+// Grid cells per axis at most (keeps the index small for huge meshes).
+constexpr int kMaxCellsPerAxis = 2048;
+// Barycentric slack (a point on an edge belongs to both faces).
+constexpr double kInsideTolerance = 1e-9;
+// The quadric of InterpolationError uses vertices within this many longest
+// edges of the face.
+constexpr double kInterpolationNeighbourhood = 1.5;
+
+}  // namespace
+
+SurfaceQuery::SurfaceQuery(const geometry::SurfaceMesh& mesh, double cell_mm) : mesh_(mesh) {
+  std::string why;
+  if (!mesh.IsValid(&why)) throw MeasurementError("surface: " + why);
+  if (mesh.faces.empty()) throw MeasurementError("surface: the mesh has no faces");
+  std::vector<double> edges;
+  edges.reserve(mesh.faces.size() * 3);
+  for (const Eigen::Vector3i& f : mesh.faces) {
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& p = mesh.positions[f[k]];
+      if (!p.allFinite())
+        throw MeasurementError("surface: vertex " + std::to_string(f[k]) + " is not finite");
+      bounds_.extend(p.head<2>());
+      edges.push_back((mesh.positions[f[(k + 1) % 3]] - p).norm());
+    }
+  }
+  std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
+  median_edge_mm_ = std::max(edges[edges.size() / 2], 1e-6);
+  cell_mm_ = cell_mm > 0.0 ? cell_mm : 2.0 * median_edge_mm_;
+  const Eigen::Vector2d size = bounds_.sizes();
+  cell_mm_ = std::max({cell_mm_, size.x() / kMaxCellsPerAxis, size.y() / kMaxCellsPerAxis});
+  nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_mm_)) + 1);
+  ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_mm_)) + 1);
+  cells_.assign(static_cast<std::size_t>(nx_) * ny_, {});
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    Eigen::AlignedBox2d box;
+    for (int k = 0; k < 3; ++k) box.extend(mesh.positions[mesh.faces[f][k]].head<2>());
+    const int x0 = static_cast<int>((box.min().x() - bounds_.min().x()) / cell_mm_);
+    const int x1 = static_cast<int>((box.max().x() - bounds_.min().x()) / cell_mm_);
+    const int y0 = static_cast<int>((box.min().y() - bounds_.min().y()) / cell_mm_);
+    const int y1 = static_cast<int>((box.max().y() - bounds_.min().y()) / cell_mm_);
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) cells_[y * nx_ + x].push_back(static_cast<int>(f));
+  }
+}
+
+std::vector<int> SurfaceQuery::FacesIn(const Eigen::AlignedBox2d& box) const {
+  std::vector<int> faces;
+  if (!box.intersects(bounds_)) return faces;
+  auto clampx = [&](double v) {
+    return std::clamp(static_cast<int>((v - bounds_.min().x()) / cell_mm_), 0, nx_ - 1);
+  };
+  auto clampy = [&](double v) {
+    return std::clamp(static_cast<int>((v - bounds_.min().y()) / cell_mm_), 0, ny_ - 1);
+  };
+  const int x0 = clampx(box.min().x()), x1 = clampx(box.max().x());
+  const int y0 = clampy(box.min().y()), y1 = clampy(box.max().y());
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x)
+      for (int f : cells_[y * nx_ + x]) {
+        Eigen::AlignedBox2d face_box;
+        for (int k = 0; k < 3; ++k) face_box.extend(mesh_.positions[mesh_.faces[f][k]].head<2>());
+        if (face_box.intersects(box)) faces.push_back(f);
+      }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+double SurfaceQuery::VertexSigma(int v) const {
+  return mesh_.uncertainty_mm.empty() ? 0.0 : static_cast<double>(mesh_.uncertainty_mm[v]);
+}
+
+std::optional<SurfacePoint> SurfaceQuery::Above(const Eigen::Vector2d& xy) const {
+  std::optional<SurfacePoint> best;
+  for (int f : FacesIn(Eigen::AlignedBox2d(xy, xy))) {
+    const Eigen::Vector3i& face = mesh_.faces[f];
+    const Eigen::Vector3d& a = mesh_.positions[face[0]];
+    const Eigen::Vector3d& b = mesh_.positions[face[1]];
+    const Eigen::Vector3d& c = mesh_.positions[face[2]];
+    const double det = (b - a).head<2>().x() * (c - a).head<2>().y() -
+                       (c - a).head<2>().x() * (b - a).head<2>().y();
+    if (std::abs(det) < 1e-12) continue;  // vertical face: the line runs along it
+    const Eigen::Vector3d w = internal::Barycentric(a.head<2>(), b.head<2>(), c.head<2>(), xy);
+    if (w.minCoeff() < -kInsideTolerance) continue;
+    const Eigen::Vector3d p = w[0] * a + w[1] * b + w[2] * c;
+    if (best && best->position.z() >= p.z()) continue;
+    SurfacePoint point;
+    point.position = Eigen::Vector3d(xy.x(), xy.y(), p.z());
+    point.face = f;
+    point.barycentric = w;
+    double variance = 0.0;
+    for (int k = 0; k < 3; ++k) variance += w[k] * w[k] * std::pow(VertexSigma(face[k]), 2);
+    point.sigma_mm = std::sqrt(variance);
+    best = point;
+  }
+  return best;
+}
+
+SurfacePoint SurfaceQuery::At(const Eigen::Vector2d& xy, const std::string& what) const {
+  auto point = Above(xy);
+  if (!point)
+    throw MeasurementError(what + " (" + std::to_string(xy.x()) + ", " + std::to_string(xy.y()) +
+                           ") mm is outside the surface");
+  return *point;
+}
+
+std::vector<int> SurfaceQuery::VerticesNear(const Eigen::Vector2d& xy, double radius_mm) const {
+  const Eigen::Vector2d r(radius_mm, radius_mm);
+  std::vector<int> vertices;
+  for (int f : FacesIn(Eigen::AlignedBox2d(xy - r, xy + r)))
+    for (int k = 0; k < 3; ++k) {
+      const int v = mesh_.faces[f][k];
+      if ((mesh_.positions[v].head<2>() - xy).norm() <= radius_mm) vertices.push_back(v);
+    }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  return vertices;
+}
+
+double SurfaceQuery::InterpolationError(const SurfacePoint& point) const {
+  const Eigen::Vector3i& face = mesh_.faces[point.face];
+  double longest = 0.0;
+  for (int k = 0; k < 3; ++k)
+    longest = std::max(
+        longest, (mesh_.positions[face[(k + 1) % 3]] - mesh_.positions[face[k]]).head<2>().norm());
+  const Eigen::Vector2d centre = point.position.head<2>();
+  const std::vector<int> near = VerticesNear(centre, kInterpolationNeighbourhood * longest);
+  if (near.size() < 10) return 0.0;
+  Eigen::MatrixXd a(near.size(), 6);
+  Eigen::VectorXd z(near.size());
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const Eigen::Vector3d& p = mesh_.positions[near[i]];
+    const double x = p.x() - centre.x(), y = p.y() - centre.y();
+    a.row(i) << 1.0, x, y, x * x, x * y, y * y;
+    z[i] = p.z();
+  }
+  const Eigen::VectorXd c = a.colPivHouseholderQr().solve(z);
+  if (!c.allFinite()) return 0.0;
+  return std::abs(c[0] - point.position.z());
+}
+
+}  // namespace bsls::measurement

@@ -1,0 +1,67 @@
+// From a side's calibration (bsls/calibration/side_calibration.h) to what
+// triangulation needs: the camera, the light planes of one of the two
+// projector models, the projector matrix for junctions, and the sigmas of the
+// calibration for the uncertainty of every point. Also the even offset that
+// turns a decode's relative q into the slide row (contracts section 2), found
+// through the projector matrix.
+//
+// Frames and units: world mm (contracts section 3); image pixels; slide (s, t)
+// in line pitches d.
+// Thread-safety: pure functions of their arguments.
+#ifndef BSLS_RECONSTRUCTION_CALIBRATED_MODEL_H_
+#define BSLS_RECONSTRUCTION_CALIBRATED_MODEL_H_
+
+#include <optional>
+#include <string>
+
+#include "bsls/calibration/side_calibration.h"
+#include "bsls/decoder/decoder.h"
+#include "bsls/reconstruction/triangulation.h"
+
+namespace bsls::reconstruction {
+
+// Which light-plane model of the calibration triangulates line samples.
+enum class PlaneModelKind {
+  kPerspective,  // thesis 6.2.2: a pencil of planes through the projector (default)
+  kParallel,     // thesis 6.2.1: parallel planes, the thesis's simpler model
+};
+
+// The triangulation model of `calibration`: its camera, the light planes of
+// `planes`, its projector matrix when fitted, and UncertaintyParams from its
+// measured sigmas (stripe-centre scatter, target reprojection, plane RMS,
+// projector residual); a sigma the calibration did not measure keeps the
+// UncertaintyParams default.
+TriangulationModel ModelOfCalibration(const calibration::SideCalibration& calibration,
+                                      PlaneModelKind planes = PlaneModelKind::kPerspective);
+
+struct SlideRowParams {
+  // A junction agrees with the offset when its projected slide row lies
+  // within this many rows of (q + offset).
+  double agreement_rows = 0.5;
+  // At least this fraction of the junctions used must agree.
+  double min_agreement = 0.8;
+  int min_junctions = 5;  // seen (not interpolated) junctions needed, >= 1
+
+  // True when the numbers are in range; otherwise names the field.
+  bool IsValid(std::string* error) const;
+};
+
+// The even offset that makes the relative q of `decode` the slide row: each
+// seen junction is triangulated on the light plane of its p, projected into
+// the slide by the calibration's projector matrix, and its slide row t
+// compared with q; the median of t - q, rounded to the nearest even integer,
+// is the offset. nullopt, with the reason in `why`, when the calibration has
+// no projector matrix (no reference views), too few junctions triangulate, or
+// fewer than min_agreement of them agree with the offset.
+std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
+                                  const calibration::SideCalibration& calibration,
+                                  std::string* why, const SlideRowParams& params = {});
+
+// Adds the even `q_offset` to every junction's q of `decode` and marks its
+// rows absolute (as decoder::DecodeParams::q_offset would have).
+// std::invalid_argument for an odd offset or rows already absolute.
+void MakeRowsAbsolute(int q_offset, decoder::DecodeResult* decode);
+
+}  // namespace bsls::reconstruction
+
+#endif  // BSLS_RECONSTRUCTION_CALIBRATED_MODEL_H_

@@ -1,0 +1,79 @@
+// The polygon mesh of one side (thesis 5.2.1): triangles between the
+// triangulated samples of neighbouring labelled lines p and p + 1, paired by
+// image row, with Gouraud vertex normals (thesis 5.2.1, [114]).
+//
+// Frames and units: world millimetres (contracts section 3); rows are image
+// rows of the camera (pixels). Faces are counter-clockwise seen from the
+// camera centre, so normals point towards the camera (+z mostly).
+//
+// Thread-safety: pure functions of their arguments.
+#ifndef BSLS_RECONSTRUCTION_SURFACE_MESH_BUILDER_H_
+#define BSLS_RECONSTRUCTION_SURFACE_MESH_BUILDER_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "bsls/geometry/surface_mesh.h"
+
+namespace bsls::reconstruction {
+
+// One triangulated sample of a line.
+struct LineVertex {
+  int row = 0;  // image row of the sample (the decoder's one centre per row)
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();  // world mm
+  float sigma_mm = 0.0f;                               // 1-sigma position uncertainty
+  std::uint8_t flags = 0;                              // geometry::VertexFlag bits
+};
+
+// The samples of labelled line p, by strictly increasing row; missing rows
+// are gaps (shadows, occlusions, unrepaired breaks).
+struct TriangulatedLine {
+  int p = 0;
+  std::vector<LineVertex> vertices;
+};
+
+struct MeshParams {
+  // A triangle edge between lines p and p + 1 longer than this many times the
+  // local spacing spans a depth jump or a shadow: the triangle is dropped.
+  // Local spacing: the median row-aligned edge between neighbouring lines
+  // over the strips p-2 .. p+2 (~ the projected line pitch, growing where the
+  // light meets the surface obliquely).
+  double max_across_ratio = 3.0;
+  // An edge along a line (consecutive rows) longer than this many times the
+  // line's median step, and longer than min_along_jump_mm, is a depth jump:
+  // no triangle uses it. Steep surfaces have long steps; the ratio leaves room.
+  double max_along_ratio = 6.0;
+  double min_along_jump_mm = 1.0;
+
+  // True when the numbers are usable; otherwise names the field and why.
+  bool IsValid(std::string* error) const;
+};
+
+// What BuildSurfaceMesh did.
+struct MeshReport {
+  int vertices = 0;
+  int triangles = 0;
+  int dropped_across = 0;  // triangles refused for a too long edge between lines
+  int dropped_along = 0;   // quads refused for a depth jump along a line
+};
+
+// Thesis 5.2.1: for each pair of neighbouring lines p, p + 1 and each row y
+// where both lines have samples at y and y + 1 (a gap on either line, i.e. a
+// missing row, leaves a hole), the quad of those four
+// samples split along its shorter diagonal into two triangles, unless an
+// edge is too long (MeshParams). Vertices are every sample of every line in
+// the order given (line by line), their attributes copied (line = p);
+// normals are the average of the unit normals of the faces around each
+// vertex (Gouraud), or the unit vector towards the camera for a vertex in no
+// face. Faces are wound counter-clockwise seen from `camera_centre`.
+// Throws std::invalid_argument for invalid params or lines whose rows are not
+// strictly increasing.
+geometry::SurfaceMesh BuildSurfaceMesh(const std::vector<TriangulatedLine>& lines,
+                                       const Eigen::Vector3d& camera_centre,
+                                       const MeshParams& params = {}, MeshReport* report = nullptr);
+
+}  // namespace bsls::reconstruction
+
+#endif  // BSLS_RECONSTRUCTION_SURFACE_MESH_BUILDER_H_

@@ -1,0 +1,112 @@
+#include "bsls/reconstruction/calibrated_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+namespace bsls::reconstruction {
+namespace {
+
+bool Fail(std::string* why, const std::string& reason) {
+  if (why) *why = reason;
+  return false;
+}
+
+}  // namespace
+
+TriangulationModel ModelOfCalibration(const calibration::SideCalibration& calibration,
+                                      PlaneModelKind planes) {
+  CalibratedGeometry geometry;
+  geometry.camera = calibration.camera.model;
+  geometry.light_plane = planes == PlaneModelKind::kPerspective
+                             ? LightPlanesOfModel(calibration.perspective.model)
+                             : LightPlanesOfModel(calibration.parallel.model);
+  if (calibration.projector_matrix) geometry.projector = calibration.projector_matrix->model;
+
+  TriangulationModel model;
+  model.side = calibration.side;
+  model.geometry = geometry;
+  // Each sigma the calibration measured replaces the default guess.
+  UncertaintyParams& u = model.uncertainty;
+  const calibration::UncertaintySigmas& s = calibration.sigmas;
+  if (s.stripe_centre_px > 0.0) u.stripe_centre_sigma_px = s.stripe_centre_px;
+  if (s.target_point_px > 0.0) u.camera_reprojection_sigma_px = s.target_point_px;
+  const double plane_rms = planes == PlaneModelKind::kPerspective
+                               ? calibration.perspective.report.rms_mm
+                               : calibration.parallel.report.rms_mm;
+  if (plane_rms > 0.0) u.light_plane_sigma_mm = plane_rms;
+  if (calibration.projector_matrix && calibration.projector_matrix->report.residual_sigma_d > 0.0)
+    u.projector_residual_sigma_d = calibration.projector_matrix->report.residual_sigma_d;
+  return model;
+}
+
+bool SlideRowParams::IsValid(std::string* error) const {
+  if (!(agreement_rows > 0.0 && agreement_rows < 1.0))
+    return Fail(error, "SlideRowParams.agreement_rows must lie in (0, 1) rows");
+  if (!(min_agreement > 0.0 && min_agreement <= 1.0))
+    return Fail(error, "SlideRowParams.min_agreement must lie in (0, 1]");
+  if (min_junctions < 1) return Fail(error, "SlideRowParams.min_junctions must be >= 1");
+  return true;
+}
+
+// Contracts section 2: q is known up to an even offset; the projector matrix
+// (thesis eq. 2.16) says which slide row each seen junction came from.
+std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
+                                  const calibration::SideCalibration& calibration,
+                                  std::string* why, const SlideRowParams& params) {
+  std::string error;
+  if (!params.IsValid(&error)) {
+    Fail(why, error);
+    return std::nullopt;
+  }
+  if (!calibration.projector_matrix) {
+    Fail(why, "the calibration has no projector matrix (its manifest had no reference views)");
+    return std::nullopt;
+  }
+  const geometry::PinholeModel& camera = calibration.camera.model;
+  const geometry::PinholeModel& projector = calibration.projector_matrix->model;
+  std::vector<double> residue;  // slide row t minus the decoded q, per junction
+  for (const decoder::DecodedJunction& j : decode.junctions) {
+    if (j.interpolated) continue;
+    const calibration::LightPlane plane = calibration.perspective.model.PlaneOfLine(j.p);
+    const auto world =
+        plane.Intersect(camera.BackProject({j.position.x, j.position.y}));
+    if (!world) continue;
+    const auto slide = projector.Project(*world);
+    if (!slide) continue;
+    residue.push_back(slide->y() - j.q);
+  }
+  if (static_cast<int>(residue.size()) < params.min_junctions) {
+    Fail(why, std::to_string(residue.size()) + " junctions could be placed on the slide, " +
+                  std::to_string(params.min_junctions) + " are needed");
+    return std::nullopt;
+  }
+  std::vector<double> sorted = residue;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  const int offset = 2 * static_cast<int>(std::lround(median / 2.0));
+  const auto agree = std::count_if(residue.begin(), residue.end(), [&](double r) {
+    return std::abs(r - offset) <= params.agreement_rows;
+  });
+  const double fraction = static_cast<double>(agree) / static_cast<double>(residue.size());
+  if (fraction < params.min_agreement) {
+    Fail(why, "only " + std::to_string(agree) + " of " + std::to_string(residue.size()) +
+                  " junctions agree with slide-row offset " + std::to_string(offset) +
+                  " (median slide row - q = " + std::to_string(median) + ")");
+    return std::nullopt;
+  }
+  return offset;
+}
+
+void MakeRowsAbsolute(int q_offset, decoder::DecodeResult* decode) {
+  if (q_offset % 2 != 0)
+    throw std::invalid_argument("MakeRowsAbsolute: q offset " + std::to_string(q_offset) +
+                                " is odd (contracts section 2: rows repeat every 2)");
+  if (decode->q_absolute)
+    throw std::invalid_argument("MakeRowsAbsolute: the decode's rows are already absolute");
+  for (decoder::DecodedJunction& j : decode->junctions) j.q += q_offset;
+  decode->q_absolute = true;
+}
+
+}  // namespace bsls::reconstruction
