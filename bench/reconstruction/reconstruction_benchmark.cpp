@@ -6,6 +6,13 @@
 //
 // The model is the true camera and the light planes of the true projector
 // (the simulator's rig), as a calibration would give them.
+//
+// BM_FullBothSides: the whole reconstruction of a face as `bsls reconstruct`
+// runs it after the frames are in memory: decode both 512 x 512 sides,
+// triangulate and mesh each, join them in their shared frame (stitch along
+// line 0, seam error). Counters: median_ms of the whole, decode_ms (median of
+// decoding both sides alone, same run), ratio = whole / decode alone, and
+// goal_ratio = whole / 40 ms (the goal: one camera frame period).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -14,6 +21,8 @@
 #include <vector>
 
 #include "bsls/decoder/decoder.h"
+#include "bsls/joining/join.h"
+#include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/reconstruction/reconstruction.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
@@ -22,23 +31,31 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-const bsls::simulator::Scene& FaceScene() {
-  static const bsls::simulator::Scene scene = [] {
+const bsls::simulator::Scene& FaceScene(bsls::pattern::Side side = bsls::pattern::Side::kLeft) {
+  static const auto make = [](bsls::pattern::Side s) {
     bsls::simulator::ThesisSceneOptions options;
     options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
-    return bsls::simulator::ThesisScene(bsls::pattern::Side::kLeft,
-                                        bsls::simulator::SurfaceKind::kFace, options);
-  }();
-  return scene;
+    return bsls::simulator::ThesisScene(s, bsls::simulator::SurfaceKind::kFace, options);
+  };
+  static const bsls::simulator::Scene left = make(bsls::pattern::Side::kLeft);
+  static const bsls::simulator::Scene right = make(bsls::pattern::Side::kRight);
+  return side == bsls::pattern::Side::kLeft ? left : right;
 }
 
-const cv::Mat& FaceFrame() {
-  static const cv::Mat frame = [] {
+const cv::Mat& FaceFrame(bsls::pattern::Side side = bsls::pattern::Side::kLeft) {
+  static const auto render = [](bsls::pattern::Side s) {
     bsls::simulator::RenderParams params;
     params.noise_sigma = 3.0;
-    return bsls::simulator::Renderer(FaceScene(), params).RenderImage(1);
-  }();
-  return frame;
+    return bsls::simulator::Renderer(FaceScene(s), params).RenderImage(1);
+  };
+  static const cv::Mat left = render(bsls::pattern::Side::kLeft);
+  static const cv::Mat right = render(bsls::pattern::Side::kRight);
+  return side == bsls::pattern::Side::kLeft ? left : right;
+}
+
+// The true model of a side's scene, as a calibration would give it.
+bsls::reconstruction::TriangulationModel TrueModel(const bsls::simulator::Scene& scene) {
+  return bsls::reconstruction::ModelOfKnownDevices(scene.side, scene.camera, scene.projector);
 }
 
 double Median(std::vector<double> v) {
@@ -65,11 +82,7 @@ void BM_Reconstruct(benchmark::State& state) {
     state.SkipWithError(("decode failed: " + decode.error).c_str());
     return;
   }
-  bsls::reconstruction::TriangulationModel model;
-  model.side = scene.side;
-  model.geometry = bsls::reconstruction::CalibratedGeometry{
-      scene.camera, bsls::reconstruction::LightPlanesOfProjector(scene.projector, scene.side),
-      scene.projector};
+  const bsls::reconstruction::TriangulationModel model = TrueModel(scene);
   std::vector<double> ms;
   bsls::reconstruction::ReconstructionReport report;
   for (auto _ : state) {
@@ -88,8 +101,55 @@ void BM_Reconstruct(benchmark::State& state) {
   state.counters["bridged"] = report.bridged_samples;
 }
 
+void BM_FullBothSides(benchmark::State& state) {
+  using bsls::pattern::Side;
+  const cv::Mat& left = FaceFrame(Side::kLeft);
+  const cv::Mat& right = FaceFrame(Side::kRight);
+  const bsls::reconstruction::TriangulationModel left_model = TrueModel(FaceScene(Side::kLeft));
+  const bsls::reconstruction::TriangulationModel right_model = TrueModel(FaceScene(Side::kRight));
+  // The baseline: decoding both sides alone, in this run.
+  std::vector<double> decode_ms;
+  for (int i = 0; i < 20; ++i) {
+    const auto t = Clock::now();
+    benchmark::DoNotOptimize(bsls::decoder::Decode(left, Side::kLeft).ok);
+    benchmark::DoNotOptimize(bsls::decoder::Decode(right, Side::kRight).ok);
+    decode_ms.push_back(Ms(t));
+  }
+  std::vector<double> ms, mesh_ms, join_ms;
+  bsls::joining::JoinResult joined;
+  for (auto _ : state) {
+    const auto t = Clock::now();
+    const bsls::decoder::DecodeResult l = bsls::decoder::Decode(left, Side::kLeft);
+    const bsls::decoder::DecodeResult r = bsls::decoder::Decode(right, Side::kRight);
+    if (!l.ok || !r.ok) {
+      state.SkipWithError("decode failed");
+      return;
+    }
+    const auto t_mesh = Clock::now();
+    const bsls::geometry::SurfaceMesh left_mesh = bsls::reconstruction::Reconstruct(l, left_model);
+    const bsls::geometry::SurfaceMesh right_mesh =
+        bsls::reconstruction::Reconstruct(r, right_model);
+    const auto t_join = Clock::now();
+    joined = bsls::joining::JoinSharedFrame(left_mesh, right_mesh, {});
+    join_ms.push_back(Ms(t_join));
+    mesh_ms.push_back(std::chrono::duration<double, std::milli>(t_join - t_mesh).count());
+    ms.push_back(Ms(t));
+    benchmark::DoNotOptimize(joined.mesh.positions.data());
+  }
+  const double median = Median(ms), baseline = Median(decode_ms);
+  state.counters["reconstruct_ms"] = Median(mesh_ms);
+  state.counters["join_ms"] = Median(join_ms);
+  state.counters["median_ms"] = median;
+  state.counters["decode_ms"] = baseline;
+  state.counters["ratio"] = median / baseline;
+  state.counters["goal_ratio"] = median / 40.0;
+  state.counters["vertices"] = static_cast<double>(joined.mesh.VertexCount());
+  state.counters["seam_rms_mm"] = joined.seam.rms_mm;
+}
+
 }  // namespace
 
 BENCHMARK(BM_Reconstruct)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_FullBothSides)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 
 BENCHMARK_MAIN();

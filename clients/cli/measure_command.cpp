@@ -9,11 +9,10 @@
 #include <cmath>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"

@@ -4,15 +4,14 @@
 // directly when the calibrations share a world frame (contracts section 4),
 // otherwise matched on the common line's nose and mouth (thesis 5.2.2) and
 // refined by ICP. The seam error is reported either way.
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
-#include <string>
-
-#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/io/frame_file.h"
@@ -50,7 +49,8 @@ Side ReconstructSide(const std::string& image, pattern::Side side,
                      const reconstruction::SidePipelineParams& params) {
   io::FrameConversion conversion;
   const cv::Mat frame = io::LoadGreyFrame(image, &conversion);
-  if (conversion.converted()) std::cerr << "bsls: note: " << image << ": " << conversion.Describe() << "\n";
+  if (conversion.converted())
+    std::cerr << "bsls: note: " << image << ": " << conversion.Describe() << "\n";
   Side result{{}, image};
   try {
     result.outcome = reconstruction::ProcessSide(frame, side, &calibration, params);
@@ -104,8 +104,9 @@ void RunReconstruct(const ReconstructOptions& o) {
 
   joining::JoinResult joined;
   try {
-    joined = by_features ? joining::JoinByFeatures(*left.outcome.surface, *right.outcome.surface, {})
-                         : joining::JoinSharedFrame(*left.outcome.surface, *right.outcome.surface, {});
+    joined = by_features
+                 ? joining::JoinByFeatures(*left.outcome.surface, *right.outcome.surface, {})
+                 : joining::JoinSharedFrame(*left.outcome.surface, *right.outcome.surface, {});
   } catch (const joining::JoinError& e) {
     throw CommandError(kExitNotProcessed, o.left_image + " + " + o.right_image + ": " + e.what());
   }

@@ -429,6 +429,19 @@ class SurfaceCliTest(unittest.TestCase):
         self.assertLess(abs(rep["heights"][0]["height_mm"]["value"]), 0.25)
         self.assertLess(abs(rep["areas"][0]["area_mm2"]["value"] - 400.0), 4.0)  # 1 %
 
+    def test_geometric_setup_needs_no_calibration(self):
+        out = self.path("setup.ply")
+        r = run("process", self.frame, "--side", "left", "--geometric-setup",
+                "--junctions", self.path("g.json"), "--surface", out, "--ascii")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertIn("q relative", r.stdout)
+        _, rows, faces = read_ascii_ply(out)
+        self.assertGreater(len(rows), 5000)
+        self.assertGreater(faces, 5000)
+        r = run("process", self.frame, "--side", "left", "--geometric-setup", "--calibration",
+                self.calibration, "--junctions", self.path("g2.json"))
+        self.assertEqual(r.returncode, EXIT_USAGE)
+
     def test_surface_needs_a_calibration(self):
         out = self.path("none.ply")
         r = run("process", self.frame, "--side", "left", "--junctions", self.path("n.json"),

@@ -14,13 +14,15 @@
 #include <map>
 
 #include "bsls/decoder/decoder.h"
+#include "bsls/joining/join.h"
+#include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/reconstruction/reconstruction.h"
 #include "bsls/reconstruction/side_pipeline.h"
 #include "bsls/simulator/calibration_session.h"
-#include "bsls/testing/calibration_sessions.h"
 #include "bsls/simulator/evaluation.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
+#include "bsls/testing/calibration_sessions.h"
 
 namespace bsls::reconstruction {
 namespace {
@@ -64,10 +66,7 @@ const Case& Rendered(SurfaceKind kind, Side side) {
 }
 
 TriangulationModel TrueModel(const simulator::Scene& scene) {
-  TriangulationModel model;
-  model.side = scene.side;
-  model.geometry = CalibratedGeometry{
-      scene.camera, LightPlanesOfProjector(scene.projector, scene.side), scene.projector};
+  TriangulationModel model = ModelOfKnownDevices(scene.side, scene.camera, scene.projector);
   // The decoder's line centres (docs/decoding.md); the geometry is exact.
   model.uncertainty.stripe_centre_sigma_px = 0.1;
   model.uncertainty.camera_reprojection_sigma_px = 0.0;
@@ -259,7 +258,6 @@ TEST(GeometricFallback, RampFromSetupParameters) {
   EXPECT_GT(nominal.height_rms, e.height_rms);
 }
 
-
 // The chain as a user runs it: a simulated calibration session (reduced,
 // sensor noise 2) calibrated by CalibrateSide, the frame decoded, its rows made
 // absolute through the fitted projector matrix, the surface reconstructed with
@@ -277,7 +275,8 @@ TEST_P(Calibrated, RowsAbsoluteAndHeightsWithinAcceptance) {
   const CalibratedCase c = GetParam();
   const Side side = calibration::testing::SideOf(c.session);
   const calibration::SideCalibration& cal = calibration::testing::SessionCalibration(c.session);
-  const simulator::CalibrationSessionParams session = calibration::testing::SessionParams(c.session);
+  const simulator::CalibrationSessionParams session =
+      calibration::testing::SessionParams(c.session);
   const Case& rendered = Rendered(c.kind, side);
   const SideOutcome out = ProcessSide(rendered.frame.image, side, &cal);
   ASSERT_TRUE(out.decode.ok) << out.decode.error;
@@ -294,8 +293,8 @@ TEST_P(Calibrated, RowsAbsoluteAndHeightsWithinAcceptance) {
   for (Eigen::Vector3d& p : mesh.positions) p = simulator::CalibrationWorldToRig(session, p);
   const Errors e = Score(rendered.scene, mesh);
   const Errors junctions = Score(rendered.scene, mesh, geometry::kVertexJunction, 0);
-  const std::string name = std::string(simulator::ToString(c.kind)) + "_" +
-                           std::string(pattern::ToString(side));
+  const std::string name =
+      std::string(simulator::ToString(c.kind)) + "_" + std::string(pattern::ToString(side));
   std::printf("[ figures  ] %s calibrated: lines %s; junctions by eq. 2.18: %s\n", name.c_str(),
               e.Summary().c_str(), junctions.Summary().c_str());
   EXPECT_EQ(out.report.junctions_by_projector, out.report.junctions);
@@ -339,6 +338,53 @@ TEST(SlideRows, NeedAProjectorMatrixAndAnEvenOffset) {
   decoder::DecodeResult decode = rendered.decode;
   EXPECT_THROW(MakeRowsAbsolute(3, &decode), std::invalid_argument);
   EXPECT_THROW(ProcessSide(rendered.frame.image, Side::kRight, &cal), std::invalid_argument);
+}
+
+// Both sides of the face, each calibrated from its own session with the
+// target at the same placement (a shared world frame), reconstructed and
+// joined: the RMS <= 0.3 mm over the whole joined surface, every
+// vertex scored in the scene of the side it came from; the seam error is
+// reported and stays near the reconstruction's own error.
+TEST(JoinedFace, BothSidesWithinAcceptanceAndSeamReported) {
+  using calibration::testing::SessionKind;
+  const calibration::SideCalibration& left_cal =
+      calibration::testing::SessionCalibration(SessionKind::kLeftNoisy);
+  const calibration::SideCalibration& right_cal =
+      calibration::testing::SessionCalibration(SessionKind::kRightClean);
+  std::string why;
+  ASSERT_TRUE(calibration::SharesWorldFrame(left_cal, right_cal, &why)) << why;
+  const Case& left = Rendered(SurfaceKind::kFace, Side::kLeft);
+  const Case& right = Rendered(SurfaceKind::kFace, Side::kRight);
+  const SideOutcome l = ProcessSide(left.frame.image, Side::kLeft, &left_cal);
+  const SideOutcome r = ProcessSide(right.frame.image, Side::kRight, &right_cal);
+  ASSERT_TRUE(l.surface && r.surface);
+  const joining::JoinResult joined = joining::JoinSharedFrame(*l.surface, *r.surface, {});
+  // Both sessions place the target alike: one map back to the rig frame.
+  const simulator::CalibrationSessionParams session =
+      calibration::testing::SessionParams(SessionKind::kLeftNoisy);
+  geometry::SurfaceMesh left_part, right_part;
+  for (std::size_t v = 0; v < joined.mesh.VertexCount(); ++v) {
+    geometry::SurfaceMesh& part = v < joined.right_vertex_offset ? left_part : right_part;
+    part.positions.push_back(simulator::CalibrationWorldToRig(session, joined.mesh.positions[v]));
+    part.uncertainty_mm.push_back(joined.mesh.uncertainty_mm[v]);
+    part.flags.push_back(joined.mesh.flags[v]);
+  }
+  const Errors el = Score(left.scene, left_part);
+  const Errors er = Score(right.scene, right_part);
+  const int scored = el.scored + er.scored;
+  const double rms = std::sqrt(
+      (el.height_rms * el.height_rms * el.scored + er.height_rms * er.height_rms * er.scored) /
+      std::max(scored, 1));
+  std::printf(
+      "[ figures  ] joined face: %d vertices scored, height RMS %.3f mm (left %.3f, right "
+      "%.3f); seam RMS %.3f mm, max %.3f mm over %d samples; %d zipper triangles\n",
+      scored, rms, el.height_rms, er.height_rms, joined.seam.rms_mm, joined.seam.max_mm,
+      joined.seam.samples, joined.zipper_triangles);
+  EXPECT_GT(scored, 9000);
+  EXPECT_LE(rms, kFaceRmsMm);
+  EXPECT_GT(joined.seam.samples, 100);
+  EXPECT_LE(joined.seam.rms_mm, kFaceRmsMm);
+  EXPECT_GT(joined.zipper_triangles, 50);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // Reconstruct (thesis 5.2): errors, bridging, smoothing and junctions, on
 // decodes made exact from the simulator's ground truth (no rendering).
+#include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/reconstruction/reconstruction.h"
 
 #include <gtest/gtest.h>
@@ -37,11 +38,7 @@ const PlaneCase& PlaneSetup(Side side) {
 }
 
 TriangulationModel TrueModel(const simulator::Scene& scene) {
-  TriangulationModel model;
-  model.side = scene.side;
-  model.geometry = CalibratedGeometry{
-      scene.camera, LightPlanesOfProjector(scene.projector, scene.side), scene.projector};
-  return model;
+  return ModelOfKnownDevices(scene.side, scene.camera, scene.projector);
 }
 
 // The ground truth as a perfect decode: every line point, every visible junction.

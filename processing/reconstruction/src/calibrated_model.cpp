@@ -41,6 +41,14 @@ TriangulationModel ModelOfCalibration(const calibration::SideCalibration& calibr
   return model;
 }
 
+TriangulationModel ModelOfKnownDevices(pattern::Side side, const geometry::PinholeModel& camera,
+                                       const geometry::PinholeModel& projector) {
+  TriangulationModel model;
+  model.side = side;
+  model.geometry = CalibratedGeometry{camera, LightPlanesOfProjector(projector, side), projector};
+  return model;
+}
+
 bool SlideRowParams::IsValid(std::string* error) const {
   if (!(agreement_rows > 0.0 && agreement_rows < 1.0))
     return Fail(error, "SlideRowParams.agreement_rows must lie in (0, 1) rows");
@@ -53,8 +61,8 @@ bool SlideRowParams::IsValid(std::string* error) const {
 // Contracts section 2: q is known up to an even offset; the projector matrix
 // (thesis eq. 2.16) says which slide row each seen junction came from.
 std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
-                                  const calibration::SideCalibration& calibration,
-                                  std::string* why, const SlideRowParams& params) {
+                                  const calibration::SideCalibration& calibration, std::string* why,
+                                  const SlideRowParams& params) {
   std::string error;
   if (!params.IsValid(&error)) {
     Fail(why, error);
@@ -70,8 +78,7 @@ std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
   for (const decoder::DecodedJunction& j : decode.junctions) {
     if (j.interpolated) continue;
     const calibration::LightPlane plane = calibration.perspective.model.PlaneOfLine(j.p);
-    const auto world =
-        plane.Intersect(camera.BackProject({j.position.x, j.position.y}));
+    const auto world = plane.Intersect(camera.BackProject({j.position.x, j.position.y}));
     if (!world) continue;
     const auto slide = projector.Project(*world);
     if (!slide) continue;

@@ -6,7 +6,8 @@ namespace bsls::reconstruction {
 
 bool SidePipelineParams::IsValid(std::string* error) const {
   if (decode.q_offset) {
-    if (error) *error = "SidePipelineParams.decode.q_offset must be unset (the calibration fixes q)";
+    if (error)
+      *error = "SidePipelineParams.decode.q_offset must be unset (the calibration fixes q)";
     return false;
   }
   return decode.IsValid(error) && reconstruction.IsValid(error) && rows.IsValid(error);
@@ -20,9 +21,9 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
   if (calibration) {
     const calibration::SideCalibration& cal = **calibration;
     if (cal.side != side)
-      throw std::invalid_argument("the calibration is of the " +
-                                  std::string(pattern::ToString(cal.side)) + " side, the frame of the " +
-                                  std::string(pattern::ToString(side)));
+      throw std::invalid_argument(
+          "the calibration is of the " + std::string(pattern::ToString(cal.side)) +
+          " side, the frame of the " + std::string(pattern::ToString(side)));
     if (cal.width != grey.cols || cal.height != grey.rows)
       throw std::invalid_argument("the calibration is for " + std::to_string(cal.width) + "x" +
                                   std::to_string(cal.height) + " frames, the frame is " +
@@ -33,8 +34,8 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
   outcome.decode = decoder::Decode(grey, side, params.decode);
   if (!outcome.decode.ok) return outcome;
   if (calibration) {
-    if (const auto offset = SlideRowOffset(outcome.decode, **calibration, &outcome.rows_note,
-                                           params.rows)) {
+    if (const auto offset =
+            SlideRowOffset(outcome.decode, **calibration, &outcome.rows_note, params.rows)) {
       MakeRowsAbsolute(*offset, &outcome.decode);
       outcome.rows_note.clear();
     }
@@ -48,8 +49,7 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
     model.side = side;
     model.geometry = std::get<GeometricSetupParams>(geometry);
   }
-  outcome.surface =
-      Reconstruct(outcome.decode, model, params.reconstruction, &outcome.report);
+  outcome.surface = Reconstruct(outcome.decode, model, params.reconstruction, &outcome.report);
   return outcome;
 }
 

@@ -34,6 +34,12 @@ enum class PlaneModelKind {
 TriangulationModel ModelOfCalibration(const calibration::SideCalibration& calibration,
                                       PlaneModelKind planes = PlaneModelKind::kPerspective);
 
+// The triangulation model of a camera and a projector known exactly (e.g. the
+// simulator's rig): light planes from the projector (LightPlanesOfProjector)
+// and the projector for junctions; default uncertainty params.
+TriangulationModel ModelOfKnownDevices(pattern::Side side, const geometry::PinholeModel& camera,
+                                       const geometry::PinholeModel& projector);
+
 struct SlideRowParams {
   // A junction agrees with the offset when its projected slide row lies
   // within this many rows of (q + offset).
@@ -54,8 +60,8 @@ struct SlideRowParams {
 // no projector matrix (no reference views), too few junctions triangulate, or
 // fewer than min_agreement of them agree with the offset.
 std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
-                                  const calibration::SideCalibration& calibration,
-                                  std::string* why, const SlideRowParams& params = {});
+                                  const calibration::SideCalibration& calibration, std::string* why,
+                                  const SlideRowParams& params = {});
 
 // Adds the even `q_offset` to every junction's q of `decode` and marks its
 // rows absolute (as decoder::DecodeParams::q_offset would have).

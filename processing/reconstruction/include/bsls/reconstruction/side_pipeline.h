@@ -9,11 +9,10 @@
 #ifndef BSLS_RECONSTRUCTION_SIDE_PIPELINE_H_
 #define BSLS_RECONSTRUCTION_SIDE_PIPELINE_H_
 
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <variant>
-
-#include <opencv2/core.hpp>
 
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/decoder/decoder.h"
@@ -36,8 +35,8 @@ struct SidePipelineParams {
 
 // What a side gives without a calibration, with one, or with the thesis's
 // explicit set-up (GeometricSetupParams) when there is no calibration.
-using SideGeometry = std::variant<std::monostate, const calibration::SideCalibration*,
-                                  GeometricSetupParams>;
+using SideGeometry =
+    std::variant<std::monostate, const calibration::SideCalibration*, GeometricSetupParams>;
 
 struct SideOutcome {
   decoder::DecodeResult decode;  // ok == false: nothing else is set
