@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "bsls/calibration/side_calibration.h"
+#include "bsls/reconstruction/side_pipeline.h"
 
 namespace bsls::cli {
 
@@ -58,6 +59,15 @@ void AddMeasureCommand(CLI::App& app);
 // The side calibration in a calibration file; CommandError (exit 3) naming
 // the file and the reason when it cannot be used.
 calibration::SideCalibration LoadCalibrationFile(const std::string& path);
+
+// Loads `image` into *frame (saying on stderr when it was converted to 8-bit
+// grey) and runs one side's pipeline on it; CommandError naming the image for
+// an unusable calibration (exit 3) or a decode that cannot be reconstructed
+// (exit 1). A frame that does not decode comes back with decode.ok == false.
+reconstruction::SideOutcome ProcessFrame(const std::string& image, pattern::Side side,
+                                         const reconstruction::SideGeometry& geometry,
+                                         const reconstruction::SidePipelineParams& params,
+                                         cv::Mat* frame);
 
 }  // namespace bsls::cli
 

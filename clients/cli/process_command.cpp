@@ -35,6 +35,23 @@ struct ProcessOptions {
 
 }  // namespace
 
+reconstruction::SideOutcome ProcessFrame(const std::string& image, pattern::Side side,
+                                         const reconstruction::SideGeometry& geometry,
+                                         const reconstruction::SidePipelineParams& params,
+                                         cv::Mat* frame) {
+  io::FrameConversion conversion;
+  *frame = io::LoadGreyFrame(image, &conversion);
+  if (conversion.converted())
+    std::cerr << "bsls: note: " << image << ": " << conversion.Describe() << "\n";
+  try {
+    return reconstruction::ProcessSide(*frame, side, geometry, params);
+  } catch (const std::invalid_argument& e) {
+    throw CommandError(kExitInput, image + ": " + e.what());
+  } catch (const reconstruction::ReconstructionError& e) {
+    throw CommandError(kExitNotProcessed, image + ": " + e.what());
+  }
+}
+
 calibration::SideCalibration LoadCalibrationFile(const std::string& path) {
   try {
     return calibration::LoadCalibration(path).calibration;
@@ -72,18 +89,8 @@ void RunProcess(const ProcessOptions& o) {
     geometry = reconstruction::GeometricSetupParams{};
   }
 
-  io::FrameConversion conversion;
-  const cv::Mat frame = io::LoadGreyFrame(o.image, &conversion);
-  if (conversion.converted()) std::cerr << "bsls: note: " << o.image << ": " << conversion.Describe() << "\n";
-
-  reconstruction::SideOutcome outcome;
-  try {
-    outcome = reconstruction::ProcessSide(frame, *side, geometry, params);
-  } catch (const std::invalid_argument& e) {
-    throw CommandError(kExitInput, o.image + " with " + o.calibration + ": " + e.what());
-  } catch (const reconstruction::ReconstructionError& e) {
-    throw CommandError(kExitNotProcessed, o.image + ": " + e.what());
-  }
+  cv::Mat frame;
+  const reconstruction::SideOutcome outcome = ProcessFrame(o.image, *side, geometry, params, &frame);
   const decoder::DecodeResult& result = outcome.decode;
   // The skeleton helps to see why a frame failed, so it is written either way.
   if (!o.skeleton.empty() && !result.skeleton.empty())

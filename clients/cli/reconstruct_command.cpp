@@ -47,18 +47,8 @@ struct Side {
 Side ReconstructSide(const std::string& image, pattern::Side side,
                      const calibration::SideCalibration& calibration,
                      const reconstruction::SidePipelineParams& params) {
-  io::FrameConversion conversion;
-  const cv::Mat frame = io::LoadGreyFrame(image, &conversion);
-  if (conversion.converted())
-    std::cerr << "bsls: note: " << image << ": " << conversion.Describe() << "\n";
-  Side result{{}, image};
-  try {
-    result.outcome = reconstruction::ProcessSide(frame, side, &calibration, params);
-  } catch (const std::invalid_argument& e) {
-    throw CommandError(kExitInput, image + ": " + e.what());
-  } catch (const reconstruction::ReconstructionError& e) {
-    throw CommandError(kExitNotProcessed, image + ": " + e.what());
-  }
+  cv::Mat frame;
+  Side result{ProcessFrame(image, side, &calibration, params, &frame), image};
   if (!result.outcome.decode.ok)
     throw CommandError(kExitNotProcessed, image + ": " + result.outcome.decode.error);
   if (!result.outcome.decode.q_absolute)
