@@ -124,6 +124,51 @@ INSTANTIATE_TEST_SUITE_P(BothSides, Faces, ::testing::Values(Side::kLeft, Side::
                            return std::string(pattern::ToString(test_info.param));
                          });
 
+// Frame size: a 2048 x 2048 face (stripe pitch about 61 px, four times the
+// thesis's) is decoded as well as a 512 one. Its junctions are matched within
+// the same part of the pattern as at 512 (2.5 px there, 0.16 of the pitch),
+// so 10 px here; sub-pixel centres within 0.6 px (0.15 px at 512). Before the
+// working resolution (docs/decoding.md, "Frame size") this frame failed: its
+// reference line was not found.
+TEST(Decoder, LargeFrameIsBinnedAndDecodedAsWell) {
+  constexpr int kSize = 2048;
+  constexpr double kScale = kSize / 512.0;
+  simulator::ThesisSceneOptions options;
+  options.rig.width = kSize;
+  options.rig.height = kSize;
+  simulator::RenderParams render;
+  render.noise_sigma = kNoiseSigma;
+  render.seed = 1;
+  const simulator::Frame frame =
+      simulator::Render(simulator::ThesisScene(Side::kRight, SurfaceKind::kFace, options), render);
+  const DecodeResult r = Decode(frame.image, Side::kRight);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_NEAR(r.pitch, 61.0, 3.0);
+  EXPECT_EQ(r.binning, 3);
+  std::vector<simulator::PointLabel> decoded;
+  for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
+  const simulator::LabelScore score = simulator::ScoreLabels(
+      simulator::VisibleJunctions(frame.truth), decoded, kMatchReach * kScale);
+  EXPECT_EQ(score.wrong_p, 0) << score.Summary();
+  EXPECT_EQ(score.wrong_v, 0) << score.Summary();
+  EXPECT_GE(score.Recall(), 0.97) << score.Summary();
+  std::vector<simulator::LinePoints> lines;
+  for (const DecodedLine& line : r.lines) lines.push_back({line.p, line.points});
+  const simulator::LineScore centres =
+      simulator::ScoreLines(simulator::TruthLines(frame.truth), lines);
+  EXPECT_LE(centres.rms, 0.15 * kScale) << "points " << centres.points;
+}
+
+// The 512 x 512 frames are not binned: their pitch is what the parameters
+// are tuned for.
+TEST(Decoder, ThesisSizeFrameIsNotBinned) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 1);
+  const DecodeResult r = Decode(frame.image, Side::kLeft);
+  ASSERT_TRUE(r.ok) << r.error;
+  EXPECT_NEAR(r.pitch, 15.3, 1.0);
+  EXPECT_EQ(r.binning, 1);
+}
+
 TEST(Decoder, ThesisChainStillLabelsAPlaneRightly) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kPlane, Side::kLeft, 3);
   DecodeParams params;

@@ -9,6 +9,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "working_resolution.h"
+
 namespace bsls::decoder {
 namespace {
 
@@ -176,12 +178,12 @@ bool SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<int, int
   return false;
 }
 
-// |dx/dy| of a line's skeleton over three rows each side of row y (0 when unknown).
-double LocalSlope(const RowValues& skeleton, int y) {
-  int a = y - 3, last = y + 3;
-  while (a <= y + 3 && !skeleton.Has(a)) ++a;
+// |dx/dy| of a line's skeleton over `reach` rows each side of row y (0 when unknown).
+double LocalSlope(const RowValues& skeleton, int y, int reach) {
+  int a = y - reach, last = y + reach;
+  while (a <= y + reach && !skeleton.Has(a)) ++a;
   while (last >= a && !skeleton.Has(last)) --last;
-  if (a > y + 3 || last <= a) return 0.0;
+  if (a > y + reach || last <= a) return 0.0;
   return std::abs((skeleton.At(last) - skeleton.At(a)) / (last - a));
 }
 
@@ -189,9 +191,13 @@ double LocalSlope(const RowValues& skeleton, int y) {
 // Rows beside a segment are skipped (the segment's light biases them), and a
 // centre far from the fit of its neighbours is dropped as an outlier; skipped
 // rows are refilled from the fit of their neighbours where the line is not
-// steep and measured rows lie on both sides.
+// steep and measured rows lie on both sides. `params` holds the lengths of
+// the full frame (ScaledForBinning); `n` is the binning the skeleton was
+// found at: the skeleton's own pixel sizes (a row's run, the slope's reach)
+// are n times larger.
 LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
-                        const interpretation::LabelledLine& line, const DecodeParams& params) {
+                        const interpretation::LabelledLine& line, const DecodeParams& params,
+                        int n) {
   // The line's pixels as sorted (x, y) for look-ups, and each row's span.
   std::vector<std::pair<int, int>> own;
   own.reserve(line.pixels.size());
@@ -219,11 +225,12 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
   out.skipped.assign(static_cast<size_t>(count), 0);
   auto skip = [&](int y) { out.skipped[static_cast<size_t>(y - first)] = 1; };
   for (const auto& [y, range] : span)
-    if (range.second - range.first <= 2) out.skeleton.Set(y, 0.5 * (range.first + range.second));
+    if (range.second - range.first <= 2 * n)
+      out.skeleton.Set(y, 0.5 * (range.first + range.second));
   for (const auto& [y, range] : span) {
     const auto [lo, hi] = range;
     // A steep line's row profile is wide, so a segment biases more rows of it.
-    const double slope = LocalSlope(out.skeleton, y);
+    const double slope = LocalSlope(out.skeleton, y, 3 * n);
     out.slope.Set(y, slope);
     const int clearance =
         params.junction_clearance +
@@ -231,7 +238,7 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
                                      std::max(0.0, slope - params.max_fill_slope)));
     const int x = (lo + hi) / 2;
     // A row where the skeleton runs sideways is a segment, not the line.
-    if (hi - lo > 2 || SegmentNearby(skeleton, own, x, y, clearance)) {
+    if (hi - lo > 2 * n || SegmentNearby(skeleton, own, x, y, clearance)) {
       skip(y);
       continue;
     }
@@ -287,20 +294,21 @@ struct JunctionPlan {
 // The first step of RefineJunction: the line's fit and the segment columns
 // to measure (the segment's ends skipped, where the lines' light biases it).
 JunctionPlan PlanJunction(const LineCentres& line, const interpretation::LabelledJunction& j,
-                          const DecodeParams& params) {
+                          const DecodeParams& params, int n_binning) {
   const double y0 = j.position.y;
   JunctionPlan plan;
   // The line as x(y): sub-pixel centres, or where a steep or crowded line has
   // too few of them, its skeleton (within a pixel of the centre).
   plan.vertical = RowsNear(line.measured, y0, params.junction_fit_rows, 0.0);
   if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) {
-    plan.vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows, 1.0);
+    plan.vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows, 1.0 * n_binning);
     if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) return plan;
   }
   plan.ok = true;
   if (j.interpolated || j.segment.empty()) return plan;
   const int n = static_cast<int>(j.segment.size());
-  for (int i = 0; i < n - 2 && static_cast<int>(plan.columns.size()) < params.segment_fit_columns;
+  for (int i = 0;
+       i < n - 2 * n_binning && static_cast<int>(plan.columns.size()) < params.segment_fit_columns;
        ++i) {
     const cv::Point& s = j.segment[i];
     if (std::abs(s.x - plan.a) <= params.junction_clearance) continue;
@@ -329,8 +337,10 @@ struct ColumnCentres {
 // too few centres near it.
 std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const ColumnCentres& columns,
                                           const interpretation::LabelledJunction& j,
-                                          const DecodeParams& params) {
+                                          const DecodeParams& params, int n) {
   if (!plan.ok) return std::nullopt;
+  // How far from the skeleton's junction row the meeting point may lie.
+  const double reach = params.junction_clearance + 1.0 * n;
   const double y0 = j.position.y;
   const double a = plan.a, b = plan.b;
   const std::vector<std::pair<double, double>>& vertical = plan.vertical;
@@ -353,7 +363,7 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
         const double den = 1.0 - e * b2;
         if (std::abs(den) < 1e-6) return false;
         *out = (c + e * (a2 - a) - e * b2 * y0) / den;
-        return std::abs(*out - y0) <= params.junction_clearance + 1.0;
+        return std::abs(*out - y0) <= reach;
       };
       std::vector<std::pair<double, double>> upper, lower;
       for (const auto& v : vertical) (v.first < 0 ? upper : lower).push_back(v);
@@ -377,7 +387,7 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
         const double disc = qb * qb - 4 * qa * qc;
         if (disc >= 0) {
           const double t = 2 * qc / (-qb + std::copysign(std::sqrt(disc), -qb));
-          if (std::abs(t) <= params.junction_clearance + 1.0)
+          if (std::abs(t) <= reach)
             return cv::Point2d(k[0] + k[1] * t + k[2] * t * t, y0 + t);
         }
       }
@@ -387,11 +397,38 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
   return cv::Point2d(a + b * (y - y0), y);
 }
 
+// The sub-pixel stage's lengths for a frame binned n x n for extraction and
+// interpretation: every pixel length of the centres and the junction fits
+// multiplied by n, so that they span the same part of the pattern as at the
+// working resolution (the averaging along a stripe capped at its largest
+// radius, 4).
+DecodeParams ScaledForBinning(const DecodeParams& params, int n) {
+  DecodeParams out = params;
+  if (n <= 1) return out;
+  out.junction_fit_rows *= n;
+  out.segment_fit_columns *= n;
+  out.junction_clearance *= n;
+  out.max_centre_residual *= n;
+  out.centre.search_radius *= n;
+  out.centre.max_width *= n;
+  out.centre.min_sigma *= n;
+  out.centre.along_radius = std::min(4, out.centre.along_radius * n);
+  return out;
+}
+
+// The binning n for a frame of measured stripe pitch `pitch` (px; 0: none).
+int BinningFor(double pitch, const DecodeParams& params) {
+  if (params.binning > 0) return params.binning;
+  if (pitch <= 0.0) return 1;
+  return std::clamp(static_cast<int>(std::lround(pitch / params.tuned_pitch)), 1,
+                    params.max_binning);
+}
+
 }  // namespace
 
 bool DecodeParams::IsValid(std::string* error) const {
   if (!spec.IsValid(error) || !extraction.IsValid(error) || !interpretation.IsValid(error) ||
-      !centre.IsValid(error))
+      !centre.IsValid(error) || !pitch.IsValid(error))
     return false;
   auto fail = [error](const char* why) {
     if (error) *error = why;
@@ -407,6 +444,9 @@ bool DecodeParams::IsValid(std::string* error) const {
   if (min_dynamic_range < 0 || max_saturated_fraction <= 0 || max_saturated_fraction > 1)
     return fail("frame checks out of range");
   if (q_offset && (*q_offset % 2) != 0) return fail("q_offset must be even");
+  if (!(tuned_pitch > 0)) return fail("tuned_pitch must be positive");
+  if (max_binning < 1 || max_binning > 16) return fail("max_binning must lie in 1..16");
+  if (binning < 0 || binning > 16) return fail("binning must lie in 0..16");
   return true;
 }
 
@@ -428,14 +468,22 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     return result;
   }
 
+  // The working resolution: the frame binned so that its stripe pitch is
+  // near the one the pixel-sized parameters are tuned for.
   auto t = Clock::now();
+  if (params.binning == 0)
+    result.pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
+  const int n = BinningFor(result.pitch, params);
+  result.binning = n;
+  const cv::Mat working = internal::BinFrame(grey, n);
   const extraction::ExtractionResult features =
-      extraction::ExtractFeatures(grey, params.extraction);
+      extraction::ExtractFeatures(working, params.extraction);
   result.times.extraction_ms = MsSince(t);
 
   t = Clock::now();
-  const interpretation::InterpretationResult interp = interpretation::Interpret(
+  interpretation::InterpretationResult interp = interpretation::Interpret(
       features.skeleton, side, params.spec, params.interpretation, features.mask);
+  internal::MapToFullFrame(n, grey.size(), &interp);
   result.times.interpretation_ms = MsSince(t);
   result.skeleton = interp.skeleton;
   result.repairs = static_cast<int>(interp.repairs.size());
@@ -448,6 +496,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   }
 
   t = Clock::now();
+  const DecodeParams subpixel = ScaledForBinning(params, n);
   const int q_offset = params.q_offset.value_or(0);
   // Lines, then junctions, are measured independently of each other: in
   // parallel (cv::parallel_for_, OpenCV's thread pool).
@@ -455,7 +504,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   std::vector<LineCentres> measured(lines.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
-      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], params);
+      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], subpixel, n);
   });
   std::map<int, LineCentres> centres;
   for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);
@@ -468,7 +517,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   std::vector<JunctionPlan> plans(junctions.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
-      plans[i] = PlanJunction(centres.at(junctions[i].p), junctions[i], params);
+      plans[i] = PlanJunction(centres.at(junctions[i].p), junctions[i], subpixel, n);
   });
   ColumnCentres columns;
   for (const JunctionPlan& plan : plans)
@@ -479,7 +528,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
       const auto [x, y] = columns.keys[i];
-      columns.centres[i] = extraction::StripeCentreInColumn(grey, x, y, params.centre);
+      columns.centres[i] = extraction::StripeCentreInColumn(grey, x, y, subpixel.centre);
     }
   });
   result.junctions.resize(junctions.size());
@@ -492,7 +541,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       d.kind = j.kind;
       d.interpolated = j.interpolated;
       d.position = j.position;
-      if (auto refined = RefineJunction(plans[i], columns, j, params)) d.position = *refined;
+      if (auto refined = RefineJunction(plans[i], columns, j, subpixel, n)) d.position = *refined;
     }
   });
 

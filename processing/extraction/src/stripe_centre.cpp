@@ -326,7 +326,7 @@ bool StripeCentreParams::IsValid(std::string* error) const {
     return false;
   };
   if (search_radius < 1 || search_radius > 64) return fail("search_radius must lie in 1..64 px");
-  if (!(max_width > 0.0 && max_width <= 64.0)) return fail("max_width must lie in (0, 64] px");
+  if (!(max_width > 0.0 && max_width <= 256.0)) return fail("max_width must lie in (0, 256] px");
   if (!(min_contrast > 0.0)) return fail("min_contrast must be > 0 grey levels");
   if (along_radius < 0 || along_radius > 4) return fail("along_radius must lie in 0..4");
   if (!(min_sigma > 0.0 && min_sigma <= 16.0)) return fail("min_sigma must lie in (0, 16] px");

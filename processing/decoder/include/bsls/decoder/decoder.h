@@ -6,6 +6,15 @@
 // sub-pixel centres on the grey frame along every labelled line and junction
 // positions where a line's and its segment's centres meet.
 //
+// Frame size: the pixel-sized parameters of extraction, interpretation and
+// centres are tuned for stripes 10-21 px apart (the thesis's 512 x 512
+// frames). The stripe pitch of each frame is measured first
+// (extraction::MeasureStripePitch); a frame whose pitch is n >= 2 times
+// tuned_pitch (rounded) is binned n x n for extraction and interpretation,
+// whose results are mapped back onto the full frame, and the sub-pixel stage
+// runs on the full frame with its pixel lengths multiplied by n
+// (docs/decoding.md, "Frame size").
+//
 // Coordinates: image pixels, x = column, y = row, origin at the centre of the
 // top-left pixel. Labels: p absolute (0 = reference line); q relative unless
 // DecodeParams::q_offset is set (contracts section 2).
@@ -23,6 +32,7 @@
 
 #include "bsls/extraction/feature_extraction.h"
 #include "bsls/extraction/stripe_centre.h"
+#include "bsls/extraction/stripe_pitch.h"
 #include "bsls/interpretation/interpreter.h"
 #include "bsls/pattern/brick_pattern.h"
 
@@ -32,6 +42,8 @@ struct DecodeParams {
   pattern::PatternSpec spec;
   extraction::ExtractionParams extraction;
   interpretation::InterpretationParams interpretation;
+  // Pixel lengths below and in `centre` are for the working resolution (see
+  // tuned_pitch): on a binned frame they are multiplied by the binning.
   extraction::StripeCentreParams centre;
   int junction_fit_rows = 7;   // rows each side of a junction fitted to place it
   int segment_fit_columns = 50;  // columns of a segment measured to place its junction
@@ -44,6 +56,16 @@ struct DecodeParams {
   // A line whose slope (dx/dy) above and below a junction differs by more
   // folds there; otherwise it is fitted as one smooth curve through it.
   double fold_slope_change = 0.5;
+  // Working resolution. The pixel-sized parameters (extraction,
+  // interpretation, centre and the lengths above) hold for a stripe pitch
+  // near tuned_pitch px: measured 10.4-20.8 px on the thesis scenes at
+  // 512 x 512, where they were tuned. A frame whose measured pitch is wider
+  // is binned n x n, n = round(pitch / tuned_pitch) (>= 1, <= max_binning),
+  // for extraction and interpretation.
+  extraction::StripePitchParams pitch;
+  double tuned_pitch = 21.0;  // px, > 0
+  int max_binning = 8;        // 1..16; 1 = never bin
+  int binning = 0;            // 0 = from the measured pitch; 1..16 forces n (tests, benchmarks)
   // A frame whose 1st-99th percentile range is narrower (grey levels) is blank.
   double min_dynamic_range = 16.0;
   // A frame with a larger fraction of pixels at 254-255 is saturated.
@@ -87,10 +109,12 @@ struct DecodeResult {
   std::vector<DecodedLine> lines;          // ordered by p
   StageTimes times;
   // Diagnostics.
+  double pitch = 0.0;  // measured stripe pitch, px of the frame (0: none found)
+  int binning = 1;     // n: extraction and interpretation ran on the frame binned n x n
   int repairs = 0;
   int label_conflicts = 0;
   std::map<interpretation::LoopClass, int> loop_classes;
-  cv::Mat skeleton;  // the repaired skeleton, CV_8UC1 0/255
+  cv::Mat skeleton;  // the repaired skeleton, CV_8UC1 0/255, frame size (redrawn when binned)
 };
 
 // Decodes a CV_8UC1 frame of the brick slide of `side`. A blank or saturated

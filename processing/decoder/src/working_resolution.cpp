@@ -1,0 +1,92 @@
+#include "working_resolution.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+namespace bsls::decoder::internal {
+namespace {
+
+// The full-frame pixel at the centre of binned pixel p (n odd: exact; n even:
+// the one just above and left of the centre).
+cv::Point Centre(const cv::Point& p, int n) {
+  return {n * p.x + (n - 1) / 2, n * p.y + (n - 1) / 2};
+}
+
+// Appends the pixels of the straight 8-connected run from a to b, a left out.
+void AppendRun(const cv::Point& a, const cv::Point& b, std::vector<cv::Point>* out) {
+  cv::LineIterator it(a, b, 8);
+  ++it;  // a itself
+  for (int i = 1; i < it.count; ++i, ++it) out->push_back(it.pos());
+}
+
+// The pixels of a binned pixel set redrawn on the full frame: each pixel's
+// centre, joined by a straight run to each of its 8-neighbours in the set.
+// `set` is a binned-size CV_8UC1 image, non-zero on the set.
+std::vector<cv::Point> RedrawSet(const std::vector<cv::Point>& pixels, const cv::Mat& set, int n) {
+  std::vector<cv::Point> out;
+  out.reserve(pixels.size() * static_cast<size_t>(n) * 2);
+  const cv::Rect inside(0, 0, set.cols, set.rows);
+  for (const cv::Point& p : pixels) {
+    const cv::Point c = Centre(p, n);
+    out.push_back(c);
+    // Each neighbour pair once: the neighbours after p in row-major order.
+    for (const cv::Point d :
+         {cv::Point(1, 0), cv::Point(-1, 1), cv::Point(0, 1), cv::Point(1, 1)}) {
+      const cv::Point q = p + d;
+      if (inside.contains(q) && set.at<uchar>(q)) AppendRun(c, Centre(q, n), &out);
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const cv::Point& a, const cv::Point& b) {
+    return a.y != b.y ? a.y < b.y : a.x < b.x;
+  });
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+}  // namespace
+
+cv::Mat BinFrame(const cv::Mat& grey, int n) {
+  if (n <= 1) return grey;
+  const cv::Size binned(grey.cols / n, grey.rows / n);
+  cv::Mat out;
+  // INTER_AREA at an integer factor is exactly the block mean, rounded.
+  cv::resize(grey(cv::Rect(0, 0, binned.width * n, binned.height * n)), out, binned, 0, 0,
+             cv::INTER_AREA);
+  return out;
+}
+
+cv::Point2d ToFullFrame(const cv::Point2d& p, int n) {
+  return {n * p.x + 0.5 * (n - 1), n * p.y + 0.5 * (n - 1)};
+}
+
+void MapToFullFrame(int n, cv::Size full, interpretation::InterpretationResult* r) {
+  if (n <= 1) return;
+  const cv::Mat& binned = r->skeleton;
+  // The skeleton.
+  std::vector<cv::Point> pixels;
+  cv::findNonZero(binned, pixels);
+  cv::Mat skeleton = cv::Mat::zeros(full, CV_8UC1);
+  for (const cv::Point& p : RedrawSet(pixels, binned, n)) skeleton.at<uchar>(p) = 255;
+  // Labelled lines: their own pixels only, so that a line does not take in
+  // the segments that leave it.
+  cv::Mat own = cv::Mat::zeros(binned.size(), CV_8UC1);
+  for (interpretation::LabelledLine& line : r->labelling.lines) {
+    for (const cv::Point& p : line.pixels) own.at<uchar>(p) = 1;
+    std::vector<cv::Point> redrawn = RedrawSet(line.pixels, own, n);
+    for (const cv::Point& p : line.pixels) own.at<uchar>(p) = 0;
+    line.pixels = std::move(redrawn);
+  }
+  // Junctions: positions, and segments in their order (from the junction on).
+  for (interpretation::LabelledJunction& j : r->labelling.junctions) {
+    j.position = ToFullFrame(j.position, n);
+    if (j.segment.empty()) continue;
+    std::vector<cv::Point> segment{Centre(j.segment.front(), n)};
+    for (size_t i = 1; i < j.segment.size(); ++i)
+      AppendRun(Centre(j.segment[i - 1], n), Centre(j.segment[i], n), &segment);
+    j.segment = std::move(segment);
+  }
+  r->skeleton = skeleton;
+}
+
+}  // namespace bsls::decoder::internal

@@ -1,0 +1,40 @@
+// Private to bsls::decoder: the working resolution of the topology stages
+// (docs/decoding.md, "Frame size"). Feature extraction and interpretation
+// have pixel-sized parameters tuned for stripes about 10-21 px apart (the
+// thesis's 512 x 512 frames); a frame with a wider pitch is binned n x n for
+// them, as a sensor bins its pixels, and what they found is mapped back onto
+// the full frame, where the sub-pixel centres are measured.
+//
+// Coordinates: pixel (x, y) of the binned frame covers the full frame's
+// pixels n x .. n x + n - 1 (and likewise in y), so its centre is at
+// n x + (n - 1) / 2 in full-frame pixel coordinates (origin at the centre of
+// the top-left pixel, contracts section 5).
+#ifndef BSLS_DECODER_SRC_WORKING_RESOLUTION_H_
+#define BSLS_DECODER_SRC_WORKING_RESOLUTION_H_
+
+#include <opencv2/core.hpp>
+
+#include "bsls/interpretation/interpreter.h"
+
+namespace bsls::decoder::internal {
+
+// The frame (CV_8UC1) binned n x n: every block of n x n pixels averaged
+// and rounded into one; the last cols % n columns and rows % n rows, which
+// fill no whole block, are left out. n == 1 returns the frame itself.
+cv::Mat BinFrame(const cv::Mat& grey, int n);
+
+// A binned frame's point in full-frame pixel coordinates.
+cv::Point2d ToFullFrame(const cv::Point2d& p, int n);
+
+// Maps an interpretation of the n x n binned frame onto the full frame of
+// `full` size: the skeleton and every labelled line are redrawn through the
+// full-frame centres of their pixels (8-neighbours joined by straight runs,
+// so they stay connected), each junction's segment likewise in its order,
+// junction positions moved; the labels are kept. The reference line,
+// repairs, corners and boundary records stay in binned coordinates (nothing
+// after the interpretation reads them).
+void MapToFullFrame(int n, cv::Size full, interpretation::InterpretationResult* r);
+
+}  // namespace bsls::decoder::internal
+
+#endif  // BSLS_DECODER_SRC_WORKING_RESOLUTION_H_
