@@ -14,6 +14,15 @@ packages=(
   # files, command line, logging
   nlohmann-json3-dev libcli11-dev libspdlog-dev libyaml-cpp-dev
   libssl-dev                        # SHA-256 of manifests and frames
+  # capture daemon: store, hardware, services, privileges
+  libsqlite3-dev                    # durable capture index
+  libusb-1.0-0-dev                  # USB framestore
+  libgpiod-dev                      # slide controller (v1.6 API)
+  libcap-dev                        # dropping capabilities
+  libsystemd-dev                    # sd_notify, watchdog
+  libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
+  python3-grpcio python3-protobuf python3-grpc-tools
+  systemd                           # systemd-analyze security in the tests
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   python3

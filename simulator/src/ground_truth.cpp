@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <opencv2/core/utility.hpp>
 #include <stdexcept>
 
@@ -22,7 +23,10 @@ nlohmann::json JunctionJson(const TruthJunction& j, bool with_in_image) {
                         {"albedo", j.albedo},
                         {"cos_incidence", j.cos_incidence},
                         {"cos_view", j.cos_view}};
-  if (with_in_image) out["in_image"] = j.in_image;
+  if (with_in_image) {
+    out["in_image"] = j.in_image;
+    out["cut_by_edge"] = j.cut_by_edge;
+  }
   return out;
 }
 
@@ -68,6 +72,39 @@ double BoundaryDistance(const cv::Mat& boundary, const Eigen::Vector2d& image, d
   return best;
 }
 
+// The image point of slide point `st` on the tangent plane (point, normal)
+// of the surface: near a junction, the strokes' edges land there.
+std::optional<Eigen::Vector2d> OnTangentPlane(const Scene& scene, const Eigen::Vector2d& st,
+                                              const Eigen::Vector3d& point,
+                                              const Eigen::Vector3d& normal) {
+  const geometry::Ray ray = scene.projector.BackProject(st);
+  const double den = normal.dot(ray.direction);
+  if (std::abs(den) < 1e-12) return std::nullopt;
+  return scene.camera.Project(ray.At(normal.dot(point - ray.origin) / den));
+}
+
+// True when an image edge runs through a stroke of the junction lengthwise:
+// its segment's stroke (rows v -+ w/2) reaches beyond the top or bottom edge,
+// or its line's stroke (u = p -+ w/2) beyond the left or right edge. The
+// camera then sees only part of that stroke's width: no centre to measure
+// and no T to tell from a line's end (docs/decoding.md, "Ground truth at
+// the image edge").
+bool CutByImageEdge(const Scene& scene, const pattern::SlideJunction& sj,
+                    const Eigen::Vector3d& world, const Eigen::Vector3d& normal) {
+  const double half = scene.pattern.stroke_width / 2.0;
+  const double s = pattern::SFromU(scene.side, sj.p);
+  const double lo_x = -0.5, hi_x = scene.width - 0.5, lo_y = -0.5, hi_y = scene.height - 0.5;
+  for (double k : {-1.0, 1.0}) {
+    const auto across_segment =
+        OnTangentPlane(scene, Eigen::Vector2d(s, sj.v + k * half), world, normal);
+    if (!across_segment || across_segment->y() < lo_y || across_segment->y() > hi_y) return true;
+    const auto across_line =
+        OnTangentPlane(scene, Eigen::Vector2d(s + k * half, sj.v), world, normal);
+    if (!across_line || across_line->x() < lo_x || across_line->x() > hi_x) return true;
+  }
+  return false;
+}
+
 std::vector<TruthJunction> TraceJunctions(const Scene& scene, const cv::Mat& boundary,
                                           const TruthParams& params) {
   std::vector<TruthJunction> out;
@@ -100,7 +137,8 @@ std::vector<TruthJunction> TraceJunctions(const Scene& scene, const cv::Mat& bou
       j.in_image = j.image.x() >= -0.5 && j.image.x() <= scene.width - 0.5 && j.image.y() >= -0.5 &&
                    j.image.y() <= scene.height - 0.5;
     }
-    if (j.in_image && facet.dot(to_camera) > 0.0) {
+    if (j.in_image) j.cut_by_edge = CutByImageEdge(scene, sj, j.world, facet);
+    if (j.in_image && !j.cut_by_edge && facet.dot(to_camera) > 0.0) {
       const geometry::Ray back = scene.camera.BackProject(j.image);
       const auto seen = scene.Intersect(back, std::numeric_limits<double>::infinity());
       j.visible = seen && (seen->point - j.world).norm() <= params.visibility_tolerance_mm;

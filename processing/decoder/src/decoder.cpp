@@ -248,11 +248,27 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
       skip(y);
   }
   // Outliers: more than max_centre_residual from the line through the
-  // neighbours within junction_fit_rows.
+  // neighbours within junction_fit_rows on the same stretch of the line: not
+  // across two or more rows skipped beside a segment, where a line may fold
+  // (nose, lips) and the far side's centres are no guide.
+  auto skipped_at = [&](int y) { return out.skipped[static_cast<size_t>(y - first)] != 0; };
+  auto stretch_end = [&](int y, int step) {  // last row of y's stretch towards step
+    int end = y;
+    for (int k = y + step;
+         k >= first && k < first + count && std::abs(k - y) <= params.junction_fit_rows;
+         k += step) {
+      if (skipped_at(k) && k + step >= first && k + step < first + count && skipped_at(k + step))
+        break;
+      end = k;
+    }
+    return end;
+  };
   std::vector<int> outliers;
   for (int y = first; y < first + count; ++y) {
     if (!out.measured.Has(y)) continue;
-    const auto s = RowsNear(out.measured, y, params.junction_fit_rows, 0.0);
+    auto s = RowsNear(out.measured, y, params.junction_fit_rows, 0.0);
+    const double lo = stretch_end(y, -1) - y, hi = stretch_end(y, +1) - y;
+    std::erase_if(s, [&](const auto& r) { return r.first < lo || r.first > hi; });
     if (s.size() < 4) continue;
     const auto fit = FitAtZero(s);
     if (fit && std::abs(out.measured.At(y) - *fit) > params.max_centre_residual)
@@ -301,7 +317,13 @@ JunctionPlan PlanJunction(const LineCentres& line, const interpretation::Labelle
   // too few of them, its skeleton (within a pixel of the centre).
   plan.vertical = RowsNear(line.measured, y0, params.junction_fit_rows, 0.0);
   if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) {
-    plan.vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows, 1.0 * n_binning);
+    // The skeleton bends into the segment within junction_clearance of the
+    // junction (most where a steep line meets it at a sharp angle): those
+    // rows are left out while enough others remain.
+    plan.vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows,
+                             static_cast<double>(params.junction_clearance));
+    if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b))
+      plan.vertical = RowsNear(line.skeleton, y0, params.junction_fit_rows, 1.0 * n_binning);
     if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) return plan;
   }
   plan.ok = true;

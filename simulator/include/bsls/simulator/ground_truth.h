@@ -48,7 +48,13 @@ struct TruthJunction {
   Eigen::Vector2d image = Eigen::Vector2d::Zero();  // distorted image point, px
   Eigen::Vector3d world = Eigen::Vector3d::Zero();  // first surface point on the projector ray, mm
   bool in_image = false;  // image point inside [-0.5, width-0.5] x [-0.5, height-0.5]
-  bool visible = false;   // in_image, and the camera sees exactly this lit side of world
+  // in_image, but an image edge runs through its segment's or its line's
+  // stroke lengthwise (the stroke's half width w/2 reaches beyond the edge):
+  // the camera sees part of a stroke only, so the junction is not counted as
+  // visible (docs/decoding.md, "Ground truth at the image edge").
+  bool cut_by_edge = false;
+  // in_image, not cut_by_edge, and the camera sees exactly this lit side of world.
+  bool visible = false;
   // Distance (px) from the image point to the nearest boundary pixel: a seen
   // and lit pixel next to an unlit/unseen one or across a depth or u jump
   // (projector shadow, camera occlusion, silhouette); the image edge is not a
@@ -114,7 +120,7 @@ GroundTruth ComputeGroundTruth(const Scene& scene, const TruthParams& params = {
 //                         "rotation": [9, row-major, world->device], "translation": [3]},
 //  "junctions": [{"x", "y", "p", "v", "kind", "world": [x, y, z],
 //                 "boundary_distance_px", "albedo", "cos_incidence", "cos_view"}],
-//  "hidden_junctions": [same, plus "in_image"],
+//  "hidden_junctions": [same, plus "in_image", "cut_by_edge"],
 //  "lines": [{"p", "points": [[x, y], ...]}]}
 // "junctions" holds the visible ones only. Pixel maps are not included.
 nlohmann::json ToJson(const GroundTruth& truth);
