@@ -18,6 +18,12 @@ std::string_view ToString(ErrorCode code) {
       return "deadline exceeded";
     case ErrorCode::kDataLoss:
       return "data loss";
+    case ErrorCode::kNotFound:
+      return "not found";
+    case ErrorCode::kAlreadyExists:
+      return "already exists";
+    case ErrorCode::kResourceExhausted:
+      return "resource exhausted";
     case ErrorCode::kInternal:
       return "internal";
   }

@@ -23,6 +23,9 @@ enum class ErrorCode {
   kUnavailable,         // the device is absent, lost, or not answering as the card would
   kDeadlineExceeded,    // a wait on the device ran out of time
   kDataLoss,            // data was lost on the way (missed OE pulses, short frame)
+  kNotFound,            // the named thing does not exist (unknown capture id)
+  kAlreadyExists,       // the thing to be created exists already
+  kResourceExhausted,   // out of a resource: disk space below the reserve, quota
   kInternal,            // a bug of ours
 };
 
