@@ -1,7 +1,7 @@
 // bsls measure: clinical figures on a reconstructed surface (thesis 7.2):
 // heights above the base plane, straight and along-the-surface distances,
 // areas of regions, and lumps or cavities against a reference surface fitted
-// around them. Every figure comes with its 1-sigma uncertainty; a plain table
+// around them or against an earlier scan of the same face (--baseline). Every figure comes with its 1-sigma uncertainty; a plain table
 // goes to stdout and, on request, a JSON report to a file.
 //
 // Points and regions are world (x, y) in millimetres (contracts section 3): a
@@ -33,6 +33,8 @@ struct MeasureOptions {
   std::vector<std::string> lesions;    // polygons
   std::string reference = "cubic";
   double ring_mm = 10.0;
+  std::string baseline;  // earlier scan the lesions are measured against
+  bool register_baseline = true;
   std::string json;
   int decimals = 2;
 };
@@ -113,9 +115,16 @@ void RunMeasure(const MeasureOptions& o) {
       throw CommandError(kExitUsage, "--lesion \"" + l + "\": a region needs at least 3 points");
   }
 
+  if (!o.baseline.empty() && lesions.empty())
+    throw CommandError(kExitUsage, "--baseline is the reference of --lesion: give a --lesion");
+  measurement::BaselineParams baseline_params;
+  baseline_params.register_rigidly = o.register_baseline;
   const geometry::SurfaceMesh mesh = io::ReadPly(o.surface);
+  const geometry::SurfaceMesh baseline =
+      o.baseline.empty() ? geometry::SurfaceMesh{} : io::ReadPly(o.baseline);
   std::vector<measurement::ReportRow> rows;
   nlohmann::json report = {{"surface", o.surface},
+                           {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)},
                            {"heights", nlohmann::json::array()},
                            {"distances", nlohmann::json::array()},
                            {"areas", nlohmann::json::array()},
@@ -144,8 +153,17 @@ void RunMeasure(const MeasureOptions& o) {
       report["areas"].push_back({{"region", o.areas[i]}, {"area_mm2", measurement::ToJson(a)}});
     }
     for (size_t i = 0; i < lesions.size(); ++i) {
-      const measurement::LesionMeasurement m =
-          measurement::MeasureLesion(surface, lesions[i], lesion_params);
+      measurement::LesionMeasurement m;
+      if (o.baseline.empty()) {
+        m = measurement::MeasureLesion(surface, lesions[i], lesion_params);
+      } else {
+        try {
+          m = measurement::MeasureLesionAgainstBaseline(surface, baseline, lesions[i],
+                                                        lesion_params, baseline_params);
+        } catch (const measurement::MeasurementError& e) {
+          throw measurement::MeasurementError("against " + o.baseline + ": " + e.what());
+        }
+      }
       for (measurement::ReportRow row : measurement::Rows(m)) {
         row.name = "lesion " + std::to_string(i + 1) + ": " + row.name;
         rows.push_back(row);
@@ -183,6 +201,11 @@ void AddMeasureCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--ring", options->ring_mm, "Width of the ring around a --lesion region, mm")
       ->capture_default_str();
+  cmd->add_option("--baseline", options->baseline,
+                  "Measure --lesion against this earlier scan of the same face (PLY) instead of "
+                  "a fitted ring: registered onto the surface outside the region");
+  cmd->add_flag("!--no-register", options->register_baseline,
+                "With --baseline: the scans share one frame, do not register them");
   cmd->add_option("--json", options->json, "Also write the report as JSON to this file");
   cmd->add_option("--decimals", options->decimals, "Decimals in the table")
       ->check(CLI::Range(0, 6))

@@ -1,8 +1,11 @@
 // bsls simulate: render frames of the projected pattern on a simulated
 // surface, with their exact ground truth.
 #include <cstdio>
+#include <cmath>
 #include <iostream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "bsls/io/frame_file.h"
 #include "bsls/simulator/renderer.h"
@@ -23,7 +26,39 @@ struct SimulateOptions {
   int size = 512;
   int supersampling = 3;
   bool eyebrows = true;
+  std::vector<std::string> lesions;  // "X,Y,H,R[,R0]"
 };
+
+// Parses a --lesion "X,Y,H,R[,R0]" (mm): centre, signed height (< 0: a
+// cavity), outer radius and flat-top radius (default R / 3).
+simulator::LesionParams ParseLesion(const std::string& text) {
+  std::vector<double> numbers;
+  std::string field;
+  std::istringstream in(text);
+  bool ok = true;
+  while (std::getline(in, field, ',')) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(field, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    ok = ok && used == field.size() && used > 0 && std::isfinite(value);
+    numbers.push_back(value);
+  }
+  if (!ok || numbers.size() < 4 || numbers.size() > 5)
+    throw CommandError(kExitUsage, "--lesion \"" + text +
+                                       "\": give X,Y,H,R[,R0] in millimetres (H < 0: a cavity)");
+  simulator::LesionParams lesion;
+  lesion.centre_xy_mm = {numbers[0], numbers[1]};
+  lesion.height_mm = numbers[2];
+  lesion.radius_mm = numbers[3];
+  lesion.top_radius_mm = numbers.size() == 5 ? numbers[4] : numbers[3] / 3.0;
+  std::string why;
+  if (!lesion.IsValid(&why)) throw CommandError(kExitUsage, "--lesion \"" + text + "\": " + why);
+  return lesion;
+}
 
 void RunSimulate(const SimulateOptions& o) {
   const auto side = pattern::ParseSide(o.side);
@@ -33,6 +68,9 @@ void RunSimulate(const SimulateOptions& o) {
   simulator::ThesisSceneOptions options;
   options.reference_cross = o.cross;
   options.face_eyebrows = o.eyebrows;
+  for (const std::string& lesion : o.lesions) options.face_lesions.push_back(ParseLesion(lesion));
+  if (!options.face_lesions.empty() && *kind != simulator::SurfaceKind::kFace)
+    throw CommandError(kExitUsage, "--lesion needs --surface face");
   options.rig.width = o.size;
   options.rig.height = o.size;
   simulator::Scene scene;
@@ -40,6 +78,8 @@ void RunSimulate(const SimulateOptions& o) {
     scene = simulator::ThesisScene(*side, *kind, options);
   } catch (const simulator::MeshLoadError& e) {
     throw io::InputError(e.what());
+  } catch (const std::invalid_argument& e) {  // overlapping lesions
+    throw CommandError(kExitUsage, e.what());
   }
   simulator::RenderParams params;
   params.noise_sigma = o.noise;
@@ -77,6 +117,9 @@ void AddSimulateCommand(CLI::App& app) {
   cmd->add_option("--supersampling", opts->supersampling, "Rays per pixel and axis (default 3)")
       ->check(CLI::Range(1, 8));
   cmd->add_flag("!--no-eyebrows", opts->eyebrows, "Face: leave out the dark eyebrow patches");
+  cmd->add_option("--lesion", opts->lesions,
+                  "Face: a lump (H > 0) or cavity (H < 0) \"X,Y,H,R[,R0]\" in world mm "
+                  "(thesis 7.2); repeat for more");
   cmd->callback([opts] { RunSimulate(*opts); });
 }
 

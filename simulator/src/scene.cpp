@@ -256,6 +256,9 @@ bool ThesisSceneOptions::IsValid(std::string* error) const {
   if (!ball.IsValid(&why)) return Fail(error, why);
   if (!bunny.IsValid(&why)) return Fail(error, why);
   if (!albedo.IsValid(&why)) return Fail(error, why);
+  for (std::size_t i = 0; i < face_lesions.size(); ++i)
+    if (!face_lesions[i].IsValid(&why))
+      return Fail(error, "face lesion " + std::to_string(i) + ": " + why);
   return true;
 }
 
@@ -294,7 +297,11 @@ Scene ThesisScene(pattern::Side side, SurfaceKind kind, const ThesisSceneOptions
       break;
     }
     case SurfaceKind::kFace: {
-      scene.surfaces = {std::make_shared<MeshSurface>(LoadFaceMesh(options.face), "face")};
+      std::shared_ptr<const Surface> face =
+          std::make_shared<MeshSurface>(LoadFaceMesh(options.face), "face");
+      if (!options.face_lesions.empty())
+        face = std::make_shared<LesionSurface>(std::move(face), options.face_lesions);
+      scene.surfaces = {std::move(face)};
       if (options.face_on_base_plane) scene.surfaces.push_back(base_plane);
       if (options.face_eyebrows)
         for (const AlbedoPatch& patch : FaceEyebrowPatches()) albedo.patches.push_back(patch);

@@ -30,15 +30,6 @@ std::shared_ptr<const simulator::Surface> Face() {
   return std::make_shared<simulator::MeshSurface>(simulator::LoadFaceMesh(face), "face");
 }
 
-// A circle of `radius` around `centre`, as a polygon of 64 vertices.
-Polygon2d Circle(const Eigen::Vector2d& centre, double radius) {
-  Polygon2d polygon;
-  for (int i = 0; i < 64; ++i) {
-    const double angle = 2.0 * std::numbers::pi * i / 64.0;
-    polygon.push_back(centre + radius * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
-  }
-  return polygon;
-}
 
 struct Case {
   const char* name;
@@ -96,7 +87,7 @@ Errors MeasureCase(const std::shared_ptr<const simulator::Surface>& base, const 
   const SurfaceQuery surface(mesh);
   const LesionMeasureParams params;
   const simulator::LesionTruth truth = decorated->Truth(0, params.level_fraction);
-  const Polygon2d region = Circle(c.lesion.centre_xy_mm, c.lesion.radius_mm + 2.0);
+  const Polygon2d region = testing::Circle(c.lesion.centre_xy_mm, c.lesion.radius_mm + 2.0);
   const LesionMeasurement m = MeasureLesion(surface, region, params);
   std::printf(
       "%s: peak %.2f +- %.2f (true %.2f) mm, area %.1f +- %.1f (true %.1f) mm^2, "
@@ -140,7 +131,7 @@ TEST(SimulatedLesionTest, ACubicReferenceFitsTheCheekBetterThanAQuadricOrAPlane)
   const auto decorated = std::make_shared<simulator::LesionSurface>(Face(), std::vector{c.lesion});
   const geometry::SurfaceMesh mesh = testing::SampleStripes(*decorated, {});
   const SurfaceQuery surface(mesh);
-  const Polygon2d region = Circle(c.lesion.centre_xy_mm, c.lesion.radius_mm + 2.0);
+  const Polygon2d region = testing::Circle(c.lesion.centre_xy_mm, c.lesion.radius_mm + 2.0);
   LesionMeasureParams plane, quadric;
   plane.reference = ReferenceKind::kPlane;
   quadric.reference = ReferenceKind::kQuadric;
@@ -166,10 +157,10 @@ TEST(SimulatedLesionTest, RejectsARegionWithoutSurface) {
       std::make_shared<simulator::LesionSurface>(Face(), std::vector{kCases[0].lesion});
   const geometry::SurfaceMesh mesh = testing::SampleStripes(*decorated, {});
   const SurfaceQuery surface(mesh);
-  EXPECT_THROW(MeasureLesion(surface, Circle({400.0, 0.0}, 10.0)), MeasurementError);
+  EXPECT_THROW(MeasureLesion(surface, testing::Circle({400.0, 0.0}, 10.0)), MeasurementError);
   LesionMeasureParams bad;
   bad.level_fraction = 1.5;
-  EXPECT_THROW(MeasureLesion(surface, Circle(kCases[0].lesion.centre_xy_mm, 20.0), bad),
+  EXPECT_THROW(MeasureLesion(surface, testing::Circle(kCases[0].lesion.centre_xy_mm, 20.0), bad),
                MeasurementError);
 }
 

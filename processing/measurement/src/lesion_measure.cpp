@@ -3,8 +3,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <cassert>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "polygon.h"
@@ -31,6 +34,8 @@ int TermsOf(ReferenceKind kind) {
       return kQuadricTerms;
     case ReferenceKind::kCubic:
       return kCubicTerms;
+    case ReferenceKind::kBaseline:
+      return 0;
   }
   return kQuadricTerms;
 }
@@ -76,6 +81,22 @@ std::vector<int> CandidateVertices(const SurfaceQuery& surface, const Eigen::Ali
   return vertices;
 }
 
+// The vertices of `surface` outside `region` within `width_mm` of its boundary.
+std::vector<int> RingVertices(const SurfaceQuery& surface, const Polygon2d& region,
+                              double width_mm) {
+  Eigen::AlignedBox2d box = internal::Bounds(region);
+  const Eigen::Vector2d ring(width_mm, width_mm);
+  box.extend(box.min() - ring);
+  box.extend(box.max() + ring);
+  std::vector<int> vertices;
+  for (int v : CandidateVertices(surface, box)) {
+    const Eigen::Vector2d xy = surface.mesh().positions[v].head<2>();
+    if (!internal::Contains(region, xy) && internal::DistanceToBoundary(region, xy) <= width_mm)
+      vertices.push_back(v);
+  }
+  return vertices;
+}
+
 }  // namespace
 
 std::string ToString(ReferenceKind kind) {
@@ -86,6 +107,8 @@ std::string ToString(ReferenceKind kind) {
       return "quadric";
     case ReferenceKind::kCubic:
       return "cubic";
+    case ReferenceKind::kBaseline:
+      return "baseline";
   }
   return "unknown";
 }
@@ -104,10 +127,12 @@ bool LesionMeasureParams::IsValid(std::string* error) const {
 }
 
 double ReferenceSurface::Z(const Eigen::Vector2d& xy) const {
+  assert(coefficients.size() >= kPlaneTerms && "a baseline's description has no surface");
   return Basis(xy - origin, static_cast<int>(coefficients.size())).dot(coefficients);
 }
 
 Eigen::Vector2d ReferenceSurface::Gradient(const Eigen::Vector2d& xy) const {
+  assert(coefficients.size() >= kPlaneTerms && "a baseline's description has no surface");
   Eigen::Vector2d g(coefficients[1], coefficients[2]);
   const Eigen::Vector2d d = xy - origin;
   if (coefficients.size() >= kQuadricTerms) {
@@ -124,6 +149,7 @@ Eigen::Vector2d ReferenceSurface::Gradient(const Eigen::Vector2d& xy) const {
 }
 
 double ReferenceSurface::SigmaZ(const Eigen::Vector2d& xy) const {
+  assert(coefficients.size() >= kPlaneTerms && "a baseline's description has no surface");
   const Eigen::VectorXd phi = Basis(xy - origin, static_cast<int>(coefficients.size()));
   return std::sqrt(std::max(0.0, phi.dot(covariance * phi)));
 }
@@ -133,18 +159,11 @@ ReferenceSurface FitReference(const SurfaceQuery& surface, const Polygon2d& regi
   std::string why;
   if (!params.IsValid(&why)) throw MeasurementError(why);
   internal::CheckPolygon(region, "lesion region");
+  if (params.reference == ReferenceKind::kBaseline)
+    throw MeasurementError(
+        "lesion reference: a baseline is an earlier scan, not a fit (MeasureLesionAgainstBaseline)");
   const geometry::SurfaceMesh& mesh = surface.mesh();
-  Eigen::AlignedBox2d box = internal::Bounds(region);
-  const Eigen::Vector2d ring(params.ring_width_mm, params.ring_width_mm);
-  box.extend(box.min() - ring);
-  box.extend(box.max() + ring);
-  std::vector<int> ring_vertices;
-  for (int v : CandidateVertices(surface, box)) {
-    const Eigen::Vector2d xy = mesh.positions[v].head<2>();
-    if (!internal::Contains(region, xy) &&
-        internal::DistanceToBoundary(region, xy) <= params.ring_width_mm)
-      ring_vertices.push_back(v);
-  }
+  const std::vector<int> ring_vertices = RingVertices(surface, region, params.ring_width_mm);
   const int terms = TermsOf(params.reference);
   if (static_cast<int>(ring_vertices.size()) < terms)
     throw MeasurementError("lesion reference: the ring of " + std::to_string(params.ring_width_mm) +
@@ -191,25 +210,52 @@ ReferenceSurface FitReference(const SurfaceQuery& surface, const Polygon2d& regi
   return reference;
 }
 
-LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& region_in,
-                                const LesionMeasureParams& params) {
-  Polygon2d region = region_in;
-  internal::CheckPolygon(region, "lesion region");
-  if (internal::SignedArea(region) < 0.0) std::reverse(region.begin(), region.end());
+namespace {
+
+// The undisturbed surface a lesion is measured against: a fitted ring
+// reference or a registered baseline scan.
+struct ReferenceView {
+  ReferenceKind kind = ReferenceKind::kCubic;
+  std::function<std::optional<double>(const Eigen::Vector2d&)> z;  // nullopt: no surface there
+  std::function<Eigen::Vector2d(const Eigen::Vector2d&)> gradient;  // (dz/dx, dz/dy)
+  std::function<double(const Eigen::Vector2d&)> sigma;              // 1 sigma of z, mm
+  double residual_rms_mm = 0.0;     // of the surface against it outside the region
+  double noise_variance_mm2 = 0.0;  // of that residual explained by the reference's own noise
+  double min_coverage = 1.0;        // share of the region it must lie under
+};
+
+// Peak, area at the level and volume of the lesion in `region` (counter-
+// clockwise) against `reference`; fills every figure of `result` but the
+// reference's description.
+void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
+                    const LesionMeasureParams& params, const ReferenceView& reference,
+                    LesionMeasurement* result_out) {
+  LesionMeasurement& result = *result_out;
   const geometry::SurfaceMesh& mesh = surface.mesh();
   const Eigen::AlignedBox2d box = internal::Bounds(region);
+  // Deviation d = z - reference (NaN where the reference has no surface).
+  std::vector<double> deviations(mesh.positions.size(), std::numeric_limits<double>::quiet_NaN());
   std::vector<int> inside;
-  for (int v : CandidateVertices(surface, box))
-    if (internal::Contains(region, mesh.positions[v].head<2>())) inside.push_back(v);
+  for (int v : CandidateVertices(surface, box)) {
+    const Eigen::Vector2d xy = mesh.positions[v].head<2>();
+    if (!internal::Contains(region, xy)) continue;
+    if (const auto z = reference.z(xy)) {
+      deviations[v] = mesh.positions[v].z() - *z;
+      inside.push_back(v);
+    }
+  }
   if (inside.empty())
-    throw MeasurementError("lesion region: no surface vertex lies inside the polygon");
-
-  LesionMeasurement result;
+    throw MeasurementError("lesion region: no surface vertex lies inside the polygon" +
+                           std::string(reference.kind == ReferenceKind::kBaseline
+                                           ? " over the baseline"
+                                           : ""));
   result.region_vertices = static_cast<int>(inside.size());
-  result.reference = FitReference(surface, region, params);
-  const ReferenceSurface& reference = result.reference;
   auto deviation = [&](int v) {
-    return mesh.positions[v].z() - reference.Z(mesh.positions[v].head<2>());
+    if (std::isnan(deviations[v])) {
+      const auto z = reference.z(mesh.positions[v].head<2>());
+      deviations[v] = z ? mesh.positions[v].z() - *z : std::numeric_limits<double>::infinity();
+    }
+    return deviations[v];
   };
 
   // Peak: sign from the extreme vertex, value from a quadratic around it.
@@ -294,17 +340,19 @@ LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& re
   double noise_variance = 0.0;
   for (int v : inside) noise_variance += std::pow(surface.VertexSigma(v), 2);
   noise_variance /= static_cast<double>(inside.size());
-  const double misfit = std::sqrt(
-      std::max(0.0, reference.residual_rms_mm * reference.residual_rms_mm - noise_variance));
+  const double misfit =
+      std::sqrt(std::max(0.0, reference.residual_rms_mm * reference.residual_rms_mm -
+                                  noise_variance - reference.noise_variance_mm2));
   result.peak_mm.value = peak;
   result.peak_mm.uncertainty = std::sqrt(peak_fit_sigma * peak_fit_sigma +
-                                         std::pow(reference.SigmaZ(peak_xy), 2) + misfit * misfit);
-  result.peak_position =
-      Eigen::Vector3d(peak_xy.x(), peak_xy.y(), reference.Z(peak_xy) + sign * peak);
+                                         std::pow(reference.sigma(peak_xy), 2) + misfit * misfit);
+  const double reference_z =
+      reference.z(peak_xy).value_or(mesh.positions[extreme].z() - deviation(extreme));
+  result.peak_position = Eigen::Vector3d(peak_xy.x(), peak_xy.y(), reference_z + sign * peak);
   result.level_mm = params.level_fraction * peak;
 
   // Area at the level, volume over the region.
-  double area = 0.0, volume = 0.0;
+  double area = 0.0, volume = 0.0, covered_xy = 0.0, uncovered_xy = 0.0;
   double boundary_ref = 0.0, boundary_length = 0.0, boundary_noise = 0.0;
   std::vector<double> volume_weight(mesh.positions.size(), 0.0);
   bool any_face = false;
@@ -319,11 +367,16 @@ LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& re
       std::swap(triangle[1], triangle[2]);
       std::swap(ids[1], ids[2]);
     }
-    const std::vector<double> values = {sign * deviation(ids[0]), sign * deviation(ids[1]),
-                                        sign * deviation(ids[2])};
     const Polygon2d piece = internal::ClipByConvex(region, triangle);
     const double piece_xy = std::abs(internal::SignedArea(piece));
     if (piece_xy <= 0.0) continue;
+    const std::vector<double> values = {sign * deviation(ids[0]), sign * deviation(ids[1]),
+                                        sign * deviation(ids[2])};
+    if (!std::isfinite(values[0] + values[1] + values[2])) {  // no reference under a vertex
+      uncovered_xy += piece_xy;
+      continue;
+    }
+    covered_xy += piece_xy;
     any_face = true;
     const Eigen::Vector3d w =
         internal::Barycentric(triangle[0], triangle[1], triangle[2], internal::Centroid(piece));
@@ -336,7 +389,7 @@ LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& re
       const double part_xy = std::abs(internal::SignedArea(part));
       if (part_xy > 0.0)
         area +=
-            part_xy * std::sqrt(1.0 + reference.Gradient(internal::Centroid(part)).squaredNorm());
+            part_xy * std::sqrt(1.0 + reference.gradient(internal::Centroid(part)).squaredNorm());
     }
     // The level line through this face: its length over the slope of d says
     // how much area a shift of the level moves.
@@ -361,18 +414,25 @@ LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& re
               Eigen::Vector2d(values[1] - values[0], values[2] - values[0]);
           const double per_mm = (crossings[1] - crossings[0]).norm() /
                                 std::max(slope.norm(), 1e-9) *
-                                std::sqrt(1.0 + reference.Gradient(middle).squaredNorm());
+                                std::sqrt(1.0 + reference.gradient(middle).squaredNorm());
           const double vertex_sigma = (surface.VertexSigma(ids[0]) + surface.VertexSigma(ids[1]) +
                                        surface.VertexSigma(ids[2])) /
                                       3.0;
           boundary_length += per_mm;
-          boundary_ref += per_mm * std::hypot(reference.SigmaZ(middle), misfit);
+          boundary_ref += per_mm * std::hypot(reference.sigma(middle), misfit);
           boundary_noise += std::pow(per_mm * vertex_sigma, 2);
         }
       }
     }
   }
   if (!any_face) throw MeasurementError("lesion region: no surface lies inside the polygon");
+  const double coverage = covered_xy / (covered_xy + uncovered_xy);
+  result.surface_coverage =
+      std::min(1.0, (covered_xy + uncovered_xy) / std::abs(internal::SignedArea(region)));
+  if (coverage < reference.min_coverage)
+    throw MeasurementError("lesion region: the baseline lies under only " +
+                           std::to_string(static_cast<int>(std::floor(100.0 * coverage))) +
+                           " % of the surface in the polygon");
   result.area_mm2.value = area;
   result.area_mm2.uncertainty =
       std::sqrt(boundary_ref * boundary_ref + boundary_noise +
@@ -382,10 +442,120 @@ LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& re
     if (volume_weight[v] > 0.0)
       volume_variance += std::pow(volume_weight[v] * surface.VertexSigma(static_cast<int>(v)), 2);
   const double region_xy = std::abs(internal::SignedArea(region));
-  volume_variance += std::pow(region_xy * reference.SigmaZ(reference.origin), 2);
+  volume_variance += std::pow(region_xy * reference.sigma(internal::Centroid(region)), 2);
   result.volume_mm3.value = volume;
   result.volume_mm3.uncertainty = std::sqrt(volume_variance);
   result.region_area_mm2 = SurfaceArea(surface, region);
+}
+
+// `region` checked and counter-clockwise.
+Polygon2d OrientedRegion(const Polygon2d& region_in) {
+  Polygon2d region = region_in;
+  internal::CheckPolygon(region, "lesion region");
+  if (internal::SignedArea(region) < 0.0) std::reverse(region.begin(), region.end());
+  return region;
+}
+
+
+}  // namespace
+
+LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& region_in,
+                                const LesionMeasureParams& params) {
+  const Polygon2d region = OrientedRegion(region_in);
+  LesionMeasurement result;
+  result.reference = FitReference(surface, region, params);
+  const ReferenceSurface& fitted = result.reference;
+  ReferenceView view;
+  view.kind = fitted.kind;
+  view.z = [&](const Eigen::Vector2d& xy) { return std::optional<double>(fitted.Z(xy)); };
+  view.gradient = [&](const Eigen::Vector2d& xy) { return fitted.Gradient(xy); };
+  view.sigma = [&](const Eigen::Vector2d& xy) { return fitted.SigmaZ(xy); };
+  view.residual_rms_mm = fitted.residual_rms_mm;
+  MeasureAgainst(surface, region, params, view, &result);
+  return result;
+}
+
+LesionMeasurement MeasureLesionAgainstBaseline(const SurfaceQuery& surface,
+                                               const geometry::SurfaceMesh& baseline,
+                                               const Polygon2d& region_in,
+                                               const LesionMeasureParams& params,
+                                               const BaselineParams& baseline_params) {
+  std::string why;
+  if (!params.IsValid(&why)) throw MeasurementError(why);
+  const Polygon2d region = OrientedRegion(region_in);
+  std::optional<SurfaceQuery> original;
+  try {
+    original.emplace(baseline);
+  } catch (const MeasurementError& e) {
+    throw MeasurementError(std::string("baseline: ") + e.what());
+  }
+  LesionMeasurement result;
+  result.baseline = RegisterToBaseline(surface, *original, region, baseline_params);
+  // The baseline moved into this surface's frame, where the region is drawn.
+  geometry::SurfaceMesh moved = baseline;
+  const Eigen::Isometry3d to_surface = result.baseline->transform.inverse();
+  for (Eigen::Vector3d& p : moved.positions) p = to_surface * p;
+  for (Eigen::Vector3d& n : moved.normals) n = to_surface.linear() * n;
+  const SurfaceQuery reference(moved);
+  double mean_variance = 0.0;
+  for (std::size_t v = 0; v < moved.positions.size(); ++v)
+    mean_variance += std::pow(reference.VertexSigma(static_cast<int>(v)), 2);
+  mean_variance /= static_cast<double>(std::max<std::size_t>(1, moved.positions.size()));
+
+  ReferenceView view;
+  view.kind = ReferenceKind::kBaseline;
+  view.z = [&](const Eigen::Vector2d& xy) -> std::optional<double> {
+    const auto point = reference.Above(xy);
+    if (!point) return std::nullopt;
+    return point->position.z();
+  };
+  view.gradient = [&](const Eigen::Vector2d& xy) -> Eigen::Vector2d {
+    const auto point = reference.Above(xy);
+    if (!point) return Eigen::Vector2d::Zero();
+    const Eigen::Vector3i& face = moved.faces[point->face];
+    const Eigen::Vector3d n = (moved.positions[face[1]] - moved.positions[face[0]])
+                                  .cross(moved.positions[face[2]] - moved.positions[face[0]]);
+    if (std::abs(n.z()) < 1e-12) return Eigen::Vector2d::Zero();
+    return Eigen::Vector2d(-n.x() / n.z(), -n.y() / n.z());
+  };
+  view.sigma = [&](const Eigen::Vector2d& xy) {
+    const auto point = reference.Above(xy);
+    if (!point) return std::sqrt(mean_variance);
+    return std::hypot(point->sigma_mm, reference.InterpolationError(*point));
+  };
+  // How the surface departs from the baseline around the region: both scans'
+  // noise plus what registration and resampling leave (robust RMS: the ring
+  // may graze the lesion's skirt).
+  std::vector<double> ring;
+  double ring_noise = 0.0;
+  for (int v : RingVertices(surface, region, params.ring_width_mm)) {
+    const Eigen::Vector3d& p = surface.mesh().positions[v];
+    if (const auto z = view.z(p.head<2>())) {
+      ring.push_back(p.z() - *z);
+      ring_noise += std::pow(view.sigma(p.head<2>()), 2);
+    }
+  }
+  ReferenceSurface& described = result.reference;
+  described.kind = ReferenceKind::kBaseline;
+  described.origin = internal::Centroid(region);
+  described.ring_vertices = static_cast<int>(ring.size());
+  if (!ring.empty()) {
+    std::vector<double> magnitudes;
+    for (double d : ring) magnitudes.push_back(std::abs(d));
+    const double robust = std::max(kMadToSigma * Median(magnitudes), kMinRobustSigmaMm);
+    double sum = 0.0;
+    int kept = 0;
+    for (double d : ring)
+      if (std::abs(d) <= 3.0 * robust) {
+        sum += d * d;
+        ++kept;
+      }
+    described.residual_rms_mm = std::sqrt(sum / std::max(kept, 1));
+    view.noise_variance_mm2 = ring_noise / static_cast<double>(ring.size());
+  }
+  view.residual_rms_mm = described.residual_rms_mm;
+  view.min_coverage = baseline_params.min_coverage;
+  MeasureAgainst(surface, region, params, view, &result);
   return result;
 }
 

@@ -1,7 +1,9 @@
 #include "bsls/measurement/report.h"
 
 #include <algorithm>
+#include <Eigen/Geometry>
 #include <iomanip>
+#include <numbers>
 #include <sstream>
 
 namespace bsls::measurement {
@@ -29,9 +31,23 @@ nlohmann::json ToJson(const GeodesicResult& result) {
           {"path_mm", path}};
 }
 
+nlohmann::json ToJson(const BaselineRegistration& registration) {
+  const Eigen::Matrix4d m = registration.transform.matrix();
+  nlohmann::json matrix = nlohmann::json::array();
+  for (int r = 0; r < 4; ++r) matrix.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return {{"rigid", registration.rigid},
+          {"surface_to_baseline", matrix},
+          {"rotation_deg", Eigen::AngleAxisd(registration.transform.linear()).angle() * 180.0 /
+                               std::numbers::pi},
+          {"translation_mm", registration.transform.translation().norm()},
+          {"iterations", registration.iterations},
+          {"pairs", registration.pairs},
+          {"rms_mm", registration.rms_mm}};
+}
+
 nlohmann::json ToJson(const LesionMeasurement& result) {
   const Eigen::Vector3d& p = result.peak_position;
-  return {{"kind", result.cavity ? "cavity" : "lump"},
+  nlohmann::json out = {{"kind", result.cavity ? "cavity" : "lump"},
           {result.cavity ? "depth_mm" : "height_mm", ToJson(result.peak_mm)},
           {"peak_position_mm", {p.x(), p.y(), p.z()}},
           {"level_mm", result.level_mm},
@@ -39,7 +55,10 @@ nlohmann::json ToJson(const LesionMeasurement& result) {
           {"volume_mm3", ToJson(result.volume_mm3)},
           {"region_area_mm2", ToJson(result.region_area_mm2)},
           {"region_vertices", result.region_vertices},
+          {"surface_coverage", result.surface_coverage},
           {"reference", ToJson(result.reference)}};
+  if (result.baseline) out["baseline"] = ToJson(*result.baseline);
+  return out;
 }
 
 nlohmann::json ToJson(const std::vector<ReportRow>& rows) {
@@ -58,11 +77,16 @@ std::vector<ReportRow> Rows(const GeodesicResult& result) {
 }
 
 std::vector<ReportRow> Rows(const LesionMeasurement& result) {
-  return {{result.cavity ? "cavity depth" : "lump height", result.peak_mm, "mm"},
-          {result.cavity ? "cavity area" : "lump area", result.area_mm2, "mm^2"},
-          {result.cavity ? "cavity volume" : "lump volume", result.volume_mm3, "mm^3"},
-          {"region area", result.region_area_mm2, "mm^2"},
-          {"reference residual RMS", {result.reference.residual_rms_mm, 0.0}, "mm"}};
+  std::vector<ReportRow> rows = {
+      {result.cavity ? "cavity depth" : "lump height", result.peak_mm, "mm"},
+      {result.cavity ? "cavity area" : "lump area", result.area_mm2, "mm^2"},
+      {result.cavity ? "cavity volume" : "lump volume", result.volume_mm3, "mm^3"},
+      {"region area", result.region_area_mm2, "mm^2"},
+      {"region covered by the surface", {100.0 * result.surface_coverage, 0.0}, "%"},
+      {"reference residual RMS", {result.reference.residual_rms_mm, 0.0}, "mm"}};
+  if (result.baseline)
+    rows.push_back({"baseline registration RMS", {result.baseline->rms_mm, 0.0}, "mm"});
+  return rows;
 }
 
 std::string FormatTable(const std::vector<ReportRow>& rows, int decimals) {

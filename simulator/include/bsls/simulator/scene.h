@@ -32,6 +32,7 @@
 #include "bsls/pattern/brick_pattern.h"
 #include "bsls/simulator/albedo.h"
 #include "bsls/simulator/mesh.h"
+#include "bsls/simulator/lesion.h"
 #include "bsls/simulator/surface.h"
 
 namespace bsls::simulator {
@@ -161,6 +162,9 @@ struct ThesisSceneOptions {
   FaceModelParams face;
   bool face_eyebrows = true;        // add FaceEyebrowPatches() to the albedo
   bool face_on_base_plane = false;  // face scenes: also the base plane (else black background)
+  // Lumps and cavities pressed into the face (thesis 7.2, Tables 7.3-7.4).
+  // World (x, y): not mirrored for the right side, both sides see one face.
+  std::vector<LesionParams> face_lesions;
   // Rises towards +x (towards the left camera, 12 deg off its view axis) from
   // x = -120 to +30 mm, 150 mm high: the whole lit half and line 0 stay visible.
   RampParams ramp;
@@ -181,8 +185,9 @@ struct ThesisSceneOptions {
 
 // The thesis set-up for one side and one object. Plane: the base plane only.
 // Ramp, ball, bunny: the object plus the base plane. Face: the face mask
-// (plus the base plane when asked). Throws MeshLoadError for face/bunny files
-// and std::invalid_argument for invalid options.
+// (plus the base plane when asked), with its lesions. Throws MeshLoadError for
+// face/bunny files and std::invalid_argument for invalid options (a lesion
+// that is invalid or overlaps another).
 Scene ThesisScene(pattern::Side side, SurfaceKind kind, const ThesisSceneOptions& options = {});
 
 }  // namespace bsls::simulator

@@ -29,22 +29,33 @@
 //     interpolation between stripes is exact to second order there.
 //  5. Volume: integral of d over the region (signed: > 0 for a lump).
 //
+// Against a baseline (MeasureLesionAgainstBaseline): the reference is an
+// earlier scan of the same face without the lesion (before it grew, before
+// surgery), rigidly registered onto the surface outside the region
+// (baseline_registration.h); steps 2-5 are the same with f the baseline's
+// height. No guess of the face under the lesion is needed, so the face's own
+// shape no longer limits the figures, only both scans' noise does.
+//
 // Frame and units: world mm, mm^2, mm^3. Errors: MeasurementError naming the
 // input and reason (region without surface, too few ring vertices, ...).
 #ifndef BSLS_MEASUREMENT_LESION_MEASURE_H_
 #define BSLS_MEASUREMENT_LESION_MEASURE_H_
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
+#include "bsls/geometry/surface_mesh.h"
+#include "bsls/measurement/baseline_registration.h"
 #include "bsls/measurement/measures.h"
 #include "bsls/measurement/surface_query.h"
 
 namespace bsls::measurement {
 
-enum class ReferenceKind { kPlane, kQuadric, kCubic };
+// Fitted ring references, or an earlier scan (MeasureLesionAgainstBaseline only).
+enum class ReferenceKind { kPlane, kQuadric, kCubic, kBaseline };
 
-// Returns "plane", "quadric" or "cubic".
+// Returns "plane", "quadric", "cubic" or "baseline".
 std::string ToString(ReferenceKind kind);
 
 struct LesionMeasureParams {
@@ -60,7 +71,8 @@ struct LesionMeasureParams {
 };
 
 // z = f(x - x0, y - y0): plane c0 + c1 x + c2 y, quadric adds c3 x^2 + c4 xy + c5 y^2,
-// cubic adds c6 x^3 + c7 x^2 y + c8 x y^2 + c9 y^3.
+// cubic adds c6 x^3 + c7 x^2 y + c8 x y^2 + c9 y^3. Of a baseline only the
+// description is kept (kind, origin, ring residual and count; no coefficients).
 struct ReferenceSurface {
   ReferenceKind kind = ReferenceKind::kQuadric;
   Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // (x0, y0), mm: the region's centroid
@@ -69,7 +81,7 @@ struct ReferenceSurface {
   double residual_rms_mm = 0.0;                      // robust RMS of the ring's vertical residuals
   int ring_vertices = 0;
 
-  // Height z of the reference at (x, y), mm.
+  // Height z of the reference at (x, y), mm (fitted kinds only, as the two below).
   double Z(const Eigen::Vector2d& xy) const;
   // (dz/dx, dz/dy) at (x, y).
   Eigen::Vector2d Gradient(const Eigen::Vector2d& xy) const;
@@ -86,8 +98,14 @@ struct LesionMeasurement {
   Measured area_mm2;         // where |d| >= level_mm, on the reference surface
   Measured volume_mm3;       // of |d| over the region (cavity: volume missing), >= 0 normally
   Measured region_area_mm2;  // the whole region, on the measured surface
+  // Share of the region's x-y area the measured surface covers, (0, 1]: below
+  // 1 where stripes were lost or hidden (shadow, occlusion), and the area and
+  // volume miss what lies in those holes.
+  double surface_coverage = 1.0;
   ReferenceSurface reference;
   int region_vertices = 0;
+  // Against a baseline: how it was registered onto this surface.
+  std::optional<BaselineRegistration> baseline;
 };
 
 // Fits the reference of `params` to the ring around `region`. Throws when the
@@ -100,6 +118,18 @@ ReferenceSurface FitReference(const SurfaceQuery& surface, const Polygon2d& regi
 // when the region holds no surface or the reference cannot be fitted.
 LesionMeasurement MeasureLesion(const SurfaceQuery& surface, const Polygon2d& region,
                                 const LesionMeasureParams& params = {});
+
+// Measures the lump or cavity inside `region` against `baseline`, an earlier
+// scan of the same face registered onto `surface` outside the region (the
+// figures are in `surface`'s frame; params.reference is not used). Throws
+// MeasurementError when the baseline has no faces, the registration fails,
+// or the baseline lies under less than baseline_params.min_coverage of the
+// region.
+LesionMeasurement MeasureLesionAgainstBaseline(const SurfaceQuery& surface,
+                                               const geometry::SurfaceMesh& baseline,
+                                               const Polygon2d& region,
+                                               const LesionMeasureParams& params = {},
+                                               const BaselineParams& baseline_params = {});
 
 }  // namespace bsls::measurement
 

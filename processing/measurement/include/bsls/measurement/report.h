@@ -28,6 +28,8 @@ nlohmann::json ToJson(const ReferenceSurface& reference);
 nlohmann::json ToJson(const GeodesicResult& result);
 // Kind, peak (with position), level, area, volume, region area, reference.
 nlohmann::json ToJson(const LesionMeasurement& result);
+// The registration: matrix surface -> baseline, rotation angle, translation, pairs, RMS.
+nlohmann::json ToJson(const BaselineRegistration& registration);
 // [{"name": ..., "value": ..., "uncertainty": ..., "unit": ...}, ...].
 nlohmann::json ToJson(const std::vector<ReportRow>& rows);
 

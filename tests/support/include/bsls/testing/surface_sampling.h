@@ -9,7 +9,11 @@
 #ifndef BSLS_TESTING_SURFACE_SAMPLING_H_
 #define BSLS_TESTING_SURFACE_SAMPLING_H_
 
+#include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
+#include <numbers>
+#include <vector>
 
 #include "bsls/geometry/surface_mesh.h"
 #include "bsls/pattern/brick_pattern.h"
@@ -49,6 +53,18 @@ geometry::SurfaceMesh SampleGrid(const simulator::Surface& surface, const GridSa
 // sample by sample (the same slide row on both lines).
 geometry::SurfaceMesh SampleStripes(const simulator::Surface& surface,
                                     const StripeSampling& params);
+
+// A circle of `radius` (mm) around `centre` as a polygon of `vertices`
+// corners: the region a test measures a lesion in.
+inline std::vector<Eigen::Vector2d> Circle(const Eigen::Vector2d& centre, double radius,
+                                           int vertices = 64) {
+  std::vector<Eigen::Vector2d> polygon;
+  for (int i = 0; i < vertices; ++i) {
+    const double angle = 2.0 * std::numbers::pi * i / vertices;
+    polygon.push_back(centre + radius * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
+  }
+  return polygon;
+}
 
 }  // namespace bsls::testing
 
