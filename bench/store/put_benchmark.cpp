@@ -53,16 +53,22 @@ double Percentile(std::vector<double> values, double fraction) {
   return values[index];
 }
 
-void BM_PutTwoFrames(benchmark::State& state) {
-  const std::string root = TempRoot();
+// A store in `root` without a free-space reserve; on failure the benchmark
+// is marked skipped with the reason.
+Result<std::unique_ptr<CaptureStore>> OpenStore(const std::string& root,
+                                               benchmark::State& state) {
   CaptureStoreOptions options;
   options.root = root;
   options.free_space_reserve_bytes = 0;
   auto store = CaptureStore::Open(options);
-  if (!store.ok()) {
-    state.SkipWithError(store.status().ToString().c_str());
-    return;
-  }
+  if (!store.ok()) state.SkipWithError(store.status().ToString().c_str());
+  return store;
+}
+
+void BM_PutTwoFrames(benchmark::State& state) {
+  const std::string root = TempRoot();
+  auto store = OpenStore(root, state);
+  if (!store.ok()) return;
   const CaptureRequest request = Request(static_cast<int>(state.range(0)));
   std::vector<double> millis;
   for (auto _ : state) {
@@ -92,14 +98,8 @@ BENCHMARK(BM_PutTwoFrames)
 
 void BM_GetTwoFrames(benchmark::State& state) {
   const std::string root = TempRoot();
-  CaptureStoreOptions options;
-  options.root = root;
-  options.free_space_reserve_bytes = 0;
-  auto store = CaptureStore::Open(options);
-  if (!store.ok()) {
-    state.SkipWithError(store.status().ToString().c_str());
-    return;
-  }
+  auto store = OpenStore(root, state);
+  if (!store.ok()) return;
   auto put = (*store)->Put(Request(static_cast<int>(state.range(0))));
   if (!put.ok()) {
     state.SkipWithError(put.status().ToString().c_str());
