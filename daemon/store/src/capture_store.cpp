@@ -149,35 +149,28 @@ Status CaptureStore::Recover() {
 
   // Every acknowledged capture: its files exist and (by default) verify.
   std::set<std::string> indexed_files;
-  CaptureFilter all;
-  all.page_size = kMaxPageSize;
-  while (true) {
-    auto page = index_->List(all);
-    if (!page.ok()) return page.status();
-    for (const CaptureInfo& info : page->captures) {
-      ++recovery_.captures_checked;
-      Status capture_status;
-      for (const StoredFrameInfo& frame : info.frames) {
-        indexed_files.insert(frame.file_name);
-        if (!capture_status.ok()) continue;
-        if (options_.verify_hashes_on_open) {
-          capture_status = VerifyFrame(info, frame, nullptr);
-        } else if (!present.count(frame.file_name)) {
-          capture_status = Status(ErrorCode::kDataLoss, "frame file " + frames_dir_ + "/" +
-                                                            frame.file_name + " is missing");
-        }
-      }
-      if (info.frames.empty()) {
-        capture_status = Status(ErrorCode::kDataLoss, "the index has no frames for it");
-      }
-      if (!capture_status.ok()) {
-        recovery_.problems.push_back(
-            CaptureProblem{info.id.str(), WithContext(capture_status, "capture " + info.id.str())});
+  const Status walked = ForEachCapture([&](const CaptureInfo& info) {
+    ++recovery_.captures_checked;
+    Status capture_status;
+    for (const StoredFrameInfo& frame : info.frames) {
+      indexed_files.insert(frame.file_name);
+      if (!capture_status.ok()) continue;
+      if (options_.verify_hashes_on_open) {
+        capture_status = VerifyFrame(info, frame, nullptr);
+      } else if (!present.count(frame.file_name)) {
+        capture_status = Status(ErrorCode::kDataLoss, "frame file " + frames_dir_ + "/" +
+                                                          frame.file_name + " is missing");
       }
     }
-    if (page->next_page_token.empty()) break;
-    all.page_token = page->next_page_token;
-  }
+    if (info.frames.empty()) {
+      capture_status = Status(ErrorCode::kDataLoss, "the index has no frames for it");
+    }
+    if (!capture_status.ok()) {
+      recovery_.problems.push_back(
+          CaptureProblem{info.id.str(), WithContext(capture_status, "capture " + info.id.str())});
+    }
+  });
+  if (!walked.ok()) return walked;
 
   // Leftovers of puts that were never acknowledged.
   bool removed_any = false;
@@ -453,26 +446,31 @@ Result<RetentionReport> CaptureStore::ApplyRetention(std::chrono::system_clock::
 
 Result<std::vector<CaptureProblem>> CaptureStore::VerifyAll() {
   std::vector<CaptureProblem> problems;
+  const Status walked = ForEachCapture([&](const CaptureInfo& info) {
+    for (const StoredFrameInfo& frame : info.frames) {
+      if (Status status = VerifyFrame(info, frame, nullptr); !status.ok()) {
+        // A capture deleted since the page was read is not a problem.
+        if (!index_->Find(info.id).ok()) break;
+        problems.push_back(
+            CaptureProblem{info.id.str(), WithContext(status, "capture " + info.id.str())});
+        break;
+      }
+    }
+  });
+  if (!walked.ok()) return walked;
+  return problems;
+}
+
+Status CaptureStore::ForEachCapture(const std::function<void(const CaptureInfo&)>& visit) {
   CaptureFilter all;
   all.page_size = kMaxPageSize;
   while (true) {
     auto page = index_->List(all);
     if (!page.ok()) return page.status();
-    for (const CaptureInfo& info : page->captures) {
-      for (const StoredFrameInfo& frame : info.frames) {
-        if (Status status = VerifyFrame(info, frame, nullptr); !status.ok()) {
-          // A capture deleted since the page was read is not a problem.
-          if (!index_->Find(info.id).ok()) break;
-          problems.push_back(
-              CaptureProblem{info.id.str(), WithContext(status, "capture " + info.id.str())});
-          break;
-        }
-      }
-    }
-    if (page->next_page_token.empty()) break;
+    for (const CaptureInfo& info : page->captures) visit(info);
+    if (page->next_page_token.empty()) return {};
     all.page_token = page->next_page_token;
   }
-  return problems;
 }
 
 Status CaptureStore::CheckIndexIntegrity() { return index_->CheckIntegrity(); }

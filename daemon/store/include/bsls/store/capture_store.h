@@ -27,6 +27,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -154,6 +155,9 @@ class CaptureStore {
   // Removes the index rows, then the files, of a capture marked deleting.
   Status RemoveCapture(const CaptureInfo& info);
   Status CheckFreeSpace(const CaptureId& id, std::uint64_t bytes);
+  // Calls `visit` on every indexed capture, page by page in index order; the
+  // first failing page read is returned.
+  Status ForEachCapture(const std::function<void(const CaptureInfo&)>& visit);
 
   CaptureStoreOptions options_;
   std::unique_ptr<FileSystem> owned_fs_;
