@@ -36,16 +36,6 @@ struct Pair {
   double distance;         // signed distance of point from that face's plane
 };
 
-// The unit normal of face `f`, on the +z side.
-Eigen::Vector3d FaceNormal(const geometry::SurfaceMesh& mesh, int f) {
-  const Eigen::Vector3i& face = mesh.faces[f];
-  Eigen::Vector3d n = (mesh.positions[face[1]] - mesh.positions[face[0]])
-                          .cross(mesh.positions[face[2]] - mesh.positions[face[0]]);
-  if (n.z() < 0.0) n = -n;
-  const double length = n.norm();
-  return length > 0.0 ? Eigen::Vector3d(n / length) : Eigen::Vector3d::UnitZ();
-}
-
 std::vector<Pair> PairUp(const std::vector<Eigen::Vector3d>& points, const SurfaceQuery& baseline,
                          const Eigen::Isometry3d& transform, double max_pair_mm) {
   std::vector<Pair> pairs;
@@ -54,7 +44,7 @@ std::vector<Pair> PairUp(const std::vector<Eigen::Vector3d>& points, const Surfa
     const Eigen::Vector3d p = transform * x;
     const auto hit = baseline.Above(p.head<2>());
     if (!hit) continue;
-    const Eigen::Vector3d n = FaceNormal(baseline.mesh(), hit->face);
+    const Eigen::Vector3d n = baseline.FaceNormal(hit->face);
     const double distance = n.dot(p - hit->position);
     if (std::abs(distance) <= max_pair_mm) pairs.push_back({p, n, distance});
   }

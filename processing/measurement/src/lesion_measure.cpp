@@ -512,9 +512,7 @@ LesionMeasurement MeasureLesionAgainstBaseline(const SurfaceQuery& surface,
   view.gradient = [&](const Eigen::Vector2d& xy) -> Eigen::Vector2d {
     const auto point = reference.Above(xy);
     if (!point) return Eigen::Vector2d::Zero();
-    const Eigen::Vector3i& face = moved.faces[point->face];
-    const Eigen::Vector3d n = (moved.positions[face[1]] - moved.positions[face[0]])
-                                  .cross(moved.positions[face[2]] - moved.positions[face[0]]);
+    const Eigen::Vector3d n = reference.FaceNormal(point->face);
     if (std::abs(n.z()) < 1e-12) return Eigen::Vector2d::Zero();
     return Eigen::Vector2d(-n.x() / n.z(), -n.y() / n.z());
   };

@@ -82,6 +82,15 @@ double SurfaceQuery::VertexSigma(int v) const {
   return mesh_.uncertainty_mm.empty() ? 0.0 : static_cast<double>(mesh_.uncertainty_mm[v]);
 }
 
+Eigen::Vector3d SurfaceQuery::FaceNormal(int face) const {
+  const Eigen::Vector3i& f = mesh_.faces[face];
+  Eigen::Vector3d n = (mesh_.positions[f[1]] - mesh_.positions[f[0]])
+                          .cross(mesh_.positions[f[2]] - mesh_.positions[f[0]]);
+  if (n.z() < 0.0) n = -n;
+  const double length = n.norm();
+  return length > 0.0 ? Eigen::Vector3d(n / length) : Eigen::Vector3d::UnitZ();
+}
+
 std::optional<SurfacePoint> SurfaceQuery::Above(const Eigen::Vector2d& xy) const {
   std::optional<SurfacePoint> best;
   for (int f : FacesIn(Eigen::AlignedBox2d(xy, xy))) {

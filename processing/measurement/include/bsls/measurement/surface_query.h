@@ -51,6 +51,8 @@ class SurfaceQuery {
   std::vector<int> VerticesNear(const Eigen::Vector2d& xy, double radius_mm) const;
   // 1-sigma uncertainty of vertex `v` (mm); 0 when unknown.
   double VertexSigma(int v) const;
+  // Unit normal of face `face`, on the +z side; +z for a degenerate face.
+  Eigen::Vector3d FaceNormal(int face) const;
   // Estimated error (mm, >= 0) of linear interpolation at `point`: how far a
   // quadric fitted to the vertices around it lies from the face's plane.
   double InterpolationError(const SurfacePoint& point) const;
