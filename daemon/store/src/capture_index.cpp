@@ -514,4 +514,15 @@ Result<std::vector<RetentionCandidate>> CaptureIndex::OldestFirst() {
   return candidates;
 }
 
+Result<IndexTotals> CaptureIndex::Totals() {
+  std::lock_guard lock(read_mutex_);
+  const std::string what = "counting the captures of " + path_;
+  Statement select(reader_, "SELECT COUNT(*), COALESCE(SUM(total_bytes), 0) FROM captures");
+  if (!select.prepared()) return DbError(reader_, select.prepare_rc(), what);
+  const int rc = select.Step();
+  if (rc != SQLITE_ROW) return DbError(reader_, rc, what);
+  return IndexTotals{static_cast<std::uint64_t>(select.Int(0)),
+                     static_cast<std::uint64_t>(select.Int(1))};
+}
+
 }  // namespace bsls::store

@@ -228,6 +228,20 @@ Status CaptureStore::VerifyFrame(const CaptureInfo& info, const StoredFrameInfo&
   return {};
 }
 
+Result<StoreUsage> CaptureStore::Usage() {
+  Result<IndexTotals> totals = index_->Totals();
+  if (!totals.ok()) return totals.status();
+  auto space = fs_.Statvfs(options_.root);
+  if (!space.ok()) return WithContext(space.status(), "reading the free space of " + options_.root);
+  StoreUsage usage;
+  usage.captures = totals->captures;
+  usage.total_bytes = totals->total_bytes;
+  usage.free_bytes = space->available_bytes > options_.free_space_reserve_bytes
+                         ? space->available_bytes - options_.free_space_reserve_bytes
+                         : 0;
+  return usage;
+}
+
 Status CaptureStore::CheckFreeSpace(const CaptureId& id, std::uint64_t bytes) {
   auto space = fs_.Statvfs(options_.root);
   if (!space.ok()) {

@@ -55,6 +55,12 @@ struct RetentionCandidate {
   std::uint64_t total_bytes = 0;
 };
 
+// How much the index holds.
+struct IndexTotals {
+  std::uint64_t captures = 0;
+  std::uint64_t total_bytes = 0;  // sum of the captures' frame file sizes
+};
+
 // The SQLite index.
 class CaptureIndex {
  public:
@@ -88,6 +94,8 @@ class CaptureIndex {
   Status Remove(const CaptureId& id);
   // Every capture, oldest (taken_wall, then id) first.
   Result<std::vector<RetentionCandidate>> OldestFirst();
+  // The number of captures and their bytes.
+  Result<IndexTotals> Totals();
 
  private:
   CaptureIndex(sqlite3* writer, sqlite3* reader, std::string path);

@@ -94,6 +94,13 @@ struct RetentionReport {
   int skipped_busy = 0;  // captures retention would delete but that were being read
 };
 
+// What the store holds and how much room is left.
+struct StoreUsage {
+  std::uint64_t captures = 0;
+  std::uint64_t total_bytes = 0;  // frame files of all captures
+  std::uint64_t free_bytes = 0;   // available to new captures (after the reserve)
+};
+
 // The store. Open one per root directory and process (LOCK enforces it).
 class CaptureStore {
  public:
@@ -141,6 +148,10 @@ class CaptureStore {
 
   // PRAGMA integrity_check of the index; kDataLoss with SQLite's findings.
   Status CheckIndexIntegrity();
+
+  // How many captures the store holds, their bytes, and the free space left
+  // for new ones (filesystem free space minus the reserve, never negative).
+  Result<StoreUsage> Usage();
 
   // The store's root directory.
   const std::string& root() const { return options_.root; }
