@@ -105,7 +105,7 @@ const SimulatedFramestore::View& SimulatedFramestore::ViewFor(Camera camera, int
   scene.projector = Shifted(scene.projector, dz);
   simulator::RenderParams render;
   render.noise_sigma = 0.0;
-  render.supersampling = 2;
+  render.supersampling = 1;  // live frames: speed over the last tenth of a pixel
   if (slide >= 1 && slide <= 3) {
     // One projector serves both sides (thesis Figure 1.1): the other side's
     // brick slide is simply projected; the scene's side only names the
@@ -137,9 +137,10 @@ Result<GreyFrame> SimulatedFramestore::Grab(const GrabOptions& options) {
     std::this_thread::sleep_until(exposed);
   }
   const double t = std::chrono::duration<double>(exposed - epoch_).count();
-  const int phase = static_cast<int>(std::floor(t / params_.breathing_period_s *
-                                                params_.breathing_phases)) %
-                    params_.breathing_phases;
+  // A still head needs one view per camera and slide.
+  const int phases = params_.breathing_amplitude_mm > 0.0 ? params_.breathing_phases : 1;
+  const int phase =
+      static_cast<int>(std::floor(t / params_.breathing_period_s * phases)) % phases;
   const int slide = params_.slide ? params_.slide() : (camera_ == Camera::kRight ? 3 : 2);
   const View* view = nullptr;
   try {

@@ -1,0 +1,110 @@
+// The gRPC service of bslsd (proto/bsls/v1/capture.proto): authorises each
+// call by the caller's role, validates every field, runs device work on the
+// capture thread (CaptureDevice), stores grabs durably (CaptureStore) before
+// acknowledging them, drives the slide controller, and streams previews and
+// events. Errors of the layers below map one to one onto gRPC status codes;
+// every message names the field or the thing and the reason.
+//
+// Thread-safety: gRPC calls the handlers from its thread pool; every member
+// is safe to call concurrently.
+#ifndef BSLS_SERVICE_CAPTURE_SERVICE_H_
+#define BSLS_SERVICE_CAPTURE_SERVICE_H_
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <string>
+
+#include "bsls/framestore/status.h"
+#include "bsls/service/capture_device.h"
+#include "bsls/service/event_hub.h"
+#include "bsls/service/roles.h"
+#include "bsls/service/unix_listener.h"
+#include "bsls/slides/slide_controller.h"
+#include "bsls/store/capture_store.h"
+#include "bsls/v1/capture.grpc.pb.h"
+
+namespace bsls::service {
+
+// Limits that keep one caller from exhausting the daemon.
+struct ServiceLimits {
+  int max_preview_streams = 8;
+  int max_event_streams = 16;
+  // Deadline given to calls that come without one (other clients than ours).
+  std::chrono::milliseconds default_deadline{10000};
+  // Longest deadline honoured for a grab or slide change.
+  std::chrono::milliseconds max_deadline{60000};
+};
+
+// The grpc::StatusCode of a layer error code.
+grpc::StatusCode ToGrpcCode(framestore::ErrorCode code);
+// A grpc::Status carrying `status`'s code and message.
+grpc::Status ToGrpc(const framestore::Status& status);
+
+class CaptureService final : public v1::CaptureDaemon::Service {
+ public:
+  // Everything is borrowed and must outlive the service; `slides` may be
+  // nullptr (no slide controller configured: slide calls fail UNAVAILABLE).
+  CaptureService(CaptureDevice* device, store::CaptureStore* store,
+                 slides::SlideController* slides, EventHub* events, const PeerRegistry* peers,
+                 const RolePolicy* policy, ServiceLimits limits, std::string software_version);
+
+  // From now on new calls that change anything fail UNAVAILABLE ("shutting
+  // down") and open streams end; calls under way finish.
+  void BeginDrain() { draining_ = true; }
+  // Grabs acknowledged (stored) since start.
+  std::uint64_t grabs_acknowledged() const { return grabs_acknowledged_; }
+
+  grpc::Status GetStatus(grpc::ServerContext* context, const v1::GetStatusRequest* request,
+                         v1::DeviceStatus* reply) override;
+  grpc::Status SelectCamera(grpc::ServerContext* context, const v1::SelectCameraRequest* request,
+                            v1::DeviceStatus* reply) override;
+  grpc::Status SetGain(grpc::ServerContext* context, const v1::SetGainRequest* request,
+                       v1::DeviceStatus* reply) override;
+  grpc::Status StreamPreview(grpc::ServerContext* context, const v1::PreviewRequest* request,
+                             grpc::ServerWriter<v1::PreviewFrame>* writer) override;
+  grpc::Status Grab(grpc::ServerContext* context, const v1::GrabRequest* request,
+                    v1::GrabResponse* reply) override;
+  grpc::Status ListCaptures(grpc::ServerContext* context, const v1::ListCapturesRequest* request,
+                            v1::ListCapturesResponse* reply) override;
+  grpc::Status GetCapture(grpc::ServerContext* context, const v1::GetCaptureRequest* request,
+                          v1::CaptureInfo* reply) override;
+  grpc::Status DeleteCapture(grpc::ServerContext* context,
+                             const v1::DeleteCaptureRequest* request,
+                             v1::DeleteCaptureResponse* reply) override;
+  grpc::Status GetSlideState(grpc::ServerContext* context, const v1::GetSlideStateRequest* request,
+                             v1::SlideState* reply) override;
+  grpc::Status SetSlide(grpc::ServerContext* context, const v1::SetSlideRequest* request,
+                        v1::SlideState* reply) override;
+  grpc::Status SetFocus(grpc::ServerContext* context, const v1::SetFocusRequest* request,
+                        v1::SlideState* reply) override;
+  grpc::Status SetLamp(grpc::ServerContext* context, const v1::SetLampRequest* request,
+                       v1::SlideState* reply) override;
+  grpc::Status WatchEvents(grpc::ServerContext* context, const v1::WatchEventsRequest* request,
+                           grpc::ServerWriter<v1::Event>* writer) override;
+
+ private:
+  // OK with the caller filled in, or UNAUTHENTICATED / PERMISSION_DENIED.
+  grpc::Status Authorize(grpc::ServerContext* context, std::string_view method, Caller* caller);
+  // The call's deadline on the steady clock, capped; the default when none.
+  Clock::time_point Deadline(const grpc::ServerContext* context) const;
+  void FillStatus(const Caller& caller, v1::DeviceStatus* reply);
+  void FillSlideState(v1::SlideState* reply) const;
+
+  CaptureDevice* device_;
+  store::CaptureStore* store_;
+  slides::SlideController* slides_;
+  EventHub* events_;
+  const PeerRegistry* peers_;
+  const RolePolicy* policy_;
+  ServiceLimits limits_;
+  std::string software_version_;
+  std::atomic<bool> draining_{false};
+  std::atomic<int> preview_streams_{0};
+  std::atomic<int> event_streams_{0};
+  std::atomic<std::uint64_t> grabs_acknowledged_{0};
+};
+
+}  // namespace bsls::service
+
+#endif  // BSLS_SERVICE_CAPTURE_SERVICE_H_

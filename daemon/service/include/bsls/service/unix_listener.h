@@ -1,0 +1,93 @@
+// The Unix-socket front door of bslsd. gRPC C++ does not expose the peer's
+// credentials, so the daemon accepts local connections itself: it reads the
+// peer's uid with SO_PEERCRED, maps it to a role, remembers the caller under
+// the connection's gRPC peer name ("fd:<n>") and only then hands the socket
+// to the gRPC server (grpc::AddInsecureChannelFromFd).
+//
+// A connection's file descriptor stays open until gRPC has finished every
+// call on it (the transport owns the endpoint, each call holds the
+// transport), so a peer name cannot be reused by a new connection while a
+// call of the old one can still look it up.
+//
+// Thread-safety: PeerRegistry is safe from any thread; UnixListener's
+// Start/Stop are called from one thread.
+#ifndef BSLS_SERVICE_UNIX_LISTENER_H_
+#define BSLS_SERVICE_UNIX_LISTENER_H_
+
+#include <sys/types.h>
+
+#include <atomic>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "bsls/framestore/status.h"
+#include "bsls/service/roles.h"
+
+namespace grpc {
+class Server;
+}
+
+namespace bsls::service {
+
+// The callers of the connections the daemon accepted itself, by gRPC peer name.
+class PeerRegistry {
+ public:
+  // Records `caller` for the connection gRPC will name `peer`.
+  void Add(const std::string& peer, Caller caller);
+  // The caller of connection `peer`; nullopt for connections not accepted here.
+  std::optional<Caller> Find(const std::string& peer) const;
+  // Connections recorded (for tests and status).
+  std::size_t size() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::string, Caller> callers_;
+};
+
+// Where and how the socket is created.
+struct UnixListenerOptions {
+  std::string path;           // socket path; its directory must exist
+  mode_t mode = 0660;         // permissions of the socket file
+  std::optional<gid_t> group; // owning group of the socket file (else the daemon's)
+  int backlog = 64;
+};
+
+class UnixListener {
+ public:
+  // Binds and listens on options.path (a stale socket file left by a dead
+  // daemon is replaced; a live one is kAlreadyExists).
+  static framestore::Result<std::unique_ptr<UnixListener>> Create(const UnixListenerOptions& options);
+  ~UnixListener();
+  UnixListener(const UnixListener&) = delete;
+  UnixListener& operator=(const UnixListener&) = delete;
+
+  // Starts accepting: each connection's caller is recorded in `registry`
+  // with its role from `policy`, then given to `server`. All three must
+  // outlive Stop().
+  void Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
+  // Stops accepting (connections already handed over stay with gRPC) and
+  // removes the socket file.
+  void Stop();
+  // The socket path.
+  const std::string& path() const { return options_.path; }
+  // Connections accepted so far.
+  std::uint64_t accepted() const { return accepted_; }
+
+ private:
+  UnixListener(UnixListenerOptions options, int fd);
+  void AcceptLoop(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
+
+  UnixListenerOptions options_;
+  int fd_ = -1;
+  int wake_[2] = {-1, -1};  // a pipe that wakes the accept loop to stop
+  std::thread thread_;
+  std::atomic<std::uint64_t> accepted_{0};
+};
+
+}  // namespace bsls::service
+
+#endif  // BSLS_SERVICE_UNIX_LISTENER_H_

@@ -1,0 +1,568 @@
+#include "bsls/service/capture_service.h"
+
+#include <google/protobuf/util/time_util.h>
+#include <grpcpp/grpcpp.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "bsls/store/sha256.h"
+
+namespace bsls::service {
+
+using framestore::Camera;
+using framestore::ErrorCode;
+using google::protobuf::util::TimeUtil;
+
+grpc::StatusCode ToGrpcCode(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kOk:
+      return grpc::StatusCode::OK;
+    case ErrorCode::kInvalidArgument:
+      return grpc::StatusCode::INVALID_ARGUMENT;
+    case ErrorCode::kFailedPrecondition:
+      return grpc::StatusCode::FAILED_PRECONDITION;
+    case ErrorCode::kPermissionDenied:
+      return grpc::StatusCode::PERMISSION_DENIED;
+    case ErrorCode::kUnavailable:
+      return grpc::StatusCode::UNAVAILABLE;
+    case ErrorCode::kDeadlineExceeded:
+      return grpc::StatusCode::DEADLINE_EXCEEDED;
+    case ErrorCode::kDataLoss:
+      return grpc::StatusCode::DATA_LOSS;
+    case ErrorCode::kNotFound:
+      return grpc::StatusCode::NOT_FOUND;
+    case ErrorCode::kAlreadyExists:
+      return grpc::StatusCode::ALREADY_EXISTS;
+    case ErrorCode::kResourceExhausted:
+      return grpc::StatusCode::RESOURCE_EXHAUSTED;
+    case ErrorCode::kInternal:
+      return grpc::StatusCode::INTERNAL;
+  }
+  return grpc::StatusCode::INTERNAL;
+}
+
+grpc::Status ToGrpc(const framestore::Status& status) {
+  if (status.ok()) return grpc::Status::OK;
+  return {ToGrpcCode(status.code()), status.message()};
+}
+
+namespace {
+
+constexpr std::string_view kMethodPrefix = "/bsls.v1.CaptureDaemon/";
+
+grpc::Status Invalid(const std::string& message) {
+  return {grpc::StatusCode::INVALID_ARGUMENT, message};
+}
+
+grpc::Status Draining() {
+  return {grpc::StatusCode::UNAVAILABLE, "bslsd is shutting down; retry on the next daemon"};
+}
+
+std::optional<Camera> FromProto(v1::Camera camera) {
+  switch (camera) {
+    case v1::CAMERA_LEFT:
+      return Camera::kLeft;
+    case v1::CAMERA_RIGHT:
+      return Camera::kRight;
+    case v1::CAMERA_THIRD:
+      return Camera::kThird;
+    default:
+      return std::nullopt;
+  }
+}
+
+v1::Camera ToProto(Camera camera) {
+  switch (camera) {
+    case Camera::kLeft:
+      return v1::CAMERA_LEFT;
+    case Camera::kRight:
+      return v1::CAMERA_RIGHT;
+    case Camera::kThird:
+      return v1::CAMERA_THIRD;
+  }
+  return v1::CAMERA_UNSPECIFIED;
+}
+
+v1::GrabSide ToProto(store::Side side) {
+  switch (side) {
+    case store::Side::kLeft:
+      return v1::GRAB_SIDE_LEFT;
+    case store::Side::kRight:
+      return v1::GRAB_SIDE_RIGHT;
+    case store::Side::kBoth:
+      return v1::GRAB_SIDE_BOTH;
+  }
+  return v1::GRAB_SIDE_UNSPECIFIED;
+}
+
+std::int64_t MonotonicNs(Clock::time_point t) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count();
+}
+
+google::protobuf::Timestamp ToProto(std::chrono::system_clock::time_point t) {
+  return TimeUtil::NanosecondsToTimestamp(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(t.time_since_epoch()).count());
+}
+
+std::chrono::system_clock::time_point FromProto(const google::protobuf::Timestamp& t) {
+  return std::chrono::system_clock::time_point(std::chrono::duration_cast<
+                                               std::chrono::system_clock::duration>(
+      std::chrono::nanoseconds(TimeUtil::TimestampToNanoseconds(t))));
+}
+
+// The frame's metadata; pixels only when `with_pixels`.
+void FillFrame(const framestore::GreyFrame& frame, bool with_pixels, const std::string& sha256,
+               v1::Frame* out) {
+  out->set_camera(ToProto(frame.camera));
+  out->set_width(static_cast<std::uint32_t>(frame.width));
+  out->set_height(static_cast<std::uint32_t>(frame.height));
+  out->set_stride(static_cast<std::uint32_t>(frame.stride));
+  if (with_pixels) out->set_pixels(frame.pixels.data(), frame.pixels.size());
+  out->set_gain(frame.gain);
+  out->set_sequence(frame.sequence);
+  *out->mutable_delivered() = ToProto(frame.timestamps.wall);
+  out->set_requested_monotonic_ns(MonotonicNs(frame.timestamps.requested));
+  out->set_exposed_monotonic_ns(MonotonicNs(frame.timestamps.exposed));
+  out->set_delivered_monotonic_ns(MonotonicNs(frame.timestamps.delivered));
+  out->set_sha256(sha256);
+}
+
+void FillStoredFrame(const store::StoredFrameInfo& info, v1::Frame* out) {
+  out->set_camera(ToProto(info.camera));
+  out->set_width(static_cast<std::uint32_t>(info.width));
+  out->set_height(static_cast<std::uint32_t>(info.height));
+  out->set_stride(static_cast<std::uint32_t>(info.width));
+  out->set_gain(info.gain);
+  out->set_sequence(info.sequence);
+  *out->mutable_delivered() = ToProto(info.timestamps.wall);
+  out->set_requested_monotonic_ns(MonotonicNs(info.timestamps.requested));
+  out->set_exposed_monotonic_ns(MonotonicNs(info.timestamps.exposed));
+  out->set_delivered_monotonic_ns(MonotonicNs(info.timestamps.delivered));
+  out->set_sha256(info.sha256);
+}
+
+void FillInfo(const store::CaptureInfo& info, v1::CaptureInfo* out) {
+  out->set_capture_id(info.id.str());
+  out->set_session_id(info.session_id);
+  out->set_patient_reference(info.patient_reference);
+  out->set_side(ToProto(info.side));
+  out->set_slide(info.slide);
+  out->set_software_version(info.software_version);
+  out->set_requested_by_uid(info.requested_by.uid);
+  out->set_requested_by(info.requested_by.name);
+  *out->mutable_taken() = ToProto(info.taken_wall);
+  *out->mutable_stored() = ToProto(info.stored_wall);
+  out->set_total_bytes(info.total_bytes);
+  for (const store::StoredFrameInfo& frame : info.frames) FillStoredFrame(frame, out->add_frames());
+}
+
+// A text field within the store's limit, else the field named.
+grpc::Status CheckText(const std::string& value, const char* field) {
+  if (value.size() > store::kMaxTextField)
+    return Invalid(std::string(field) + " is " + std::to_string(value.size()) +
+                   " bytes; at most " + std::to_string(store::kMaxTextField) + " are accepted");
+  return grpc::Status::OK;
+}
+
+}  // namespace
+
+CaptureService::CaptureService(CaptureDevice* device, store::CaptureStore* store,
+                               slides::SlideController* slides, EventHub* events,
+                               const PeerRegistry* peers, const RolePolicy* policy,
+                               ServiceLimits limits, std::string software_version)
+    : device_(device),
+      store_(store),
+      slides_(slides),
+      events_(events),
+      peers_(peers),
+      policy_(policy),
+      limits_(limits),
+      software_version_(std::move(software_version)) {}
+
+grpc::Status CaptureService::Authorize(grpc::ServerContext* context, std::string_view method,
+                                       Caller* caller) {
+  const std::string full = std::string(kMethodPrefix) + std::string(method);
+  std::optional<Caller> found = peers_->Find(context->peer());
+  if (!found) {
+    // A TCP caller: its identity is the verified client certificate.
+    const std::shared_ptr<const grpc::AuthContext> auth = context->auth_context();
+    if (auth && auth->IsPeerAuthenticated()) {
+      for (const grpc::string_ref& cn : auth->FindPropertyValues("x509_common_name")) {
+        Caller tcp;
+        tcp.name.assign(cn.data(), cn.size());
+        tcp.transport = "tcp";
+        tcp.role = policy_->RoleOfCertificate(tcp.name);
+        found = tcp;
+        break;
+      }
+    }
+  }
+  if (!found)
+    return {grpc::StatusCode::UNAUTHENTICATED,
+            "bslsd cannot tell who is calling on " + context->peer() +
+                ": connect through the daemon's Unix socket or with a client certificate"};
+  *caller = *found;
+  const Role needed = RequiredRole(full);
+  if (caller->role < needed) {
+    spdlog::warn("refused {} to {}: needs role {}", method, caller->Describe(), ToString(needed));
+    return {grpc::StatusCode::PERMISSION_DENIED,
+            std::string(method) + " needs the " + std::string(ToString(needed)) + " role; " +
+                caller->Describe() + " does not have it"};
+  }
+  return grpc::Status::OK;
+}
+
+Clock::time_point CaptureService::Deadline(const grpc::ServerContext* context) const {
+  const Clock::time_point now = Clock::now();
+  if (context->deadline() == std::chrono::system_clock::time_point::max())
+    return now + limits_.default_deadline;  // a client that set none
+  const auto remaining = std::chrono::duration_cast<Clock::duration>(
+      context->deadline() - std::chrono::system_clock::now());
+  return now + std::min<Clock::duration>(remaining, limits_.max_deadline);
+}
+
+void CaptureService::FillStatus(const Caller& caller, v1::DeviceStatus* reply) {
+  const DeviceSnapshot device = device_->Snapshot();
+  reply->set_backend(device.capabilities.backend);
+  reply->set_device(device.capabilities.device);
+  reply->set_available(device.available);
+  reply->set_availability_reason(device.availability_reason);
+  for (Camera camera : device.capabilities.cameras) reply->add_cameras(ToProto(camera));
+  reply->set_selected_camera(ToProto(device.camera));
+  v1::GainRange* gain = reply->mutable_gain_range();
+  gain->set_min(device.capabilities.gain.min);
+  gain->set_max(device.capabilities.gain.max);
+  gain->set_nominal(device.capabilities.gain.nominal);
+  gain->set_unit(device.capabilities.gain.unit);
+  reply->set_gain(device.gain);
+  reply->set_width(static_cast<std::uint32_t>(device.capabilities.width));
+  reply->set_height(static_cast<std::uint32_t>(device.capabilities.height));
+  reply->set_preview_rate_hz(device.preview_rate_hz);
+  FillSlideState(reply->mutable_slide());
+  reply->set_software_version(software_version_);
+  if (framestore::Result<store::StoreUsage> usage = store_->Usage(); usage.ok()) {
+    reply->set_captures_stored(usage->captures);
+    reply->set_store_free_bytes(usage->free_bytes);
+  }
+  reply->set_caller_role(std::string(ToString(caller.role)));
+}
+
+grpc::Status CaptureService::GetStatus(grpc::ServerContext* context, const v1::GetStatusRequest*,
+                                       v1::DeviceStatus* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "GetStatus", &caller); !s.ok()) return s;
+  FillStatus(caller, reply);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::SelectCamera(grpc::ServerContext* context,
+                                          const v1::SelectCameraRequest* request,
+                                          v1::DeviceStatus* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "SelectCamera", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  const std::optional<Camera> camera = FromProto(request->camera());
+  if (!camera)
+    return Invalid("camera " + std::to_string(request->camera()) +
+                   " is not a camera: use CAMERA_LEFT, CAMERA_RIGHT or CAMERA_THIRD");
+  if (grpc::Status s = ToGrpc(device_->SelectCamera(*camera, Deadline(context))); !s.ok()) return s;
+  spdlog::info("camera {} selected by {}", framestore::ToString(*camera), caller.Describe());
+  FillStatus(caller, reply);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::SetGain(grpc::ServerContext* context,
+                                     const v1::SetGainRequest* request, v1::DeviceStatus* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "SetGain", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  if (grpc::Status s = ToGrpc(device_->SetGain(request->gain(), Deadline(context))); !s.ok())
+    return s;
+  spdlog::info("gain {} set by {}", request->gain(), caller.Describe());
+  FillStatus(caller, reply);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::StreamPreview(grpc::ServerContext* context,
+                                           const v1::PreviewRequest* request,
+                                           grpc::ServerWriter<v1::PreviewFrame>* writer) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "StreamPreview", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  std::optional<Camera> camera;
+  if (request->camera() != v1::CAMERA_UNSPECIFIED) {
+    camera = FromProto(request->camera());
+    if (!camera || !device_->Snapshot().capabilities.HasCamera(*camera))
+      return Invalid("preview camera " + std::to_string(request->camera()) +
+                     " is not one of the device's cameras");
+  }
+  if (request->decimation() > 250)
+    return Invalid("preview decimation " + std::to_string(request->decimation()) +
+                   " is above 250 (10 s between frames)");
+  if (++preview_streams_ > limits_.max_preview_streams) {
+    --preview_streams_;
+    return {grpc::StatusCode::RESOURCE_EXHAUSTED,
+            "bslsd already serves " + std::to_string(limits_.max_preview_streams) +
+                " preview streams; close one first"};
+  }
+  struct Release {
+    std::atomic<int>& count;
+    ~Release() { --count; }
+  } release{preview_streams_};
+
+  const std::uint32_t every = std::max<std::uint32_t>(1, request->decimation());
+  std::unique_ptr<CaptureDevice::Preview> preview = device_->OpenPreview();
+  std::uint64_t skipped = 0;
+  std::uint32_t counter = 0;
+  while (!context->IsCancelled() && !draining_) {
+    std::uint64_t dropped = 0;
+    std::shared_ptr<const framestore::GreyFrame> frame =
+        preview->Next(Clock::now() + std::chrono::milliseconds(250), &dropped);
+    if (!frame) continue;
+    skipped += dropped;
+    // A preview of another camera than the selected one waits for it.
+    if ((camera && frame->camera != *camera) || (counter++ % every) != 0) continue;
+    v1::PreviewFrame message;
+    FillFrame(*frame, true, "", message.mutable_frame());
+    message.set_dropped(skipped);
+    skipped = 0;
+    if (!writer->Write(message)) break;  // the client went away
+  }
+  return draining_ ? Draining() : grpc::Status::OK;
+}
+
+grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRequest* request,
+                                  v1::GrabResponse* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "Grab", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  GrabSides sides;
+  store::Side side;
+  switch (request->side()) {
+    case v1::GRAB_SIDE_LEFT:
+      sides = GrabSides::kLeft;
+      side = store::Side::kLeft;
+      break;
+    case v1::GRAB_SIDE_RIGHT:
+      sides = GrabSides::kRight;
+      side = store::Side::kRight;
+      break;
+    case v1::GRAB_SIDE_BOTH:
+      sides = GrabSides::kBoth;
+      side = store::Side::kBoth;
+      break;
+    default:
+      return Invalid("grab side " + std::to_string(request->side()) +
+                     " is not a side: use GRAB_SIDE_LEFT, GRAB_SIDE_RIGHT or GRAB_SIDE_BOTH");
+  }
+  if (grpc::Status s = CheckText(request->session_id(), "session_id"); !s.ok()) return s;
+  if (grpc::Status s = CheckText(request->patient_reference(), "patient_reference"); !s.ok())
+    return s;
+
+  framestore::Result<std::vector<framestore::GreyFrame>> frames =
+      device_->Grab(sides, Deadline(context));
+  if (!frames.ok()) {
+    spdlog::error("grab {} for {} failed: {}", store::ToString(side), caller.Describe(),
+                  frames.status().ToString());
+    return ToGrpc(frames.status());
+  }
+  store::CaptureRequest capture;
+  capture.session_id = request->session_id();
+  capture.patient_reference = request->patient_reference();
+  capture.side = side;
+  capture.slide = slides_ ? slides_->State().slide : 0;
+  capture.software_version = software_version_;
+  capture.requested_by = {caller.uid, caller.name};
+  capture.frames = std::move(frames).value();
+  framestore::Result<store::CaptureInfo> stored = store_->Put(capture);
+  if (!stored.ok()) {
+    spdlog::error("grab {} for {} not stored: {}", store::ToString(side), caller.Describe(),
+                  stored.status().ToString());
+    return ToGrpc(stored.status());
+  }
+  ++grabs_acknowledged_;
+  spdlog::info("grab {} stored as {} for {}", store::ToString(side), stored->id.str(),
+               caller.Describe());
+  FillInfo(*stored, reply->mutable_capture());
+  if (request->include_frames())
+    for (std::size_t i = 0; i < capture.frames.size(); ++i)
+      reply->mutable_capture()->mutable_frames(static_cast<int>(i))->set_pixels(
+          capture.frames[i].pixels.data(), capture.frames[i].pixels.size());
+  v1::Event event;
+  v1::CaptureStored* note = event.mutable_capture_stored();
+  note->set_capture_id(stored->id.str());
+  note->set_side(ToProto(side));
+  note->set_requested_by(caller.name);
+  events_->Publish(std::move(event));
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::ListCaptures(grpc::ServerContext* context,
+                                          const v1::ListCapturesRequest* request,
+                                          v1::ListCapturesResponse* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "ListCaptures", &caller); !s.ok()) return s;
+  if (request->page_size() < 0 || request->page_size() > store::kMaxPageSize)
+    return Invalid("page_size " + std::to_string(request->page_size()) + " is outside 0.." +
+                   std::to_string(store::kMaxPageSize));
+  store::CaptureFilter filter;
+  if (!request->session_id().empty()) filter.session_id = request->session_id();
+  if (!request->patient_reference().empty()) filter.patient_reference = request->patient_reference();
+  if (request->has_taken_from()) filter.taken_from = FromProto(request->taken_from());
+  if (request->has_taken_before()) filter.taken_before = FromProto(request->taken_before());
+  filter.page_size = request->page_size();
+  filter.page_token = request->page_token();
+  framestore::Result<store::CapturePage> page = store_->List(filter);
+  if (!page.ok()) return ToGrpc(page.status());
+  for (const store::CaptureInfo& info : page->captures) FillInfo(info, reply->add_captures());
+  reply->set_next_page_token(page->next_page_token);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::GetCapture(grpc::ServerContext* context,
+                                        const v1::GetCaptureRequest* request,
+                                        v1::CaptureInfo* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "GetCapture", &caller); !s.ok()) return s;
+  framestore::Result<store::Capture> capture = store_->Get(request->capture_id());
+  if (!capture.ok()) return ToGrpc(capture.status());
+  FillInfo(capture->info, reply);
+  for (std::size_t i = 0; i < capture->frames.size(); ++i) {
+    const framestore::GreyFrame& frame = capture->frames[i];
+    reply->mutable_frames(static_cast<int>(i))->set_pixels(frame.pixels.data(),
+                                                           frame.pixels.size());
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::DeleteCapture(grpc::ServerContext* context,
+                                           const v1::DeleteCaptureRequest* request,
+                                           v1::DeleteCaptureResponse*) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "DeleteCapture", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  if (grpc::Status s = ToGrpc(store_->Delete(request->capture_id())); !s.ok()) return s;
+  spdlog::info("capture {} deleted by {}", request->capture_id(), caller.Describe());
+  v1::Event event;
+  event.mutable_capture_deleted()->set_capture_id(request->capture_id());
+  event.mutable_capture_deleted()->set_deleted_by(caller.name);
+  events_->Publish(std::move(event));
+  return grpc::Status::OK;
+}
+
+void CaptureService::FillSlideState(v1::SlideState* reply) const {
+  if (slides_ == nullptr) {
+    reply->set_last_error("no slide controller is configured");
+    return;
+  }
+  const slides::SlideState state = slides_->State();
+  reply->set_slide(state.slide);
+  reply->set_in_place(state.in_place);
+  reply->set_moving(state.moving);
+  reply->set_lamp_on(state.lamp_on);
+  reply->set_focus_position(state.focus_position);
+  reply->set_last_error(state.last_error);
+}
+
+namespace {
+
+grpc::Status NoSlides() {
+  return {grpc::StatusCode::UNAVAILABLE,
+          "bslsd has no slide controller (slides.backend is none in its configuration)"};
+}
+
+}  // namespace
+
+grpc::Status CaptureService::GetSlideState(grpc::ServerContext* context,
+                                           const v1::GetSlideStateRequest*,
+                                           v1::SlideState* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "GetSlideState", &caller); !s.ok()) return s;
+  FillSlideState(reply);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::SetSlide(grpc::ServerContext* context,
+                                      const v1::SetSlideRequest* request, v1::SlideState* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "SetSlide", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  if (slides_ == nullptr) return NoSlides();
+  if (request->slide() < 1 || request->slide() > 3)
+    return Invalid("slide " + std::to_string(request->slide()) +
+                   " does not exist: 1 reference, 2 left pattern, 3 right pattern");
+  spdlog::info("slide {} requested by {}", request->slide(), caller.Describe());
+  if (grpc::Status s = ToGrpc(slides_->ChangeTo(request->slide(), Deadline(context))); !s.ok()) {
+    spdlog::error("slide {} for {} failed: {}", request->slide(), caller.Describe(),
+                  s.error_message());
+    return s;
+  }
+  FillSlideState(reply);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::SetFocus(grpc::ServerContext* context,
+                                      const v1::SetFocusRequest* request, v1::SlideState* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "SetFocus", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  if (slides_ == nullptr) return NoSlides();
+  if (request->steps() < -1000 || request->steps() > 1000)
+    return Invalid("focus steps " + std::to_string(request->steps()) + " is outside -1000..1000");
+  spdlog::info("focus {:+d} steps by {}", request->steps(), caller.Describe());
+  if (grpc::Status s = ToGrpc(slides_->Focus(request->steps(), Deadline(context))); !s.ok())
+    return s;
+  FillSlideState(reply);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::SetLamp(grpc::ServerContext* context,
+                                     const v1::SetLampRequest* request, v1::SlideState* reply) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "SetLamp", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  if (slides_ == nullptr) return NoSlides();
+  spdlog::info("lamp {} by {}", request->on() ? "on" : "off", caller.Describe());
+  if (grpc::Status s = ToGrpc(slides_->SetLamp(request->on())); !s.ok()) return s;
+  FillSlideState(reply);
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::WatchEvents(grpc::ServerContext* context,
+                                         const v1::WatchEventsRequest*,
+                                         grpc::ServerWriter<v1::Event>* writer) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "WatchEvents", &caller); !s.ok()) return s;
+  if (draining_) return Draining();
+  if (++event_streams_ > limits_.max_event_streams) {
+    --event_streams_;
+    return {grpc::StatusCode::RESOURCE_EXHAUSTED,
+            "bslsd already serves " + std::to_string(limits_.max_event_streams) +
+                " event streams; close one first"};
+  }
+  struct Release {
+    std::atomic<int>& count;
+    ~Release() { --count; }
+  } release{event_streams_};
+  std::unique_ptr<EventHub::Watcher> watcher = events_->Watch();
+  // The client learns at once that the stream is open.
+  writer->SendInitialMetadata();
+  while (!context->IsCancelled() && !draining_) {
+    std::uint64_t dropped = 0;
+    std::optional<v1::Event> event =
+        watcher->Next(Clock::now() + std::chrono::milliseconds(250), &dropped);
+    if (!event) continue;
+    if (dropped > 0) {
+      v1::Event lost;
+      *lost.mutable_time() = event->time();
+      lost.mutable_error()->set_message(std::to_string(dropped) +
+                                        " events were dropped: this watcher read too slowly");
+      if (!writer->Write(lost)) break;
+    }
+    if (!writer->Write(*event)) break;
+  }
+  return draining_ ? Draining() : grpc::Status::OK;
+}
+
+}  // namespace bsls::service

@@ -1,0 +1,165 @@
+#include "bsls/service/unix_listener.h"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <pwd.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <grpcpp/server.h>
+#include <grpcpp/server_posix.h>
+#include <vector>
+
+namespace bsls::service {
+
+using framestore::ErrorCode;
+using framestore::Result;
+using framestore::Status;
+
+void PeerRegistry::Add(const std::string& peer, Caller caller) {
+  std::lock_guard lock(mutex_);
+  callers_[peer] = std::move(caller);
+}
+
+std::optional<Caller> PeerRegistry::Find(const std::string& peer) const {
+  std::lock_guard lock(mutex_);
+  auto it = callers_.find(peer);
+  if (it == callers_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::size_t PeerRegistry::size() const {
+  std::lock_guard lock(mutex_);
+  return callers_.size();
+}
+
+namespace {
+
+std::string Errno(const std::string& what) { return what + ": " + std::strerror(errno); }
+
+std::string UserName(uid_t uid) {
+  std::vector<char> buffer(16384);
+  passwd entry{};
+  passwd* found = nullptr;
+  if (::getpwuid_r(uid, &entry, buffer.data(), buffer.size(), &found) == 0 && found != nullptr)
+    return found->pw_name;
+  return "uid" + std::to_string(uid);
+}
+
+// True when something accepts connections on the socket at `path`.
+bool SocketIsLive(const sockaddr_un& address) {
+  const int probe = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (probe < 0) return false;
+  const bool live =
+      ::connect(probe, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
+  ::close(probe);
+  return live;
+}
+
+}  // namespace
+
+UnixListener::UnixListener(UnixListenerOptions options, int fd)
+    : options_(std::move(options)), fd_(fd) {}
+
+Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOptions& options) {
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (options.path.empty() || options.path.size() >= sizeof(address.sun_path))
+    return Status(ErrorCode::kInvalidArgument,
+                  "socket path '" + options.path + "' is empty or longer than " +
+                      std::to_string(sizeof(address.sun_path) - 1) + " bytes");
+  std::memcpy(address.sun_path, options.path.c_str(), options.path.size() + 1);
+
+  struct stat existing {};
+  if (::lstat(options.path.c_str(), &existing) == 0) {
+    if (!S_ISSOCK(existing.st_mode))
+      return Status(ErrorCode::kAlreadyExists,
+                    "socket path " + options.path + " exists and is not a socket");
+    if (SocketIsLive(address))
+      return Status(ErrorCode::kAlreadyExists,
+                    "another daemon is listening on " + options.path);
+    ::unlink(options.path.c_str());  // left by a daemon that died
+  }
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+  if (fd < 0) return Status(ErrorCode::kUnavailable, Errno("socket(AF_UNIX)"));
+  // The file is created with the umask applied; permissions are set next,
+  // before anyone is accepted.
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
+    Status status(errno == EACCES ? ErrorCode::kPermissionDenied : ErrorCode::kUnavailable,
+                  Errno("bind " + options.path));
+    ::close(fd);
+    return status;
+  }
+  if (::chmod(options.path.c_str(), options.mode) != 0 ||
+      (options.group && ::chown(options.path.c_str(), static_cast<uid_t>(-1), *options.group) != 0)) {
+    Status status(ErrorCode::kPermissionDenied, Errno("setting owner/mode of " + options.path));
+    ::close(fd);
+    ::unlink(options.path.c_str());
+    return status;
+  }
+  if (::listen(fd, options.backlog) != 0) {
+    Status status(ErrorCode::kUnavailable, Errno("listen " + options.path));
+    ::close(fd);
+    ::unlink(options.path.c_str());
+    return status;
+  }
+  std::unique_ptr<UnixListener> listener(new UnixListener(options, fd));
+  if (::pipe2(listener->wake_, O_CLOEXEC) != 0)
+    return Status(ErrorCode::kUnavailable, Errno("pipe"));
+  return listener;
+}
+
+UnixListener::~UnixListener() {
+  Stop();
+  if (fd_ >= 0) ::close(fd_);
+  for (int& end : wake_)
+    if (end >= 0) ::close(end);
+}
+
+void UnixListener::Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy) {
+  thread_ = std::thread([this, server, registry, policy] { AcceptLoop(server, registry, policy); });
+}
+
+void UnixListener::Stop() {
+  if (thread_.joinable()) {
+    const char byte = 0;
+    [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
+    thread_.join();
+    ::unlink(options_.path.c_str());
+  }
+}
+
+void UnixListener::AcceptLoop(grpc::Server* server, PeerRegistry* registry,
+                              const RolePolicy* policy) {
+  for (;;) {
+    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
+    if (::poll(fds, 2, -1) < 0) {
+      if (errno == EINTR) continue;
+      return;
+    }
+    if (fds[1].revents != 0) return;
+    const int connection = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
+    if (connection < 0) continue;  // EAGAIN, ECONNABORTED, EMFILE: try the next one
+    ucred credentials{};
+    socklen_t length = sizeof(credentials);
+    if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &credentials, &length) != 0) {
+      ::close(connection);
+      continue;
+    }
+    Caller caller;
+    caller.uid = credentials.uid;
+    caller.name = UserName(credentials.uid);
+    caller.transport = "unix";
+    caller.role = policy->RoleOfUid(credentials.uid);
+    // gRPC names the connection after the descriptor it is given.
+    registry->Add("fd:" + std::to_string(connection), std::move(caller));
+    ++accepted_;
+    grpc::AddInsecureChannelFromFd(server, connection);
+  }
+}
+
+}  // namespace bsls::service

@@ -1,0 +1,156 @@
+// Starts the real bslsd executable for the integration tests: a temporary
+// directory holds its configuration, store and Unix socket; the tests talk
+// to it over gRPC like any client and stop it with signals.
+#ifndef BSLS_TESTS_DAEMON_DAEMON_PROCESS_H_
+#define BSLS_TESTS_DAEMON_DAEMON_PROCESS_H_
+
+#include <grpcpp/grpcpp.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bsls/v1/capture.grpc.pb.h"
+
+namespace bsls::testing {
+
+namespace fs = std::filesystem;
+
+// A fresh directory under the test temp dir, world-searchable so that
+// callers of other uids reach the socket inside.
+inline fs::path MakeDaemonDir(const std::string& name) {
+  const fs::path dir = fs::path(::testing::TempDir()) /
+                       ("bslsd_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  ::chmod(dir.c_str(), 0755);
+  return dir;
+}
+
+// The configuration file of a test daemon: simulated devices unless
+// `extra` says otherwise (YAML appended verbatim, top-level keys).
+inline fs::path WriteDaemonConfig(const fs::path& dir, const std::string& extra = {}) {
+  const fs::path path = dir / "bslsd.yaml";
+  std::ofstream out(path);
+  out << "store:\n  root: " << (dir / "store").string() << "\n  reserve_mib: 16\n"
+      << "listen:\n  unix_socket: " << (dir / "bslsd.sock").string() << "\n  socket_mode: \"0666\"\n"
+      << "log_level: warn\n"
+      // A still head: one rendered view per camera and slide (rendering is
+      // the simulated framestore's only slow step).
+      << "framestore:\n  simulated_breathing_mm: 0\n"
+      << extra;
+  return path;
+}
+
+class DaemonProcess {
+ public:
+  // Starts bslsd with `config` and extra arguments; stdout and stderr go to
+  // <dir>/bslsd.log. Returns once the socket answers GetStatus (or after
+  // `timeout`, with ready() false).
+  DaemonProcess(const fs::path& dir, const fs::path& config, std::vector<std::string> args = {},
+                std::chrono::seconds timeout = std::chrono::seconds(120))
+      : dir_(dir), socket_(dir / "bslsd.sock") {
+    std::vector<std::string> argv = {BSLSD_PATH, "--config", config.string()};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const std::string log = (dir / "bslsd.log").string();
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      std::vector<char*> raw;
+      for (std::string& a : argv) raw.push_back(a.data());
+      raw.push_back(nullptr);
+      ::execv(raw[0], raw.data());
+      ::_exit(127);
+    }
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (std::chrono::steady_clock::now() < until && !exited()) {
+      if (fs::exists(socket_)) {
+        auto stub = Stub();
+        grpc::ClientContext context;
+        context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(2));
+        v1::DeviceStatus status;
+        if (stub->GetStatus(&context, {}, &status).ok()) {
+          ready_ = true;
+          break;
+        }
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
+  ~DaemonProcess() {
+    if (pid_ > 0 && !exited()) Kill();
+  }
+
+  bool ready() const { return ready_; }
+  pid_t pid() const { return pid_; }
+  const fs::path& socket() const { return socket_; }
+  // The daemon's log so far (for failure messages).
+  std::string Log() const {
+    std::ifstream in(dir_ / "bslsd.log");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  }
+
+  // A new channel to the daemon's socket.
+  std::shared_ptr<grpc::Channel> Channel() const {
+    return grpc::CreateChannel("unix:" + socket_.string(), grpc::InsecureChannelCredentials());
+  }
+  std::unique_ptr<v1::CaptureDaemon::Stub> Stub() const { return v1::CaptureDaemon::NewStub(Channel()); }
+
+  // SIGTERM, then waits up to `timeout`: the exit status (-1 if it did not exit).
+  int Terminate(std::chrono::seconds timeout = std::chrono::seconds(60)) {
+    ::kill(pid_, SIGTERM);
+    return Wait(timeout);
+  }
+  // SIGKILL and reap.
+  void Kill() {
+    ::kill(pid_, SIGKILL);
+    Wait(std::chrono::seconds(30));
+  }
+  // The exit code once the process ended (-1 while it runs or if killed).
+  int Wait(std::chrono::seconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (!exited() && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    return exit_code_;
+  }
+  bool exited() {
+    if (reaped_) return true;
+    int status = 0;
+    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+      reaped_ = true;
+      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    }
+    return reaped_;
+  }
+
+ private:
+  fs::path dir_;
+  fs::path socket_;
+  pid_t pid_ = -1;
+  bool ready_ = false;
+  bool reaped_ = false;
+  int exit_code_ = -1;
+};
+
+// A client context with a deadline (our clients always set one).
+inline std::unique_ptr<grpc::ClientContext> Deadline(std::chrono::milliseconds ms) {
+  auto context = std::make_unique<grpc::ClientContext>();
+  context->set_deadline(std::chrono::system_clock::now() + ms);
+  return context;
+}
+
+}  // namespace bsls::testing
+
+#endif  // BSLS_TESTS_DAEMON_DAEMON_PROCESS_H_

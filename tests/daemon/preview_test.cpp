@@ -1,0 +1,88 @@
+// Preview to four clients at once, one of them reading slowly (issue 4, "Done
+// means"): the others keep the camera's 25 frames/s. Timing depends on the
+// machine, so this test is labelled `timing` (not run under the sanitizers).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdio>
+#include <thread>
+
+#include "daemon_process.h"
+
+namespace bsls::testing {
+namespace {
+
+using std::chrono::milliseconds;
+using Clock = std::chrono::steady_clock;
+
+struct StreamFigures {
+  int frames = 0;          // received inside the window
+  std::uint64_t dropped = 0;
+  bool ok = true;
+};
+
+// Reads previews until `end`; counts those that arrive after `window_start`.
+StreamFigures ReadPreview(v1::CaptureDaemon::Stub& stub, Clock::time_point window_start,
+                          Clock::time_point end, milliseconds pause) {
+  StreamFigures figures;
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() +
+                       std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                           end - Clock::now() + std::chrono::seconds(5)));
+  auto reader = stub.StreamPreview(&context, {});
+  v1::PreviewFrame frame;
+  while (Clock::now() < end && reader->Read(&frame)) {
+    if (Clock::now() >= window_start) {
+      ++figures.frames;
+      figures.dropped += frame.dropped();
+    }
+    if (pause.count() > 0) std::this_thread::sleep_for(pause);
+  }
+  context.TryCancel();
+  while (reader->Read(&frame)) {
+  }
+  reader->Finish().IgnoreError();
+  return figures;
+}
+
+TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
+  const fs::path dir = MakeDaemonDir("preview");
+  const fs::path config = WriteDaemonConfig(dir, "roles:\n  admin: [root]\n");
+  DaemonProcess daemon(dir, config);
+  ASSERT_TRUE(daemon.ready()) << daemon.Log();
+
+  // Warm-up: one breathing period renders every phase of the view once.
+  {
+    auto stub = daemon.Stub();
+    const Clock::time_point now = Clock::now();
+    ReadPreview(*stub, now, now + std::chrono::seconds(5), milliseconds(0));
+  }
+  constexpr double kWindowSeconds = 5.0;
+  const Clock::time_point start = Clock::now() + std::chrono::seconds(1);
+  const Clock::time_point end =
+      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kWindowSeconds));
+  StreamFigures figures[4];
+  std::vector<std::thread> clients;
+  for (int i = 0; i < 4; ++i) {
+    clients.emplace_back([&, i] {
+      auto stub = daemon.Stub();  // each client its own connection
+      figures[i] = ReadPreview(*stub, start, end, i == 3 ? milliseconds(250) : milliseconds(0));
+    });
+  }
+  for (std::thread& t : clients) t.join();
+  for (int i = 0; i < 3; ++i) {
+    const double fps = figures[i].frames / kWindowSeconds;
+    std::printf("[ figures  ] client %d: %.1f frames/s, %llu dropped\n", i, fps,
+                static_cast<unsigned long long>(figures[i].dropped));
+    EXPECT_GE(fps, 24.0) << "client " << i;
+  }
+  const double slow_fps = figures[3].frames / kWindowSeconds;
+  std::printf("[ figures  ] slow client: %.1f frames/s, %llu dropped\n", slow_fps,
+              static_cast<unsigned long long>(figures[3].dropped));
+  EXPECT_GT(figures[3].dropped, 0u);  // it was told what it missed
+  EXPECT_LE(slow_fps, 5.0);
+  EXPECT_EQ(daemon.Terminate(), 0) << daemon.Log();
+}
+
+}  // namespace
+}  // namespace bsls::testing

@@ -1,0 +1,28 @@
+#!/usr/bin/env bash
+# The hardened unit's exposure as systemd rates it (issue 4: at most 2.5), and
+# the unit, sysusers and tmpfiles files as systemd parses them.
+set -euo pipefail
+unit=$1
+limit=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cp "$unit" "$work/"
+name=$(basename "$unit")
+report=$(systemd-analyze security --offline=true --no-pager "$work/$name" 2>&1)
+exposure=$(printf '%s\n' "$report" | sed -n 's/.*Overall exposure level for [^:]*: \([0-9.]*\).*/\1/p')
+if [ -z "$exposure" ]; then
+  printf '%s\n' "$report"
+  echo "FAIL: systemd-analyze gave no exposure level for $name"
+  exit 1
+fi
+echo "$name: exposure $exposure (limit $limit)"
+if ! awk -v e="$exposure" -v l="$limit" 'BEGIN { exit !(e <= l) }'; then
+  printf '%s\n' "$report" | grep '✗'
+  echo "FAIL: exposure $exposure of $name is above $limit"
+  exit 1
+fi
+# The unit parses without warnings about unknown settings.
+if systemd-analyze verify --man=no "$work/$name" 2>&1 | grep -i "unknown\|invalid\|failed to parse"; then
+  echo "FAIL: systemd-analyze verify complains about $name"
+  exit 1
+fi
