@@ -1,7 +1,7 @@
 # The libraries the fuzz targets explore (tests/fuzz): built with libFuzzer's
 # coverage instrumentation when BSLS_FUZZ is on, and the fuzz programs.
 set(BSLS_FUZZ_COVERAGE bsls_decoder bsls_extraction bsls_interpretation bsls_pattern
-    decoder_fuzz)
+    decoder_fuzz bsls_capture_service bsls_slides capture_service_fuzz)
 
 # Common compile settings for every BSLS target.
 function(bsls_target_defaults target)

@@ -21,19 +21,11 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
-#include <grpcpp/grpcpp.h>
-#include <grpcpp/security/server_credentials.h>
 #include <memory>
 #include <spdlog/spdlog.h>
-#include <sstream>
 
-#include "backends.h"
-#include "bsls/service/capture_device.h"
-#include "bsls/service/capture_service.h"
-#include "bsls/service/event_hub.h"
-#include "bsls/service/unix_listener.h"
 #include "config.h"
+#include "daemon.h"
 #include "privileges.h"
 
 #ifndef BSLS_VERSION
@@ -69,18 +61,10 @@ class Watchdog {
   std::atomic<std::chrono::steady_clock::rep> last_{0};
 };
 
-std::string ReadFile(const std::string& path, bool* ok) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  *ok = static_cast<bool>(in) || in.eof();
-  return buffer.str();
-}
-
 int Run(const bslsd::Config& config) {
   spdlog::set_level(spdlog::level::from_str(config.log_level));
-  framestore::Result<service::RolePolicy> policy = bslsd::ResolveRoles(config.roles);
-  if (!policy.ok()) {
+  if (framestore::Result<service::RolePolicy> policy = bslsd::ResolveRoles(config.roles);
+      !policy.ok()) {
     spdlog::critical("{}", policy.status().message());
     return kExitConfig;
   }
@@ -106,123 +90,23 @@ int Run(const bslsd::Config& config) {
   sigaddset(&signals, SIGHUP);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 
-  // 3. The store: recovery reports damaged acknowledged captures, never drops them.
-  framestore::Result<std::unique_ptr<store::CaptureStore>> opened =
-      store::CaptureStore::Open(config.store);
-  if (!opened.ok()) {
-    spdlog::critical("capture store: {}", opened.status().ToString());
-    return kExitRuntime;
-  }
-  std::unique_ptr<store::CaptureStore> captures = std::move(opened).value();
-  const store::RecoveryReport& recovery = captures->recovery_report();
-  spdlog::info("capture store {}: {} captures checked, {} damaged, {} leftovers removed",
-               config.store.root, recovery.captures_checked, recovery.problems.size(),
-               recovery.temp_files_removed + recovery.orphan_files_removed);
-  for (const store::CaptureProblem& problem : recovery.problems)
-    spdlog::error("capture {} is damaged: {}", problem.id, problem.status.message());
-
-  // 4. Slides and framestore.
-  service::EventHub events;
-  framestore::Result<std::unique_ptr<slides::SlideController>> slide_controller =
-      bslsd::OpenSlides(config, &events);
-  if (!slide_controller.ok()) {
-    spdlog::critical("{}", slide_controller.status().message());
-    return kExitRuntime;
-  }
-  std::unique_ptr<slides::SlideController> slides = std::move(slide_controller).value();
-  framestore::Result<std::unique_ptr<framestore::Framestore>> framestore_opened =
-      bslsd::OpenFramestore(config, std::move(privileged).value(), slides.get());
-  if (!framestore_opened.ok()) {
-    spdlog::critical("{}", framestore_opened.status().message());
-    return framestore_opened.status().code() == framestore::ErrorCode::kInvalidArgument
-               ? kExitConfig
-               : kExitRuntime;
-  }
-  spdlog::info("framestore: {}", (*framestore_opened)->capabilities().device);
-
+  // 3. Everything else, then serve.
   Watchdog watchdog;
-  service::DeviceCallbacks callbacks;
-  callbacks.tick = [&watchdog] { watchdog.Feed(); };
-  callbacks.lost = [&events](const std::string& reason) {
-    spdlog::error("framestore lost: {}", reason);
-    v1::Event event;
-    event.mutable_device_lost()->set_reason(reason);
-    events.Publish(std::move(event));
-  };
-  callbacks.found = [&events](const std::string& device) {
-    spdlog::info("framestore found again: {}", device);
-    v1::Event event;
-    event.mutable_device_found()->set_device(device);
-    events.Publish(std::move(event));
-  };
-  callbacks.camera_changed = [&events](framestore::Camera camera, int gain) {
-    v1::Event event;
-    event.mutable_camera_changed()->set_camera(
-        static_cast<v1::Camera>(static_cast<int>(camera) + 1));
-    event.mutable_camera_changed()->set_gain(gain);
-    events.Publish(std::move(event));
-  };
-  service::CaptureDevice device(std::move(framestore_opened).value(), callbacks);
-
-  // 5. The service.
-  service::PeerRegistry peers;
-  service::CaptureService service(&device, captures.get(), slides.get(), &events, &peers,
-                                  &*policy, config.limits, BSLS_VERSION);
-  grpc::ServerBuilder builder;
-  builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
-  builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
-  grpc::ResourceQuota quota("bslsd");
-  quota.SetMaxThreads(64);
-  builder.SetResourceQuota(quota);
-  builder.RegisterService(&service);
-  int tcp_port = 0;
-  if (!config.listen.tcp.empty()) {
-    bool ok_cert = false, ok_key = false, ok_ca = false;
-    grpc::SslServerCredentialsOptions tls(GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
-    tls.pem_root_certs = ReadFile(config.listen.tls_client_ca, &ok_ca);
-    tls.pem_key_cert_pairs.push_back(
-        {ReadFile(config.listen.tls_key, &ok_key), ReadFile(config.listen.tls_certificate, &ok_cert)});
-    if (!ok_cert || !ok_key || !ok_ca) {
-      spdlog::critical("listen.tcp: cannot read the TLS files {}, {}, {}",
-                       config.listen.tls_certificate, config.listen.tls_key,
-                       config.listen.tls_client_ca);
-      return kExitConfig;
-    }
-    builder.AddListeningPort(config.listen.tcp, grpc::SslServerCredentials(tls), &tcp_port);
+  framestore::Result<std::unique_ptr<bslsd::Daemon>> started = bslsd::Daemon::Start(
+      config, std::move(privileged).value(), [&watchdog] { watchdog.Feed(); });
+  if (!started.ok()) {
+    spdlog::critical("{}", started.status().message());
+    return started.status().code() == framestore::ErrorCode::kInvalidArgument ? kExitConfig
+                                                                             : kExitRuntime;
   }
-  std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
-  if (!server || (!config.listen.tcp.empty() && tcp_port == 0)) {
-    spdlog::critical("the gRPC server could not start (TCP {})", config.listen.tcp);
-    return kExitRuntime;
-  }
-  std::unique_ptr<service::UnixListener> listener;
-  if (!config.listen.unix_socket.empty()) {
-    service::UnixListenerOptions options;
-    options.path = config.listen.unix_socket;
-    options.mode = static_cast<mode_t>(config.listen.socket_mode);
-    if (!config.listen.socket_group.empty()) {
-      group* entry = ::getgrnam(config.listen.socket_group.c_str());
-      if (entry == nullptr) {
-        spdlog::critical("listen.socket_group: group '{}' does not exist",
-                         config.listen.socket_group);
-        return kExitConfig;
-      }
-      options.group = entry->gr_gid;
-    }
-    framestore::Result<std::unique_ptr<service::UnixListener>> created =
-        service::UnixListener::Create(options);
-    if (!created.ok()) {
-      spdlog::critical("{}", created.status().message());
-      return kExitRuntime;
-    }
-    listener = std::move(created).value();
-    listener->Start(server.get(), &peers, &*policy);
-  }
+  std::unique_ptr<bslsd::Daemon> daemon = std::move(started).value();
   spdlog::info("bslsd {} serving on {}{}", BSLS_VERSION, config.listen.unix_socket,
-               tcp_port ? " and TCP port " + std::to_string(tcp_port) + " (mutual TLS)" : "");
+               daemon->tcp_port() ? " and TCP port " + std::to_string(daemon->tcp_port()) +
+                                        " (mutual TLS)"
+                                  : "");
   sd_notify(0, "READY=1\nSTATUS=serving");
 
-  // 6. Until SIGTERM/SIGINT; retention runs once a minute meanwhile.
+  // 4. Until SIGTERM/SIGINT; retention runs once a minute meanwhile.
   for (;;) {
     timespec minute{60, 0};
     const int signal = sigtimedwait(&signals, nullptr, &minute);
@@ -230,24 +114,11 @@ int Run(const bslsd::Config& config) {
       spdlog::info("signal {}: draining", signal);
       break;
     }
-    if (config.store.retention.max_age || config.store.retention.max_total_bytes) {
-      framestore::Result<store::RetentionReport> report =
-          captures->ApplyRetention(std::chrono::system_clock::now());
-      if (!report.ok())
-        spdlog::error("retention: {}", report.status().message());
-      else if (!report->deleted.empty())
-        spdlog::info("retention deleted {} captures ({} bytes)", report->deleted.size(),
-                     report->bytes_freed);
-    }
+    daemon->ApplyRetention();
   }
   sd_notify(0, "STOPPING=1\nSTATUS=draining");
-  service.BeginDrain();
-  if (listener) listener->Stop();
-  events.Close();
-  // Calls under way (a grab being stored) finish; then the rest are cancelled.
-  server->Shutdown(std::chrono::system_clock::now() + config.drain_timeout);
-  server->Wait();
-  spdlog::info("bslsd stopped after {} acknowledged grabs", service.grabs_acknowledged());
+  daemon->Drain();
+  spdlog::info("bslsd stopped after {} acknowledged grabs", daemon->grabs_acknowledged());
   return 0;
 }
 

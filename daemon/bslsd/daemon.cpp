@@ -1,0 +1,163 @@
+#include "daemon.h"
+
+#include <grp.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <grpcpp/security/server_credentials.h>
+#include <sstream>
+
+#ifndef BSLS_VERSION
+#define BSLS_VERSION "unknown"
+#endif
+
+namespace bsls::bslsd {
+
+using framestore::ErrorCode;
+using framestore::Result;
+using framestore::Status;
+
+namespace {
+
+Result<std::string> ReadPem(const std::string& path, const char* key) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status(ErrorCode::kInvalidArgument, std::string(key) + ": cannot read " + path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+v1::Camera ToProto(framestore::Camera camera) {
+  return static_cast<v1::Camera>(static_cast<int>(camera) + 1);
+}
+
+}  // namespace
+
+Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDevices privileged,
+                                              std::function<void()> tick) {
+  std::unique_ptr<Daemon> d(new Daemon);
+  d->config_ = config;
+  Result<service::RolePolicy> policy = ResolveRoles(config.roles);
+  if (!policy.ok()) return policy.status();
+  d->policy_ = std::move(policy).value();
+
+  // The store: recovery reports damaged acknowledged captures, never drops them.
+  Result<std::unique_ptr<store::CaptureStore>> opened = store::CaptureStore::Open(config.store);
+  if (!opened.ok())
+    return Status(opened.status().code(), "capture store: " + opened.status().message());
+  d->store_ = std::move(opened).value();
+  const store::RecoveryReport& recovery = d->store_->recovery_report();
+  spdlog::info("capture store {}: {} captures checked, {} damaged, {} leftovers removed",
+               config.store.root, recovery.captures_checked, recovery.problems.size(),
+               recovery.temp_files_removed + recovery.orphan_files_removed);
+  for (const store::CaptureProblem& problem : recovery.problems)
+    spdlog::error("capture {} is damaged: {}", problem.id, problem.status.message());
+
+  Result<std::unique_ptr<slides::SlideController>> slides = OpenSlides(config, &d->events_);
+  if (!slides.ok()) return slides.status();
+  d->slides_ = std::move(slides).value();
+  Result<std::unique_ptr<framestore::Framestore>> framestore =
+      OpenFramestore(config, std::move(privileged), d->slides_.get());
+  if (!framestore.ok()) return framestore.status();
+  spdlog::info("framestore: {}", (*framestore)->capabilities().device);
+
+  service::EventHub* events = &d->events_;
+  service::DeviceCallbacks callbacks;
+  callbacks.tick = std::move(tick);
+  callbacks.lost = [events](const std::string& reason) {
+    spdlog::error("framestore lost: {}", reason);
+    v1::Event event;
+    event.mutable_device_lost()->set_reason(reason);
+    events->Publish(std::move(event));
+  };
+  callbacks.found = [events](const std::string& device) {
+    spdlog::info("framestore found again: {}", device);
+    v1::Event event;
+    event.mutable_device_found()->set_device(device);
+    events->Publish(std::move(event));
+  };
+  callbacks.camera_changed = [events](framestore::Camera camera, int gain) {
+    v1::Event event;
+    event.mutable_camera_changed()->set_camera(ToProto(camera));
+    event.mutable_camera_changed()->set_gain(gain);
+    events->Publish(std::move(event));
+  };
+  d->device_ =
+      std::make_unique<service::CaptureDevice>(std::move(framestore).value(), std::move(callbacks));
+  d->service_ = std::make_unique<service::CaptureService>(
+      d->device_.get(), d->store_.get(), d->slides_.get(), &d->events_, &d->peers_, &d->policy_,
+      config.limits, BSLS_VERSION);
+
+  grpc::ServerBuilder builder;
+  builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
+  builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
+  grpc::ResourceQuota quota("bslsd");
+  quota.SetMaxThreads(64);
+  builder.SetResourceQuota(quota);
+  builder.RegisterService(d->service_.get());
+  if (!config.listen.tcp.empty()) {
+    // Mutual TLS only: a client without a certificate signed by the CA fails the handshake.
+    grpc::SslServerCredentialsOptions tls(
+        GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
+    Result<std::string> ca = ReadPem(config.listen.tls_client_ca, "listen.tls_client_ca");
+    Result<std::string> key = ReadPem(config.listen.tls_key, "listen.tls_key");
+    Result<std::string> cert = ReadPem(config.listen.tls_certificate, "listen.tls_certificate");
+    for (const Result<std::string>* pem : {&ca, &key, &cert})
+      if (!pem->ok()) return pem->status();
+    tls.pem_root_certs = *ca;
+    tls.pem_key_cert_pairs.push_back({*key, *cert});
+    builder.AddListeningPort(config.listen.tcp, grpc::SslServerCredentials(tls), &d->tcp_port_);
+  }
+  d->server_ = builder.BuildAndStart();
+  if (!d->server_ || (!config.listen.tcp.empty() && d->tcp_port_ == 0))
+    return Status(ErrorCode::kUnavailable,
+                  "the gRPC server could not start" +
+                      (config.listen.tcp.empty() ? std::string()
+                                                 : " on TCP " + config.listen.tcp));
+  if (!config.listen.unix_socket.empty()) {
+    service::UnixListenerOptions options;
+    options.path = config.listen.unix_socket;
+    options.mode = static_cast<mode_t>(config.listen.socket_mode);
+    if (!config.listen.socket_group.empty()) {
+      group* entry = ::getgrnam(config.listen.socket_group.c_str());
+      if (entry == nullptr)
+        return Status(ErrorCode::kInvalidArgument, "listen.socket_group: group '" +
+                                                       config.listen.socket_group +
+                                                       "' does not exist");
+      options.group = entry->gr_gid;
+    }
+    Result<std::unique_ptr<service::UnixListener>> listener =
+        service::UnixListener::Create(options);
+    if (!listener.ok()) return listener.status();
+    d->listener_ = std::move(listener).value();
+    d->listener_->Start(d->server_.get(), &d->peers_, &d->policy_);
+  }
+  return d;
+}
+
+Daemon::~Daemon() { Drain(); }
+
+void Daemon::Drain() {
+  if (drained_) return;
+  drained_ = true;
+  if (service_) service_->BeginDrain();
+  if (listener_) listener_->Stop();
+  events_.Close();
+  if (server_) {
+    // Calls under way (a grab being stored) finish; then the rest are cancelled.
+    server_->Shutdown(std::chrono::system_clock::now() + config_.drain_timeout);
+    server_->Wait();
+  }
+}
+
+void Daemon::ApplyRetention() {
+  if (!config_.store.retention.max_age && !config_.store.retention.max_total_bytes) return;
+  Result<store::RetentionReport> report = store_->ApplyRetention(std::chrono::system_clock::now());
+  if (!report.ok())
+    spdlog::error("retention: {}", report.status().message());
+  else if (!report->deleted.empty())
+    spdlog::info("retention deleted {} captures ({} bytes)", report->deleted.size(),
+                 report->bytes_freed);
+}
+
+}  // namespace bsls::bslsd
