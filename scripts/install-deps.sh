@@ -17,14 +17,16 @@ packages=(
   # capture daemon: store, hardware, services, privileges
   libsqlite3-dev                    # durable capture index
   libusb-1.0-0-dev                  # USB framestore
+  zlib1g-dev                        # CRC-32 of the USB framestore protocol
   libgpiod-dev                      # slide controller (v1.6 API)
   libcap-dev                        # dropping capabilities
   libsystemd-dev                    # sd_notify, watchdog
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
-  python3-grpcio python3-protobuf python3-grpc-tools
+  python3-grpcio python3-protobuf python3-grpc-tools python3-numpy
   systemd                           # systemd-analyze security in the tests
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev
+  openssl                           # test certificates for the mutual-TLS tests
   python3
 )
 

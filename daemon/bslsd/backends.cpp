@@ -7,6 +7,8 @@
 #include "bsls/framestore/isa_card_emulator.h"
 #include "bsls/framestore/isa_framestore.h"
 #include "bsls/framestore/simulated_framestore.h"
+#include "bsls/framestore/usb_device_model.h"
+#include "bsls/framestore/usb_framestore.h"
 #include "bsls/slides/emulated_slide_changer.h"
 
 namespace bsls::bslsd {
@@ -168,8 +170,31 @@ Result<std::unique_ptr<framestore::Framestore>> OpenFramestore(const Config& con
       return std::unique_ptr<framestore::Framestore>(std::move(store).value());
     }
     case Backend::kUsb:
-      return Status(ErrorCode::kUnavailable,
-                    "framestore.backend usb: this build has no USB framestore backend yet");
+    case Backend::kEmulatedUsb: {
+      std::unique_ptr<framestore::UsbTransport> transport;
+      if (config.framestore.backend == Backend::kEmulatedUsb) {
+        framestore::SimulatedFramestoreParams params = SimulatedParams(config, slides);
+        params.paced = false;
+        params.breathing_amplitude_mm = 0.0;
+        params.breathing_phases = 1;
+        Result<std::unique_ptr<framestore::SimulatedFramestore>> source =
+            framestore::SimulatedFramestore::Open(params);
+        if (!source.ok()) return source.status();
+        auto video = std::make_shared<SimulatedVideo>(std::move(source).value());
+        for (int input = 0; input < 2; ++input) video->Picture(input, -2);
+        transport = std::make_unique<framestore::UsbDeviceModel>(
+            [video](int input, std::int64_t frame) { return video->Picture(input, frame); });
+      } else {
+        Result<std::unique_ptr<framestore::UsbTransport>> opened =
+            framestore::OpenLibusbTransport();
+        if (!opened.ok()) return opened.status();
+        transport = std::move(opened).value();
+      }
+      Result<std::unique_ptr<framestore::UsbFramestore>> store =
+          framestore::UsbFramestore::Open(std::move(transport));
+      if (!store.ok()) return store.status();
+      return std::unique_ptr<framestore::Framestore>(std::move(store).value());
+    }
   }
   return Status(ErrorCode::kInvalidArgument, "framestore.backend is not known");
 }

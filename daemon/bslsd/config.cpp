@@ -81,7 +81,9 @@ void ParseFramestore(const YAML::Node& node, FramestoreConfig& out) {
     else if (backend == "isa") out.backend = Backend::kIsa;
     else if (backend == "emulated-isa") out.backend = Backend::kEmulatedIsa;
     else if (backend == "usb") out.backend = Backend::kUsb;
-    else Fail("framestore.backend", "'" + backend + "' is not simulated, isa, emulated-isa or usb");
+    else if (backend == "emulated-usb") out.backend = Backend::kEmulatedUsb;
+    else Fail("framestore.backend",
+              "'" + backend + "' is not simulated, isa, emulated-isa, usb or emulated-usb");
   }
   int base = out.isa_base;
   ReadInRange(node, "framestore", "isa_base", base, 0x100, 0x3FC);
@@ -370,6 +372,8 @@ std::string Dump(const Config& config) {
         return "emulated-isa";
       case Backend::kUsb:
         return "usb";
+      case Backend::kEmulatedUsb:
+        return "emulated-usb";
     }
     return "?";
   };

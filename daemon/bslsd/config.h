@@ -21,7 +21,7 @@
 namespace bsls::bslsd {
 
 // Which framestore backend the daemon opens.
-enum class Backend { kSimulated, kIsa, kEmulatedIsa, kUsb };
+enum class Backend { kSimulated, kIsa, kEmulatedIsa, kUsb, kEmulatedUsb };
 
 struct FramestoreConfig {
   Backend backend = Backend::kSimulated;

@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
   app.add_option("--set", overrides, "override a key, e.g. --set framestore.backend=usb")
       ->take_all();
   app.add_flag("--check-config", check, "check the configuration, print it and exit");
-  app.add_option("--backend", backend, "framestore.backend: simulated, isa, emulated-isa, usb");
+  app.add_option("--backend", backend, "framestore.backend: simulated, isa, emulated-isa, usb, emulated-usb");
   app.add_option("--store", store_root, "store.root: the capture store's directory");
   app.add_option("--socket", socket, "listen.unix_socket");
   app.add_option("--tcp", tcp, "listen.tcp (host:port, mutual TLS)");
