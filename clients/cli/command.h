@@ -6,6 +6,9 @@
 //   2  the command line is wrong
 //   3  an input file is missing, unreadable or not usable
 //   4  an output file could not be written
+//   5  a service could not be reached, or did not answer in time (try again)
+//   6  a service refused the caller (no certificate, or a role without the right)
+//   7  a service could not do it (device failed, disk full, damaged frame)
 //   70 an internal error (a bug: please report it)
 #ifndef BSLS_CLIENTS_CLI_COMMAND_H_
 #define BSLS_CLIENTS_CLI_COMMAND_H_
@@ -26,6 +29,9 @@ enum ExitCode : int {
   kExitUsage = 2,
   kExitInput = 3,
   kExitOutput = 4,
+  kExitUnavailable = 5,
+  kExitRefused = 6,
+  kExitServiceFailed = 7,
   kExitInternal = 70,
 };
 
@@ -55,6 +61,9 @@ void AddSimulateCalibrationCommand(CLI::App& app);
 void AddReconstructCommand(CLI::App& app);
 // Adds `bsls measure` to the application.
 void AddMeasureCommand(CLI::App& app);
+// Adds the capture daemon's commands: `bsls status`, `camera`, `gain`,
+// `slide`, `grab`, `captures`, `preview`.
+void AddDeviceCommands(CLI::App& app);
 
 // The side calibration in a calibration file; CommandError (exit 3) naming
 // the file and the reason when it cannot be used.

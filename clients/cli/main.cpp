@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   AddSimulateCalibrationCommand(app);
   AddReconstructCommand(app);
   AddMeasureCommand(app);
+  AddDeviceCommands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

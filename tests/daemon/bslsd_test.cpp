@@ -2,7 +2,10 @@
 // socket and store, driven over gRPC (issue 4, "Done means").
 #include <gtest/gtest.h>
 #include <openssl/sha.h>
+#include <arpa/inet.h>
 #include <grp.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -13,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "bsls/testing/certificates.h"
 #include "daemon_process.h"
 
 namespace bsls::testing {
@@ -390,6 +394,115 @@ TEST_F(Bslsd, EmulatedIsaCardBackendGrabsBothSides) {
   });
   EXPECT_LT(static_cast<unsigned char>(*lo), 30);
   EXPECT_GT(static_cast<unsigned char>(*hi), 150);
+}
+
+TEST_F(Bslsd, EmulatedUsbFramestoreBackendGrabsBothSides) {
+  Start("usb", kSimulatedSlides, {"--backend", "emulated-usb"});
+  auto stub = daemon_->Stub();
+  v1::DeviceStatus status;
+  ASSERT_TRUE(stub->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
+  EXPECT_EQ(status.backend(), "usb");
+  grpc::Status grab;
+  const v1::GrabResponse reply = GrabBoth(*stub, "usb", &grab, true);
+  ASSERT_TRUE(grab.ok()) << grab.error_message();
+  ASSERT_EQ(reply.capture().frames_size(), 2);
+  EXPECT_EQ(PixelHash(reply.capture().frames(1)), reply.capture().frames(1).sha256());
+}
+
+// A TCP port on loopback that nothing listens on right now.
+int FreeLoopbackPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  int port = 0;
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0)
+    port = ntohs(address.sin_port);
+  ::close(fd);
+  return port;
+}
+
+// A stub over TCP with `client` as the client certificate (none when its
+// key is empty), trusting `server_ca`.
+std::unique_ptr<v1::CaptureDaemon::Stub> TlsStub(int port, const fs::path& server_ca,
+                                                 const PemFiles& client) {
+  grpc::SslCredentialsOptions tls;
+  tls.pem_root_certs = ReadText(server_ca);
+  if (!client.key.empty()) {
+    tls.pem_private_key = ReadText(client.key);
+    tls.pem_cert_chain = ReadText(client.certificate);
+  }
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);  // a fresh handshake per stub
+  return v1::CaptureDaemon::NewStub(grpc::CreateCustomChannel(
+      "127.0.0.1:" + std::to_string(port), grpc::SslCredentials(tls), args));
+}
+
+// Remote callers: TCP is mutual TLS only, the certificate's common name is
+// the caller and maps to a role; no certificate, or one from another CA,
+// never gets past the handshake; the Unix socket keeps working beside it.
+TEST_F(Bslsd, TcpServesOnlyMutualTlsCallersWithTheirCertificatesRole) {
+  dir_ = MakeDaemonDir("tls");
+  TestPki pki(dir_ / "pki", "clinic");
+  const PemFiles server = pki.Issue("localhost", true);
+  const PemFiles analyst = pki.Issue("analyst");
+  const PemFiles station = pki.Issue("station");
+  const PemFiles stranger = pki.Issue("stranger");
+  TestPki rogue(dir_ / "pki", "rogue");
+  const PemFiles forged = rogue.Issue("station");
+  ASSERT_TRUE(pki.ok() && rogue.ok()) << "openssl could not make the test certificates";
+  const int port = FreeLoopbackPort();
+  ASSERT_GT(port, 0);
+  config_ = WriteDaemonConfig(dir_, std::string(kSimulatedSlides) +
+                                        "roles:\n  admin: [root]\n  certificates:\n"
+                                        "    analyst: viewer\n    station: operator\n");
+  daemon_ = std::make_unique<DaemonProcess>(
+      dir_, config_,
+      std::vector<std::string>{"--tcp", "127.0.0.1:" + std::to_string(port), "--set",
+                               "listen.tls_certificate=" + server.certificate.string(), "--set",
+                               "listen.tls_key=" + server.key.string(), "--set",
+                               "listen.tls_client_ca=" + pki.ca().string()});
+  ASSERT_TRUE(daemon_->ready()) << daemon_->Log();
+
+  // The analyst (viewer) sees the status but may not grab.
+  auto viewer = TlsStub(port, pki.ca(), analyst);
+  v1::DeviceStatus status;
+  grpc::Status call = viewer->GetStatus(Deadline(milliseconds(10000)).get(), {}, &status);
+  ASSERT_TRUE(call.ok()) << call.error_message() << "\n" << daemon_->Log();
+  EXPECT_EQ(status.caller_role(), "viewer");
+  GrabBoth(*viewer, "remote", &call);
+  EXPECT_EQ(call.error_code(), grpc::StatusCode::PERMISSION_DENIED) << call.error_message();
+
+  // The station (operator) grabs; the capture records who asked.
+  auto operator_stub = TlsStub(port, pki.ca(), station);
+  const v1::GrabResponse grab = GrabBoth(*operator_stub, "remote", &call);
+  ASSERT_TRUE(call.ok()) << call.error_message();
+  EXPECT_EQ(grab.capture().requested_by(), "station");
+
+  // A certificate of the right CA whose name has no role: refused by role.
+  auto unknown = TlsStub(port, pki.ca(), stranger);
+  call = unknown->GetStatus(Deadline(milliseconds(10000)).get(), {}, &status);
+  EXPECT_EQ(call.error_code(), grpc::StatusCode::PERMISSION_DENIED) << call.error_message();
+
+  // No client certificate, or one signed by another CA: the handshake fails, every time.
+  int successes = 0;
+  for (int i = 0; i < 20; ++i) {
+    auto anonymous = TlsStub(port, pki.ca(), PemFiles{});
+    auto impostor = TlsStub(port, pki.ca(), forged);
+    for (auto* stub : {anonymous.get(), impostor.get()}) {
+      call = stub->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status);
+      successes += call.ok();
+      EXPECT_EQ(call.error_code(), grpc::StatusCode::UNAVAILABLE) << call.error_message();
+    }
+  }
+  EXPECT_EQ(successes, 0);
+
+  // The local socket is unaffected, and the remote grab is in the store.
+  auto local = daemon_->Stub();
+  ASSERT_TRUE(local->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
+  EXPECT_EQ(status.captures_stored(), 1u);
 }
 
 // The roles of issue 4 tried on every call: uids 60001-60004 are viewer,

@@ -17,6 +17,9 @@ import grpc
 
 from bsls_client import CaptureClient, CaptureError
 
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
+from test_pki import free_port, make_pki  # noqa: E402
+
 BSLSD = None
 
 
@@ -25,11 +28,18 @@ class DaemonTest(unittest.TestCase):
     def setUpClass(cls):
         cls.dir = tempfile.mkdtemp(prefix="bslsd_python_")
         cls.socket = os.path.join(cls.dir, "bslsd.sock")
+        cls.pki = staticmethod(make_pki(cls.dir, clients=("analyst",)))
+        cls.port = free_port()
         config = os.path.join(cls.dir, "bslsd.yaml")
         with open(config, "w") as out:
             out.write(f"store:\n  root: {cls.dir}/store\n  reserve_mib: 16\n"
                       f"listen:\n  unix_socket: {cls.socket}\n"
+                      f"  tcp: 127.0.0.1:{cls.port}\n"
+                      f"  tls_certificate: {cls.pki('server.pem')}\n"
+                      f"  tls_key: {cls.pki('server.key')}\n"
+                      f"  tls_client_ca: {cls.pki('ca.pem')}\n"
                       "roles:\n  admin: [root]\n  others: admin\n"
+                      "  certificates:\n    analyst: viewer\n"
                       "slides:\n  backend: simulated\nlog_level: warn\n")
         cls.log = open(os.path.join(cls.dir, "bslsd.log"), "w")
         cls.daemon = subprocess.Popen([BSLSD, "--config", config], stdout=cls.log,
@@ -109,6 +119,29 @@ class DaemonTest(unittest.TestCase):
         with self.assertRaises(CaptureError) as raised:
             self.client.capture(capture.capture_id)
         self.assertEqual(raised.exception.code, grpc.StatusCode.NOT_FOUND)
+
+    def test_remote_analyst_over_mutual_tls_reads_but_may_not_grab(self):
+        taken = self.client.grab("left", session_id="py-remote", include_frames=True)
+
+        def read(name):
+            with open(self.pki(name), "rb") as f:
+                return f.read()
+        with CaptureClient.tcp(f"127.0.0.1:{self.port}", read("ca.pem"), read("analyst.pem"),
+                               read("analyst.key"), timeout=30) as remote:
+            self.assertEqual(remote.status().caller_role, "viewer")
+            fetched = remote.capture(taken.capture_id)
+            self.assertTrue(all(frame.verify() for frame in fetched.frames))
+            self.assertEqual(fetched.frames[0].sha256, taken.frames[0].sha256)
+            with self.assertRaises(CaptureError) as raised:
+                remote.grab("left")
+            self.assertEqual(raised.exception.code, grpc.StatusCode.PERMISSION_DENIED)
+        # Without a client certificate the handshake never completes.
+        anonymous = CaptureClient(grpc.secure_channel(
+            f"127.0.0.1:{self.port}", grpc.ssl_channel_credentials(read("ca.pem"))), timeout=5)
+        with self.assertRaises(CaptureError) as raised:
+            anonymous.status()
+        self.assertEqual(raised.exception.code, grpc.StatusCode.UNAVAILABLE)
+        anonymous.close()
 
 
 if __name__ == "__main__":
