@@ -77,6 +77,25 @@ class SimulatedVideo {
   std::int64_t last_frame_ = -1;
 };
 
+// The video inputs of an emulated device (ISA card or USB firmware model): a
+// still simulated head per camera, rendered up front (a view renders in tens
+// of milliseconds, longer than the card's digitise timeout); the emulated
+// device keeps its own video timing.
+Result<framestore::VideoSource> EmulatedVideo(const Config& config,
+                                              slides::SlideController* slides) {
+  framestore::SimulatedFramestoreParams params = SimulatedParams(config, slides);
+  params.paced = false;
+  params.breathing_amplitude_mm = 0.0;
+  params.breathing_phases = 1;
+  Result<std::unique_ptr<framestore::SimulatedFramestore>> source =
+      framestore::SimulatedFramestore::Open(params);
+  if (!source.ok()) return source.status();
+  auto video = std::make_shared<SimulatedVideo>(std::move(source).value());
+  for (int input = 0; input < 2; ++input) video->Picture(input, -2);
+  return framestore::VideoSource(
+      [video](int input, std::int64_t frame) { return video->Picture(input, frame); });
+}
+
 }  // namespace
 
 Result<PrivilegedDevices> OpenPrivileged(const Config& config) {
@@ -145,21 +164,11 @@ Result<std::unique_ptr<framestore::Framestore>> OpenFramestore(const Config& con
     case Backend::kEmulatedIsa: {
       std::unique_ptr<framestore::PortIo> io = std::move(privileged.port_io);
       if (config.framestore.backend == Backend::kEmulatedIsa) {
-        framestore::SimulatedFramestoreParams params = SimulatedParams(config, slides);
-        params.paced = false;  // the emulated card keeps the video timing
-        // One still head: a view renders in tens of milliseconds, longer
-        // than the card's digitise timeout, so both are rendered up front.
-        params.breathing_amplitude_mm = 0.0;
-        params.breathing_phases = 1;
-        Result<std::unique_ptr<framestore::SimulatedFramestore>> source =
-            framestore::SimulatedFramestore::Open(params);
-        if (!source.ok()) return source.status();
-        auto video = std::make_shared<SimulatedVideo>(std::move(source).value());
-        for (int input = 0; input < 2; ++input) video->Picture(input, -2);
+        Result<framestore::VideoSource> video = EmulatedVideo(config, slides);
+        if (!video.ok()) return video.status();
         framestore::IsaCardEmulatorParams card;
         card.base = config.framestore.isa_base;
-        io = std::make_unique<framestore::IsaCardEmulator>(
-            card, [video](int input, std::int64_t frame) { return video->Picture(input, frame); });
+        io = std::make_unique<framestore::IsaCardEmulator>(card, std::move(video).value());
       }
       if (!io) return Status(ErrorCode::kInternal, "the ISA backend's ports were not opened");
       framestore::IsaFramestoreParams params;
@@ -173,17 +182,9 @@ Result<std::unique_ptr<framestore::Framestore>> OpenFramestore(const Config& con
     case Backend::kEmulatedUsb: {
       std::unique_ptr<framestore::UsbTransport> transport;
       if (config.framestore.backend == Backend::kEmulatedUsb) {
-        framestore::SimulatedFramestoreParams params = SimulatedParams(config, slides);
-        params.paced = false;
-        params.breathing_amplitude_mm = 0.0;
-        params.breathing_phases = 1;
-        Result<std::unique_ptr<framestore::SimulatedFramestore>> source =
-            framestore::SimulatedFramestore::Open(params);
-        if (!source.ok()) return source.status();
-        auto video = std::make_shared<SimulatedVideo>(std::move(source).value());
-        for (int input = 0; input < 2; ++input) video->Picture(input, -2);
-        transport = std::make_unique<framestore::UsbDeviceModel>(
-            [video](int input, std::int64_t frame) { return video->Picture(input, frame); });
+        Result<framestore::VideoSource> video = EmulatedVideo(config, slides);
+        if (!video.ok()) return video.status();
+        transport = std::make_unique<framestore::UsbDeviceModel>(std::move(video).value());
       } else {
         Result<std::unique_ptr<framestore::UsbTransport>> opened =
             framestore::OpenLibusbTransport();

@@ -10,12 +10,10 @@ import json
 import os
 import subprocess
 import sys
-import tempfile
-import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from test_pki import free_port, make_pki  # noqa: E402
+from bslsd_harness import Bslsd  # noqa: E402
 
 BSLS = None
 BSLSD = None
@@ -26,41 +24,21 @@ EXIT_OK, EXIT_USAGE, EXIT_INPUT, EXIT_UNAVAILABLE, EXIT_REFUSED = 0, 2, 3, 5, 6
 class DeviceCliTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.dir = tempfile.mkdtemp(prefix="bsls_device_cli_")
-        cls.socket = os.path.join(cls.dir, "bslsd.sock")
-        cls.pki = staticmethod(make_pki(cls.dir))
-        cls.port = free_port()
-        config = os.path.join(cls.dir, "bslsd.yaml")
-        with open(config, "w") as out:
-            out.write(f"store:\n  root: {cls.dir}/store\n  reserve_mib: 16\n"
-                      f"listen:\n  unix_socket: {cls.socket}\n"
-                      f"  tcp: 127.0.0.1:{cls.port}\n"
-                      f"  tls_certificate: {cls.pki('server.pem')}\n"
-                      f"  tls_key: {cls.pki('server.key')}\n"
-                      f"  tls_client_ca: {cls.pki('ca.pem')}\n"
-                      "roles:\n  admin: [root]\n  certificates:\n    station: operator\n"
-                      "framestore:\n  simulated_breathing_mm: 0\n"
-                      "slides:\n  backend: simulated\nlog_level: warn\n")
-        cls.log = open(os.path.join(cls.dir, "bslsd.log"), "w")
-        cls.daemon = subprocess.Popen([BSLSD, "--config", config], stdout=cls.log,
-                                      stderr=subprocess.STDOUT)
-        deadline = time.monotonic() + 120
-        while cls.bsls("status").returncode != EXIT_OK:
-            if time.monotonic() > deadline or cls.daemon.poll() is not None:
-                raise RuntimeError("bslsd did not start: " +
-                                   open(os.path.join(cls.dir, "bslsd.log")).read())
-            time.sleep(0.2)
+        cls.daemon = Bslsd(BSLSD, lambda socket: cls.bsls("status", daemon="unix:" + socket)
+                           .returncode == EXIT_OK,
+                           "  admin: [root]\n  certificates:\n    station: operator\n",
+                           prefix="bsls_device_cli_")
+        cls.dir, cls.socket, cls.port = cls.daemon.dir, cls.daemon.socket, cls.daemon.port
+        cls.pki = staticmethod(cls.daemon.pki)
 
     @classmethod
     def tearDownClass(cls):
-        cls.daemon.terminate()
-        code = cls.daemon.wait(60)
-        cls.log.close()
+        code = cls.daemon.stop()
         assert code == 0, f"bslsd exited with {code}"
 
     @classmethod
     def bsls(cls, *args, daemon=None):
-        return subprocess.run([BSLS, *args, "--daemon", daemon or "unix:" + cls.socket,
+        return subprocess.run([BSLS, *args, "--daemon", daemon or "unix:" + cls.daemon.socket,
                                "--timeout", "60"],
                               capture_output=True, text=True, timeout=180)
 

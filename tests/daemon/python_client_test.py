@@ -6,9 +6,7 @@ the statuses of bad input.
     python_client_test.py BSLSD [unittest args]
 """
 import os
-import subprocess
 import sys
-import tempfile
 import threading
 import time
 import unittest
@@ -18,7 +16,7 @@ import grpc
 from bsls_client import CaptureClient, CaptureError
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from test_pki import free_port, make_pki  # noqa: E402
+from bslsd_harness import Bslsd  # noqa: E402
 
 BSLSD = None
 
@@ -26,42 +24,24 @@ BSLSD = None
 class DaemonTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.dir = tempfile.mkdtemp(prefix="bslsd_python_")
-        cls.socket = os.path.join(cls.dir, "bslsd.sock")
-        cls.pki = staticmethod(make_pki(cls.dir, clients=("analyst",)))
-        cls.port = free_port()
-        config = os.path.join(cls.dir, "bslsd.yaml")
-        with open(config, "w") as out:
-            out.write(f"store:\n  root: {cls.dir}/store\n  reserve_mib: 16\n"
-                      f"listen:\n  unix_socket: {cls.socket}\n"
-                      f"  tcp: 127.0.0.1:{cls.port}\n"
-                      f"  tls_certificate: {cls.pki('server.pem')}\n"
-                      f"  tls_key: {cls.pki('server.key')}\n"
-                      f"  tls_client_ca: {cls.pki('ca.pem')}\n"
-                      "roles:\n  admin: [root]\n  others: admin\n"
-                      "  certificates:\n    analyst: viewer\n"
-                      "slides:\n  backend: simulated\nlog_level: warn\n")
-        cls.log = open(os.path.join(cls.dir, "bslsd.log"), "w")
-        cls.daemon = subprocess.Popen([BSLSD, "--config", config], stdout=cls.log,
-                                      stderr=subprocess.STDOUT)
-        cls.client = CaptureClient.unix(cls.socket, timeout=60)
-        deadline = time.monotonic() + 120
-        while True:
+        def ready(socket):
             try:
-                cls.client.status()
-                break
+                CaptureClient.unix(socket, timeout=5).status()
+                return True
             except CaptureError:
-                if time.monotonic() > deadline or cls.daemon.poll() is not None:
-                    raise RuntimeError("bslsd did not start: " +
-                                       open(os.path.join(cls.dir, "bslsd.log")).read())
-                time.sleep(0.1)
+                return False
+        cls.daemon = Bslsd(BSLSD, ready,
+                           "  admin: [root]\n  others: admin\n"
+                           "  certificates:\n    analyst: viewer\n",
+                           certificates=("analyst",), prefix="bslsd_python_")
+        cls.socket, cls.port = cls.daemon.socket, cls.daemon.port
+        cls.pki = staticmethod(cls.daemon.pki)
+        cls.client = CaptureClient.unix(cls.socket, timeout=60)
 
     @classmethod
     def tearDownClass(cls):
         cls.client.close()
-        cls.daemon.terminate()
-        code = cls.daemon.wait(60)
-        cls.log.close()
+        code = cls.daemon.stop()
         assert code == 0, f"bslsd exited with {code}"
 
     def test_scripted_session_stores_every_grab_with_its_slide(self):
