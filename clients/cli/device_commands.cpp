@@ -29,16 +29,33 @@ const std::map<std::string, v1::GrabSide> kSides = {
 const std::map<std::string, int> kSlides = {{"reference", 1}, {"1", 1},     {"left", 2},
                                             {"2", 2},         {"right", 3}, {"3", 3}};
 
-std::string CameraName(v1::Camera camera) {
-  for (const auto& [name, value] : kCameras)
-    if (value == camera) return name;
+// The name under which `names` holds `value`; "unspecified" when none.
+template <typename Enum>
+std::string NameOf(const std::map<std::string, Enum>& names, Enum value) {
+  for (const auto& [name, entry] : names)
+    if (entry == value) return name;
   return "unspecified";
 }
 
-std::string SideName(v1::GrabSide side) {
-  for (const auto& [name, value] : kSides)
-    if (value == side) return name;
-  return "unspecified";
+std::string CameraName(v1::Camera camera) { return NameOf(kCameras, camera); }
+std::string SideName(v1::GrabSide side) { return NameOf(kSides, side); }
+
+// Creates the output folder `dir` (of option -o); CommandError (exit 4) when it cannot.
+void MakeFolder(const std::string& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec)
+    throw CommandError(kExitOutput, "-o " + dir + ": cannot create the folder: " + ec.message());
+}
+
+// The frame's pixels as an image (no copy); CommandError (exit 7) naming
+// `what` when the message holds fewer bytes than its size says.
+cv::Mat FrameImage(const v1::Frame& frame, const std::string& what) {
+  if (frame.stride() < frame.width() ||
+      frame.pixels().size() < static_cast<std::size_t>(frame.stride()) * frame.height())
+    throw CommandError(kExitServiceFailed, what + ": a frame arrived shorter than its size says");
+  return cv::Mat(static_cast<int>(frame.height()), static_cast<int>(frame.width()), CV_8UC1,
+                 const_cast<char*>(frame.pixels().data()), frame.stride());
 }
 
 // The message as one line of JSON with the proto's field names.
@@ -93,18 +110,10 @@ void PrintStatus(const v1::DeviceStatus& status, bool json) {
 
 // Writes each frame of `info` as DIR/<capture id>_<camera>.png; the paths.
 std::vector<std::string> WriteFrames(const v1::CaptureInfo& info, const std::string& dir) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec)
-    throw CommandError(kExitOutput, "-o " + dir + ": cannot create the folder: " + ec.message());
+  MakeFolder(dir);
   std::vector<std::string> paths;
   for (const v1::Frame& frame : info.frames()) {
-    if (frame.pixels().size() < static_cast<std::size_t>(frame.stride()) * frame.height() ||
-        frame.stride() < frame.width())
-      throw CommandError(kExitServiceFailed, "capture " + info.capture_id() +
-                                                 ": a frame arrived shorter than its size says");
-    const cv::Mat view(static_cast<int>(frame.height()), static_cast<int>(frame.width()), CV_8UC1,
-                       const_cast<char*>(frame.pixels().data()), frame.stride());
+    const cv::Mat view = FrameImage(frame, "capture " + info.capture_id());
     const std::string path =
         (fs::path(dir) / (info.capture_id() + "_" + CameraName(frame.camera()) + ".png")).string();
     io::WritePngAtomically(path, view);
@@ -329,10 +338,7 @@ void AddDeviceCommands(CLI::App& app) {
       ->check(CLI::Range(1, 100000));
   preview->add_option("-o,--out", preview_args->out, "folder for preview_NNNNN.png")->required();
   preview->callback([options, preview_args] {
-    std::error_code ec;
-    fs::create_directories(preview_args->out, ec);
-    if (ec)
-      throw CommandError(kExitOutput, "-o " + preview_args->out + ": cannot create the folder");
+    MakeFolder(preview_args->out);
     v1::PreviewRequest request;
     if (!preview_args->camera.empty()) request.set_camera(kCameras.at(preview_args->camera));
     // The stream's deadline covers every frame asked for, at 25 Hz, plus the timeout.
@@ -345,13 +351,7 @@ void AddDeviceCommands(CLI::App& app) {
     std::uint64_t dropped = 0;
     const auto start = std::chrono::steady_clock::now();
     while (taken < preview_args->frames && reader->Read(&message)) {
-      const v1::Frame& frame = message.frame();
-      if (frame.stride() < frame.width() ||
-          frame.pixels().size() < static_cast<std::size_t>(frame.stride()) * frame.height())
-        throw CommandError(kExitServiceFailed,
-                           "preview: a frame arrived shorter than its size says");
-      const cv::Mat view(static_cast<int>(frame.height()), static_cast<int>(frame.width()), CV_8UC1,
-                         const_cast<char*>(frame.pixels().data()), frame.stride());
+      const cv::Mat view = FrameImage(message.frame(), "preview");
       char name[32];
       std::snprintf(name, sizeof name, "preview_%05d.png", taken);
       io::WritePngAtomically((fs::path(preview_args->out) / name).string(), view);

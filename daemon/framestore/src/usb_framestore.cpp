@@ -150,8 +150,7 @@ Result<GreyFrame> UsbFramestore::Grab(const GrabOptions& options) {
   GreyFrame frame;
   frame.timestamps.requested = Clock::now();
   const std::uint16_t tag = ++tag_;
-  if (Status s = transport_->ControlOut(usb::kGrab, tag, params_.control_timeout); !s.ok())
-    return Transfer(s);
+  if (Status s = Send(usb::kGrab, tag); !s.ok()) return s;
 
   auto fail = [this](Status status) -> Status {
     if (status.code() == ErrorCode::kUnavailable) return Transfer(status);
