@@ -69,6 +69,10 @@ void AddDeviceCommands(CLI::App& app);
 // the file and the reason when it cannot be used.
 calibration::SideCalibration LoadCalibrationFile(const std::string& path);
 
+// The whole file; CommandError (exit 3) naming `option` and `path` when it
+// cannot be read.
+std::string ReadInputFile(const std::string& path, const std::string& option);
+
 // Loads `image` into *frame (saying on stderr when it was converted to 8-bit
 // grey) and runs one side's pipeline on it; CommandError naming the image for
 // an unusable calibration (exit 3) or a decode that cannot be reconstructed

@@ -1,6 +1,7 @@
-// How `bsls` reaches a running service (the capture daemon bslsd): the
-// address and TLS options every remote subcommand shares, the channel, the
-// deadline of each call, and gRPC statuses mapped to the tool's exit codes.
+// How `bsls` reaches a running service (the capture daemon bslsd, the
+// processing service bsls-processd): the address and TLS options every
+// remote subcommand shares, the channel, the deadline of each call, and gRPC
+// statuses mapped to the tool's exit codes.
 #ifndef BSLS_CLIENTS_CLI_DAEMON_CONNECTION_H_
 #define BSLS_CLIENTS_CLI_DAEMON_CONNECTION_H_
 
@@ -11,6 +12,7 @@
 #include <memory>
 #include <string>
 
+#include "bsls/processing/processing_client.h"
 #include "command.h"
 
 namespace bsls::cli {
@@ -29,6 +31,26 @@ struct ServiceAddress {
 // Adds --daemon, --tls-ca, --tls-cert, --tls-key and --timeout to `command`;
 // the daemon's address defaults to $BSLS_DAEMON, else the system socket.
 void AddDaemonOptions(CLI::App& command, ServiceAddress& address);
+
+// Adds --server (default $BSLS_SERVER; none: the work is done here), the
+// TLS options and --timeout to a command that can run on the processing
+// service. --server takes one address or several for round_robin
+// ("ipv4:127.0.0.1:7001,127.0.0.1:7002", "dns:///processd:7000").
+void AddServerOptions(CLI::App& command, ServiceAddress& address);
+
+// A client of the processing service at `address`; CommandError (exit 2)
+// for TCP to another machine without the TLS files, (exit 3) when a TLS
+// file cannot be read.
+processing::ProcessingClient OpenProcessingClient(const ServiceAddress& address);
+
+// Throws the CommandError that the status of a processing call means: bad
+// input (exit 3), not processed (1), busy or unreachable (5), refused (6),
+// failed (7); returns when it is OK.
+void CheckWork(const grpc::Status& status, const std::string& what, const ServiceAddress& address);
+
+// Prints work progress on stderr ("\r" updates on a terminal, a line per
+// stage otherwise); `quiet` prints nothing.
+processing::ProgressCallback ProgressPrinter(bool quiet);
 
 // A channel to the service; CommandError (exit 2) when TCP is asked for
 // without the TLS files, (exit 3) when a TLS file cannot be read.

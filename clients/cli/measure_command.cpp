@@ -12,14 +12,13 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"
-#include "bsls/measurement/geodesic.h"
-#include "bsls/measurement/lesion_measure.h"
-#include "bsls/measurement/measures.h"
-#include "bsls/measurement/report.h"
+#include "bsls/measurement/measurement_error.h"
+#include "bsls/measurement/plan.h"
 #include "command.h"
 
 namespace bsls::cli {
@@ -68,12 +67,6 @@ std::vector<Eigen::Vector2d> ParsePoints(const std::string& text, const std::str
   return points;
 }
 
-std::string PointText(const Eigen::Vector2d& p) {
-  std::ostringstream out;
-  out << "(" << p.x() << ", " << p.y() << ")";
-  return out.str();
-}
-
 measurement::ReferenceKind ParseReference(const std::string& name) {
   if (name == "plane") return measurement::ReferenceKind::kPlane;
   if (name == "quadric") return measurement::ReferenceKind::kQuadric;
@@ -81,103 +74,55 @@ measurement::ReferenceKind ParseReference(const std::string& name) {
   throw CommandError(kExitUsage, "--reference " + name + ": must be plane, quadric or cubic");
 }
 
-// Every requested figure, measured; rows for the table and the JSON report.
+// Every requested figure, measured; a table on stdout and the JSON report.
 void RunMeasure(const MeasureOptions& o) {
   if (o.heights.empty() && o.distances.empty() && o.areas.empty() && o.lesions.empty())
     throw CommandError(kExitUsage,
                        "nothing to measure: give --height, --distance, --area or --lesion");
-  measurement::LesionMeasureParams lesion_params;
-  lesion_params.reference = ParseReference(o.reference);
-  lesion_params.ring_width_mm = o.ring_mm;
+  if (!o.baseline.empty() && o.lesions.empty())
+    throw CommandError(kExitUsage, "--baseline is the reference of --lesion: give a --lesion");
+  measurement::MeasurementPlan plan;
+  plan.lesion.reference = ParseReference(o.reference);
+  plan.lesion.ring_width_mm = o.ring_mm;
   std::string why;
-  if (!lesion_params.IsValid(&why)) throw CommandError(kExitUsage, "--ring: " + why);
+  if (!plan.lesion.IsValid(&why)) throw CommandError(kExitUsage, "--ring: " + why);
   // Parse everything before the (slow) work so a typo fails at once.
-  std::vector<Eigen::Vector2d> heights;
   for (const std::string& h : o.heights) {
     const auto points = ParsePoints(h, "--height");
     if (points.size() != 1) throw CommandError(kExitUsage, "--height \"" + h + "\": give one X,Y");
-    heights.push_back(points[0]);
+    plan.heights.push_back(points[0]);
   }
-  std::vector<std::vector<Eigen::Vector2d>> distances, areas, lesions;
   for (const std::string& d : o.distances) {
-    distances.push_back(ParsePoints(d, "--distance"));
-    if (distances.back().size() != 2)
+    const auto points = ParsePoints(d, "--distance");
+    if (points.size() != 2)
       throw CommandError(kExitUsage, "--distance \"" + d + "\": give two points \"X,Y X,Y\"");
+    plan.distances.push_back({points[0], points[1]});
   }
-  for (const std::string& a : o.areas) {
-    areas.push_back(ParsePoints(a, "--area"));
-    if (areas.back().size() < 3)
-      throw CommandError(kExitUsage, "--area \"" + a + "\": a region needs at least 3 points");
-  }
-  for (const std::string& l : o.lesions) {
-    lesions.push_back(ParsePoints(l, "--lesion"));
-    if (lesions.back().size() < 3)
-      throw CommandError(kExitUsage, "--lesion \"" + l + "\": a region needs at least 3 points");
-  }
-
-  if (!o.baseline.empty() && lesions.empty())
-    throw CommandError(kExitUsage, "--baseline is the reference of --lesion: give a --lesion");
-  measurement::BaselineParams baseline_params;
-  baseline_params.register_rigidly = o.register_baseline;
+  for (const auto& [texts, regions, option] :
+       {std::tuple{&o.areas, &plan.areas, "--area"}, std::tuple{&o.lesions, &plan.lesions, "--lesion"}})
+    for (const std::string& text : *texts) {
+      regions->push_back(ParsePoints(text, option));
+      if (regions->back().size() < 3)
+        throw CommandError(kExitUsage, std::string(option) + " \"" + text +
+                                           "\": a region needs at least 3 points");
+    }
+  plan.baseline_params.register_rigidly = o.register_baseline;
   const geometry::SurfaceMesh mesh = io::ReadPly(o.surface);
-  const geometry::SurfaceMesh baseline =
-      o.baseline.empty() ? geometry::SurfaceMesh{} : io::ReadPly(o.baseline);
-  std::vector<measurement::ReportRow> rows;
-  nlohmann::json report = {{"surface", o.surface},
-                           {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)},
-                           {"heights", nlohmann::json::array()},
-                           {"distances", nlohmann::json::array()},
-                           {"areas", nlohmann::json::array()},
-                           {"lesions", nlohmann::json::array()}};
+  if (!o.baseline.empty()) {
+    plan.baseline = io::ReadPly(o.baseline);
+    plan.baseline_name = o.baseline;
+  }
+  measurement::MeasurementOutcome outcome;
   try {
-    const measurement::SurfaceQuery surface(mesh);
-    for (const Eigen::Vector2d& xy : heights) {
-      const measurement::Measured h = measurement::HeightAboveBase(surface, xy);
-      rows.push_back({"height at " + PointText(xy), h, "mm"});
-      report["heights"].push_back(
-          {{"at", {xy.x(), xy.y()}}, {"height_mm", measurement::ToJson(h)}});
-    }
-    for (const auto& d : distances) {
-      const measurement::GeodesicResult g = measurement::GeodesicDistance(surface, d[0], d[1]);
-      const std::string between = PointText(d[0]) + "-" + PointText(d[1]);
-      rows.push_back({"straight " + between, g.straight_mm, "mm"});
-      rows.push_back({"along surface " + between, g.distance_mm, "mm"});
-      nlohmann::json entry = measurement::ToJson(g);
-      entry["from"] = {d[0].x(), d[0].y()};
-      entry["to"] = {d[1].x(), d[1].y()};
-      report["distances"].push_back(entry);
-    }
-    for (size_t i = 0; i < areas.size(); ++i) {
-      const measurement::Measured a = measurement::SurfaceArea(surface, areas[i]);
-      rows.push_back({"area of region " + std::to_string(i + 1), a, "mm^2"});
-      report["areas"].push_back({{"region", o.areas[i]}, {"area_mm2", measurement::ToJson(a)}});
-    }
-    for (size_t i = 0; i < lesions.size(); ++i) {
-      measurement::LesionMeasurement m;
-      if (o.baseline.empty()) {
-        m = measurement::MeasureLesion(surface, lesions[i], lesion_params);
-      } else {
-        try {
-          m = measurement::MeasureLesionAgainstBaseline(surface, baseline, lesions[i],
-                                                        lesion_params, baseline_params);
-        } catch (const measurement::MeasurementError& e) {
-          throw measurement::MeasurementError("against " + o.baseline + ": " + e.what());
-        }
-      }
-      for (measurement::ReportRow row : measurement::Rows(m)) {
-        row.name = "lesion " + std::to_string(i + 1) + ": " + row.name;
-        rows.push_back(row);
-      }
-      nlohmann::json entry = measurement::ToJson(m);
-      entry["region"] = o.lesions[i];
-      report["lesions"].push_back(entry);
-    }
+    outcome = measurement::MeasurePlan(mesh, plan);
   } catch (const measurement::MeasurementError& e) {
     throw CommandError(kExitNotProcessed, o.surface + ": " + e.what());
   }
-  report["rows"] = measurement::ToJson(rows);
+  nlohmann::json report = {{"surface", o.surface},
+                           {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
+  report.update(outcome.report);
   if (!o.json.empty()) io::WriteFileAtomically(o.json, report.dump(2) + "\n");
-  std::cout << measurement::FormatTable(rows, o.decimals);
+  std::cout << measurement::FormatTable(outcome.rows, o.decimals);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // calibration (or the thesis's explicit set-up), also its surface in world
 // millimetres.
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <string>
 
@@ -11,7 +12,9 @@
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/reconstruction/side_pipeline.h"
+#include "bsls/rpc/frame_message.h"
 #include "command.h"
+#include "daemon_connection.h"
 
 namespace bsls::cli {
 namespace {
@@ -31,6 +34,8 @@ struct ProcessOptions {
   bool ascii = false;
   bool no_repair = false;
   bool json_summary = false;
+  bool quiet = false;
+  ServiceAddress server;  // target empty: the work is done here
 };
 
 }  // namespace
@@ -60,7 +65,81 @@ calibration::SideCalibration LoadCalibrationFile(const std::string& path) {
   }
 }
 
+std::string ReadInputFile(const std::string& path, const std::string& option) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw CommandError(kExitInput, option + " " + path + ": cannot be read");
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
 namespace {
+
+// The same job on the processing service: the frame (converted here to 8-bit
+// grey) and the calibration file go up, the contracts' files come back.
+void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
+  if (o.geometric_setup)
+    throw CommandError(kExitUsage, "--geometric-setup runs here only: drop --server");
+  if (!o.skeleton.empty()) throw CommandError(kExitUsage, "--skeleton runs here only: drop --server");
+  io::FrameConversion conversion;
+  const cv::Mat frame = io::LoadGreyFrame(o.image, &conversion);
+  if (conversion.converted())
+    std::cerr << "bsls: note: " << o.image << ": " << conversion.Describe() << "\n";
+  v1::ProcessFrameRequest request;
+  rpc::ToFrameMessage(frame, request.mutable_frame());
+  request.set_side(side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
+  if (!o.calibration.empty())
+    *request.mutable_calibration() =
+        processing::ProcessingClient::Inline(ReadInputFile(o.calibration, "--calibration"));
+  request.set_want_surface(!o.surface.empty());
+  request.set_want_overlay(!o.overlay.empty());
+  request.mutable_decode()->set_method(o.method == "thesis" ? v1::DecodeOptions::METHOD_THESIS
+                                                            : v1::DecodeOptions::METHOD_MODERN);
+  request.mutable_decode()->set_no_repair(o.no_repair);
+  request.mutable_surface()->set_plane_model(o.plane_model == "parallel"
+                                                 ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
+                                                 : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
+  request.mutable_surface()->set_smooth_lines(o.smooth);
+  request.mutable_surface()->set_ascii_ply(o.ascii);
+  request.set_request_tag(o.image.substr(0, 256));
+
+  processing::ProcessingClient client = OpenProcessingClient(o.server);
+  const processing::WorkOutcome out =
+      client.ProcessFrame(request, ProgressPrinter(o.quiet || o.json_summary));
+  CheckWork(out.status, o.image, o.server);
+  const v1::SideSummary& s = out.result.sides(0);
+  if (!o.calibration.empty() && !s.q_absolute())
+    std::cerr << "bsls: note: " << o.image << ": q stays relative: " << s.rows_note() << "\n";
+  io::WriteFileAtomically(o.junctions, out.files.at("junctions.json"));
+  if (!o.overlay.empty()) io::WriteFileAtomically(o.overlay, out.files.at("overlay.png"));
+  if (!o.surface.empty()) io::WriteFileAtomically(o.surface, out.files.at("surface.ply"));
+  double total_ms = 0;
+  for (const v1::StageTime& t : out.result.times())
+    if (t.stage() == "decode") total_ms = t.ms();
+  if (o.json_summary) {
+    nlohmann::json j = {{"image", o.image},
+                        {"side", o.side},
+                        {"junctions", s.junctions()},
+                        {"interpolated", s.interpolated_junctions()},
+                        {"lines", s.lines()},
+                        {"q_absolute", s.q_absolute()},
+                        {"repairs", s.repairs()},
+                        {"time_ms", total_ms},
+                        {"replica", out.result.replica()},
+                        {"attempts", out.attempts}};
+    if (!o.surface.empty())
+      j["surface"] = {{"vertices", s.vertices()}, {"triangles", s.triangles()},
+                      {"bridged", s.bridged_samples()}};
+    std::cout << j.dump() << "\n";
+  } else {
+    std::printf("%s (%s): %u junctions (%u interpolated) on %u lines, %u repairs, q %s, %.1f ms "
+                "on %s\n",
+                o.image.c_str(), o.side.c_str(), s.junctions(), s.interpolated_junctions(),
+                s.lines(), s.repairs(), s.q_absolute() ? "absolute" : "relative", total_ms,
+                out.result.replica().c_str());
+    if (!o.surface.empty())
+      std::printf("%s: %u vertices (%u bridged), %u triangles\n", o.surface.c_str(), s.vertices(),
+                  s.bridged_samples(), s.triangles());
+  }
+}
 
 void RunProcess(const ProcessOptions& o) {
   const auto side = pattern::ParseSide(o.side);
@@ -71,6 +150,7 @@ void RunProcess(const ProcessOptions& o) {
                        "uncalibrated height formula)");
   if (!o.calibration.empty() && o.geometric_setup)
     throw CommandError(kExitUsage, "--calibration and --geometric-setup exclude each other");
+  if (!o.server.target.empty()) return RunProcessRemote(o, *side);
   reconstruction::SidePipelineParams params;
   params.decode.extraction.method =
       o.method == "thesis" ? extraction::ExtractionMethod::kThesis : extraction::ExtractionMethod::kModern;
@@ -167,6 +247,8 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_flag("--ascii", opts->ascii, "Write an ASCII PLY instead of binary");
   cmd->add_flag("--no-repair", opts->no_repair, "Label what is seen; seal no discontinuity");
   cmd->add_flag("--json", opts->json_summary, "Print the summary as one JSON object");
+  cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
+  AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunProcess(*opts); });
 }
 

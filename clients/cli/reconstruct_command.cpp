@@ -4,11 +4,10 @@
 // directly when the calibrations share a world frame (contracts section 4),
 // otherwise matched on the common line's nose and mouth (thesis 5.2.2) and
 // refined by ICP. The seam error is reported either way.
-#include <Eigen/Geometry>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -16,9 +15,10 @@
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"
-#include "bsls/joining/join.h"
-#include "bsls/reconstruction/side_pipeline.h"
+#include "bsls/session/session.h"
+#include "bsls/rpc/frame_message.h"
 #include "command.h"
+#include "daemon_connection.h"
 
 namespace bsls::cli {
 namespace {
@@ -36,112 +36,133 @@ struct ReconstructOptions {
   std::string plane_model = "perspective";
   bool smooth = false;
   bool ascii = false;
+  bool quiet = false;
+  ServiceAddress server;  // target empty: the work is done here
 };
 
-struct Side {
-  reconstruction::SideOutcome outcome;
-  std::string image;
-};
-
-// Decodes and reconstructs one side; CommandError naming the image otherwise.
-Side ReconstructSide(const std::string& image, pattern::Side side,
-                     const calibration::SideCalibration& calibration,
-                     const reconstruction::SidePipelineParams& params) {
-  cv::Mat frame;
-  Side result{ProcessFrame(image, side, &calibration, params, &frame), image};
-  if (!result.outcome.decode.ok)
-    throw CommandError(kExitNotProcessed, image + ": " + result.outcome.decode.error);
-  if (!result.outcome.decode.q_absolute)
-    std::cerr << "bsls: note: " << image << ": q stays relative: " << result.outcome.rows_note
-              << "\n";
-  return result;
+// Loads one side's frame (saying when it was converted to 8-bit grey).
+cv::Mat LoadFrame(const std::string& image) {
+  io::FrameConversion conversion;
+  cv::Mat frame = io::LoadGreyFrame(image, &conversion);
+  if (conversion.converted())
+    std::cerr << "bsls: note: " << image << ": " << conversion.Describe() << "\n";
+  return frame;
 }
 
-nlohmann::json SideJson(const Side& s) {
-  const reconstruction::ReconstructionReport& r = s.outcome.report;
-  return {{"image", s.image},
-          {"junctions", s.outcome.decode.junctions.size()},
-          {"lines", s.outcome.decode.lines.size()},
-          {"q_absolute", s.outcome.decode.q_absolute},
-          {"vertices", r.vertices},
-          {"triangles", r.triangles},
-          {"bridged", r.bridged_samples},
-          {"decode_ms", s.outcome.decode.times.total_ms},
-          {"reconstruct_ms", r.time_ms}};
+// The run's summary on stdout, from its report (session::SessionReport).
+void PrintSessionSummary(const nlohmann::json& report, const std::string& output) {
+  for (const char* side : {"left", "right"}) {
+    const nlohmann::json& s = report.at(side);
+    std::printf("%-6s %s: %d junctions, %d vertices\n", (std::string(side) + ":").c_str(),
+                s.at("image").get<std::string>().c_str(), s.at("junctions").get<int>(),
+                s.at("vertices").get<int>());
+  }
+  const nlohmann::json& j = report.at("join");
+  const bool by_features = j.at("method") == "features+icp";
+  std::printf("join:  %s, seam RMS %.3f mm (max %.3f mm over %d samples)",
+              by_features ? "nose/mouth features + ICP" : "shared world frame",
+              j.at("seam_rms_mm").get<double>(), j.at("seam_max_mm").get<double>(),
+              j.at("seam_samples").get<int>());
+  if (by_features) {
+    const auto& t = j.at("translation_mm");
+    std::printf(", right side moved %.2f deg, %.2f mm in %d ICP steps",
+                j.at("rotation_deg").get<double>(),
+                std::hypot(t[0].get<double>(), t[1].get<double>(), t[2].get<double>()),
+                j.at("icp_iterations").get<int>());
+  }
+  std::printf("\n%s: %d vertices, %d triangles, %.0f ms in all\n", output.c_str(),
+              report.at("vertices").get<int>(), report.at("triangles").get<int>(),
+              report.at("total_ms").get<double>());
+}
+
+// The same job on the processing service: frames (converted here to 8-bit
+// grey) and calibration files go up, the surfaces and the report come back.
+void RunReconstructRemote(const ReconstructOptions& o) {
+  v1::ReconstructSessionRequest request;
+  rpc::ToFrameMessage(LoadFrame(o.left_image), request.mutable_left());
+  rpc::ToFrameMessage(LoadFrame(o.right_image), request.mutable_right());
+  *request.mutable_left_calibration() = processing::ProcessingClient::Inline(
+      ReadInputFile(o.left_calibration, "--calibration-left"));
+  *request.mutable_right_calibration() = processing::ProcessingClient::Inline(
+      ReadInputFile(o.right_calibration, "--calibration-right"));
+  request.set_join(o.join == "shared"     ? v1::ReconstructSessionRequest::JOIN_SHARED
+                   : o.join == "features" ? v1::ReconstructSessionRequest::JOIN_FEATURES
+                                          : v1::ReconstructSessionRequest::JOIN_AUTO);
+  request.mutable_surface()->set_plane_model(o.plane_model == "parallel"
+                                                 ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
+                                                 : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
+  request.mutable_surface()->set_smooth_lines(o.smooth);
+  request.mutable_surface()->set_ascii_ply(o.ascii);
+  request.set_want_side_surfaces(!o.left_surface.empty() || !o.right_surface.empty());
+  request.set_request_tag((o.left_image + " + " + o.right_image).substr(0, 256));
+
+  processing::ProcessingClient client = OpenProcessingClient(o.server);
+  const processing::WorkOutcome out = client.ReconstructSession(request, ProgressPrinter(o.quiet));
+  CheckWork(out.status, o.left_image + " + " + o.right_image, o.server);
+  for (const v1::SideSummary& s : out.result.sides())
+    if (!s.q_absolute())
+      std::cerr << "bsls: note: " << (s.side() == v1::SIDE_LEFT ? o.left_image : o.right_image)
+                << ": q stays relative: " << s.rows_note() << "\n";
+  nlohmann::json report = nlohmann::json::parse(out.files.at("report.json"));
+  report["left"]["image"] = o.left_image;
+  report["right"]["image"] = o.right_image;
+  const auto encoding = o.ascii ? io::PlyEncoding::kAscii : io::PlyEncoding::kBinaryLittleEndian;
+  // PLY comes back; other formats are written here from it.
+  auto write = [&](const std::string& path, const std::string& artifact) {
+    io::WriteSurface(path, io::DecodePly(out.files.at(artifact), artifact), encoding);
+  };
+  if (!o.left_surface.empty()) write(o.left_surface, "left.ply");
+  if (!o.right_surface.empty()) write(o.right_surface, "right.ply");
+  if (!o.report.empty()) io::WriteFileAtomically(o.report, report.dump(2) + "\n");
+  write(o.output, "surface.ply");
+  PrintSessionSummary(report, o.output);
 }
 
 void RunReconstruct(const ReconstructOptions& o) {
-  const auto start = std::chrono::steady_clock::now();
+  if (!o.server.target.empty()) return RunReconstructRemote(o);
   const calibration::SideCalibration left_cal = LoadCalibrationFile(o.left_calibration);
   const calibration::SideCalibration right_cal = LoadCalibrationFile(o.right_calibration);
-  if (left_cal.side != pattern::Side::kLeft)
-    throw CommandError(kExitInput, o.left_calibration + ": is a calibration of the right side");
-  if (right_cal.side != pattern::Side::kRight)
-    throw CommandError(kExitInput, o.right_calibration + ": is a calibration of the left side");
-  std::string why;
-  const bool shared = calibration::SharesWorldFrame(left_cal, right_cal, &why);
-  if (o.join == "shared" && !shared)
-    throw CommandError(kExitInput, o.left_calibration + " and " + o.right_calibration +
-                                       " do not share a world frame: " + why);
-  const bool by_features = o.join == "features" || (o.join == "auto" && !shared);
+  session::SessionParams params;
+  params.side.planes = o.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
+                                                   : reconstruction::PlaneModelKind::kPerspective;
+  params.side.reconstruction.smooth_lines = o.smooth;
+  params.join = o.join == "shared"     ? session::JoinMode::kShared
+                : o.join == "features" ? session::JoinMode::kFeatures
+                                       : session::JoinMode::kAuto;
+  const cv::Mat left_frame = LoadFrame(o.left_image);
+  const cv::Mat right_frame = LoadFrame(o.right_image);
 
-  reconstruction::SidePipelineParams params;
-  params.planes = o.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
-                                              : reconstruction::PlaneModelKind::kPerspective;
-  params.reconstruction.smooth_lines = o.smooth;
-  const Side left = ReconstructSide(o.left_image, pattern::Side::kLeft, left_cal, params);
-  const Side right = ReconstructSide(o.right_image, pattern::Side::kRight, right_cal, params);
-
-  joining::JoinResult joined;
+  session::SessionOutcome s;
   try {
-    joined = by_features
-                 ? joining::JoinByFeatures(*left.outcome.surface, *right.outcome.surface, {})
-                 : joining::JoinSharedFrame(*left.outcome.surface, *right.outcome.surface, {});
-  } catch (const joining::JoinError& e) {
-    throw CommandError(kExitNotProcessed, o.left_image + " + " + o.right_image + ": " + e.what());
+    s = session::ReconstructSession(left_frame, left_cal, right_frame, right_cal, params);
+  } catch (const session::SessionError& e) {
+    // Name the files the error is about.
+    const std::map<session::SessionPart, std::string> subjects = {
+        {session::SessionPart::kLeftFrame, o.left_image},
+        {session::SessionPart::kRightFrame, o.right_image},
+        {session::SessionPart::kLeftCalibration, o.left_calibration},
+        {session::SessionPart::kRightCalibration, o.right_calibration},
+        {session::SessionPart::kCalibrations, o.left_calibration + " and " + o.right_calibration},
+        {session::SessionPart::kJoin, o.left_image + " + " + o.right_image},
+        {session::SessionPart::kMeasurements, o.left_image + " + " + o.right_image}};
+    const std::string subject = subjects.at(e.part());
+    throw CommandError(e.reason() == session::SessionErrorReason::kInvalidInput ? kExitInput
+                                                                                : kExitNotProcessed,
+                       subject + ": " + e.what());
   }
+  for (const auto* side : {&s.left, &s.right})
+    if (!side->decode.q_absolute)
+      std::cerr << "bsls: note: " << (side == &s.left ? o.left_image : o.right_image)
+                << ": q stays relative: " << side->rows_note << "\n";
   const auto encoding = o.ascii ? io::PlyEncoding::kAscii : io::PlyEncoding::kBinaryLittleEndian;
-  const double total_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-
-  const Eigen::AngleAxisd rotation(joined.rotation);
-  nlohmann::json report = {
-      {"left", SideJson(left)},
-      {"right", SideJson(right)},
-      {"join",
-       {{"method", by_features ? "features+icp" : "shared-frame"},
-        {"shared_frame", shared},
-        {"shared_frame_note", shared ? "" : why},
-        {"seam_rms_mm", joined.seam.rms_mm},
-        {"seam_max_mm", joined.seam.max_mm},
-        {"seam_samples", joined.seam.samples},
-        {"rotation_deg", rotation.angle() * 180.0 / M_PI},
-        {"translation_mm",
-         {joined.translation.x(), joined.translation.y(), joined.translation.z()}},
-        {"icp_iterations", joined.iterations},
-        {"zipper_triangles", joined.zipper_triangles}}},
-      {"vertices", joined.mesh.VertexCount()},
-      {"triangles", joined.mesh.faces.size()},
-      {"total_ms", total_ms}};
+  const nlohmann::json report = session::SessionReport(s, o.left_image, o.right_image);
 
   // Side surfaces first: the joined one, written last, says the run is complete.
-  if (!o.left_surface.empty()) io::WriteSurface(o.left_surface, *left.outcome.surface, encoding);
-  if (!o.right_surface.empty()) io::WriteSurface(o.right_surface, *right.outcome.surface, encoding);
+  if (!o.left_surface.empty()) io::WriteSurface(o.left_surface, *s.left.surface, encoding);
+  if (!o.right_surface.empty()) io::WriteSurface(o.right_surface, *s.right.surface, encoding);
   if (!o.report.empty()) io::WriteFileAtomically(o.report, report.dump(2) + "\n");
-  io::WriteSurface(o.output, joined.mesh, encoding);
-
-  std::printf("left:  %s: %zu junctions, %d vertices\n", o.left_image.c_str(),
-              left.outcome.decode.junctions.size(), left.outcome.report.vertices);
-  std::printf("right: %s: %zu junctions, %d vertices\n", o.right_image.c_str(),
-              right.outcome.decode.junctions.size(), right.outcome.report.vertices);
-  std::printf("join:  %s, seam RMS %.3f mm (max %.3f mm over %d samples)",
-              by_features ? "nose/mouth features + ICP" : "shared world frame", joined.seam.rms_mm,
-              joined.seam.max_mm, joined.seam.samples);
-  if (by_features)
-    std::printf(", right side moved %.2f deg, %.2f mm in %d ICP steps",
-                rotation.angle() * 180.0 / M_PI, joined.translation.norm(), joined.iterations);
-  std::printf("\n%s: %zu vertices, %zu triangles, %.0f ms in all\n", o.output.c_str(),
-              joined.mesh.VertexCount(), joined.mesh.faces.size(), total_ms);
+  io::WriteSurface(o.output, s.joined.mesh, encoding);
+  PrintSessionSummary(report, o.output);
 }
 
 }  // namespace
@@ -171,6 +192,8 @@ void AddReconstructCommand(CLI::App& app) {
       ->check(CLI::IsMember({"perspective", "parallel"}));
   cmd->add_flag("--smooth", opts->smooth, "Smooth along each line (thesis eq. 5.32) first");
   cmd->add_flag("--ascii", opts->ascii, "Write ASCII PLY instead of binary");
+  cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
+  AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunReconstruct(*opts); });
 }
 

@@ -4,6 +4,8 @@
 #include <pwd.h>
 #include <yaml-cpp/yaml.h>
 
+#include "bsls/io/config_document.h"
+
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -17,51 +19,21 @@ using framestore::Status;
 
 namespace {
 
-// A configuration error that names the key; caught in LoadConfig.
-struct KeyError {
-  std::string key;
-  std::string reason;
-};
-
 [[noreturn]] void Fail(const std::string& key, const std::string& reason) {
-  throw KeyError{key, reason};
+  throw io::ConfigKeyError(key, reason);
 }
 
-// Refuses keys of `node` (a map) that are not in `known`.
-void OnlyKeys(const YAML::Node& node, const std::string& where,
-              const std::set<std::string>& known) {
-  if (!node) return;
-  if (!node.IsMap()) Fail(where, "must be a mapping");
-  for (const auto& item : node) {
-    const std::string key = item.first.as<std::string>();
-    if (!known.count(key)) {
-      std::string list;
-      for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-      Fail(where.empty() ? key : where + "." + key, "is not a known key (known: " + list + ")");
-    }
-  }
-}
+using io::OnlyKeys;
 
 template <typename T>
 void Read(const YAML::Node& parent, const std::string& where, const char* key, T& out) {
-  const YAML::Node node = parent[key];
-  if (!node) return;
-  try {
-    out = node.as<T>();
-  } catch (const YAML::Exception&) {
-    Fail(where + "." + key, "has the wrong type ('" + YAML::Dump(node) + "')");
-  }
+  io::ReadKey(parent, where, key, out);
 }
 
 template <typename Number>
 void ReadInRange(const YAML::Node& parent, const std::string& where, const char* key,
                  Number& out, Number min, Number max) {
-  Read(parent, where, key, out);
-  if (out < min || out > max) {
-    std::ostringstream range;
-    range << "is " << out << "; it must be in [" << min << ", " << max << "]";
-    Fail(where + "." + key, range.str());
-  }
+  io::ReadKeyInRange(parent, where, key, out, min, max);
 }
 
 service::Role RoleFrom(const std::string& key, const std::string& text) {
@@ -250,54 +222,18 @@ Config DefaultConfig() {
 Result<Config> LoadConfig(const std::optional<std::string>& path,
                           const std::vector<std::string>& overrides) {
   YAML::Node root;
-  if (path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(*path, ec))
-      return Status(ErrorCode::kNotFound, "configuration file " + *path + " does not exist");
-    try {
-      root = YAML::LoadFile(*path);
-    } catch (const YAML::Exception& e) {
-      return Status(ErrorCode::kInvalidArgument,
-                    "configuration file " + *path + " is not valid YAML: " + e.what());
-    }
-  }
-  if (!root || root.IsNull()) root = YAML::Node(YAML::NodeType::Map);
-  for (const std::string& assignment : overrides) {
-    const std::size_t equals = assignment.find('=');
-    if (equals == std::string::npos || equals == 0)
-      return Status(ErrorCode::kInvalidArgument,
-                    "override '" + assignment + "' is not of the form key.path=value");
-    const std::string key = assignment.substr(0, equals);
-    YAML::Node value;
-    try {
-      value = YAML::Load(assignment.substr(equals + 1));
-    } catch (const YAML::Exception& e) {
-      return Status(ErrorCode::kInvalidArgument,
-                    "override '" + assignment + "': the value is not valid YAML");
-    }
-    // Walk/create the dotted path (nodes are references; reassigning is not).
-    std::vector<std::string> parts;
-    std::stringstream stream(key);
-    for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
-    if (parts.size() == 1) {
-      root[parts[0]] = value;
-    } else if (parts.size() == 2) {
-      root[parts[0]][parts[1]] = value;
-    } else if (parts.size() == 3) {
-      root[parts[0]][parts[1]][parts[2]] = value;
-    } else {
-      return Status(ErrorCode::kInvalidArgument,
-                    "override key '" + key + "' is deeper than three levels");
-    }
+  try {
+    root = io::LoadConfigDocument(path, overrides);
+  } catch (const io::ConfigKeyError& e) {
+    return Status(e.missing_file() ? ErrorCode::kNotFound : ErrorCode::kInvalidArgument, e.what());
   }
   try {
     Config config = Parse(root);
     if (Status status = Validate(config); !status.ok()) return status;
     return config;
-  } catch (const KeyError& e) {
+  } catch (const io::ConfigKeyError& e) {
     return Status(ErrorCode::kInvalidArgument,
-                  "configuration" + (path ? " " + *path : std::string()) + ": " + e.key + " " +
-                      e.reason);
+                  "configuration" + (path ? " " + *path : std::string()) + ": " + e.what());
   } catch (const YAML::Exception& e) {
     return Status(ErrorCode::kInvalidArgument,
                   "configuration" + (path ? " " + *path : std::string()) + ": " + e.what());

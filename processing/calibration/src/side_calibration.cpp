@@ -206,8 +206,18 @@ ProjectorPose PoseOfProjector(const PerspectivePlaneFit& perspective,
 }
 
 // Thesis chapter 6 (6.1 camera, 6.2 projector) for one side of the rig.
-SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params) {
+SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params,
+                              const CalibrationProgress& progress) {
   const auto start = Clock::now();
+  const double total_views = static_cast<double>(
+      manifest.camera_views.size() + manifest.screen_views.size() + manifest.reference_views.size());
+  int views_begun = 0;
+  // Every view is announced before it is read; the caller may stop there.
+  auto begin_view = [&](const std::string& name) {
+    if (progress && !progress(name, views_begun / total_views))
+      Throw(CalibrationErrorReason::kCancelled, "calibration: stopped before " + name);
+    ++views_begun;
+  };
   const std::string file = manifest.path.string();
   std::string why;
   if (!params.IsValid(&why))
@@ -232,6 +242,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
   for (size_t i = 0; i < manifest.camera_views.size(); ++i) {
     const ManifestView& view = manifest.camera_views[i];
     const std::string name = ViewName(view, "camera", i);
+    begin_view(name);
     const cv::Mat grey = LoadView(view, name, &width, &height);
     const TargetDetection detection = DetectTarget(grey, manifest.target, params.target);
     if (!detection.ok)
@@ -282,6 +293,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
   for (size_t i = 0; i < manifest.screen_views.size(); ++i) {
     const ManifestView& view = manifest.screen_views[i];
     const std::string name = ViewName(view, "screen", i);
+    begin_view(name);
     const cv::Mat grey = LoadView(view, name, &width, &height);
     decoder::DecodeResult result = decoder::Decode(grey, manifest.side, decode);
     if (!result.ok)
@@ -339,6 +351,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
   for (size_t i = 0; i < manifest.reference_views.size(); ++i) {
     const ManifestView& view = manifest.reference_views[i];
     const std::string name = ViewName(view, "reference", i);
+    begin_view(name);
     const cv::Mat grey = LoadView(view, name, &width, &height);
     std::string cross_why;
     const auto cross = FindReferenceCross(grey, params.cross, &cross_why);

@@ -19,10 +19,11 @@ enum class CalibrationErrorReason {
   kUnreadableInput,  // a listed file is missing or cannot be read as an image
   kNotFound,         // the target, the pattern or the cross is not (fully) found in a view
   kNotConverged,     // an iterative refinement stopped before converging
+  kCancelled,        // the caller stopped it (CalibrationProgress returned false)
 };
 
 // Returns "invalid params", "invalid input", "too few points", "coplanar",
-// "degenerate", "unreadable input", "not found" or "not converged".
+// "degenerate", "unreadable input", "not found", "not converged" or "cancelled".
 constexpr std::string_view ToString(CalibrationErrorReason reason) {
   switch (reason) {
     case CalibrationErrorReason::kInvalidParams:
@@ -37,6 +38,8 @@ constexpr std::string_view ToString(CalibrationErrorReason reason) {
       return "degenerate";
     case CalibrationErrorReason::kUnreadableInput:
       return "unreadable input";
+    case CalibrationErrorReason::kCancelled:
+      return "cancelled";
     case CalibrationErrorReason::kNotFound:
       return "not found";
     case CalibrationErrorReason::kNotConverged:

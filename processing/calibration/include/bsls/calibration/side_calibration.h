@@ -41,6 +41,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -202,9 +203,15 @@ struct SideCalibration {
 bool SharesWorldFrame(const SideCalibration& left, const SideCalibration& right, std::string* why,
                       double tolerance_mm = 5.0);
 
+// Called before each view is read with its name and the fraction of the
+// views begun; returning false stops the calibration (CalibrationError
+// kCancelled).
+using CalibrationProgress = std::function<bool(const std::string& view, double fraction)>;
+
 // Thesis chapter 6 for one side: every step above. Throws CalibrationError
 // naming the manifest or the view and the reason.
-SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params = {});
+SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params = {},
+                              const CalibrationProgress& progress = {});
 
 // The projector pose of thesis Table 6.2 from the fitted models (step 5
 // optional). Pure; used by CalibrateSide and after loading a file.

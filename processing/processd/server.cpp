@@ -1,0 +1,85 @@
+#include "server.h"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <stdexcept>
+
+#include "bsls/rpc/tls.h"
+
+namespace bsls::processd {
+
+std::unique_ptr<Server> Server::Start(const Config& config, const std::string& software_version) {
+  Validate(config);
+  std::unique_ptr<Server> s(new Server);
+  s->config_ = config;
+
+  processing::ProcessingServiceOptions options;
+  options.workers = Workers(config);
+  options.queue = Queue(config);
+  options.calibration_cache_entries = static_cast<std::size_t>(config.calibration_cache_entries);
+  options.replica = config.replica;
+  options.software_version = software_version;
+  if (!config.scratch_dir.empty()) options.scratch_dir = config.scratch_dir;
+  options.max_upload_bytes = config.max_upload_bytes;
+  s->service_ = std::make_unique<processing::ProcessingService>(options);
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::ServerBuilder builder;
+  builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
+  builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
+  // Handler threads: every worker and queue place, plus quick calls.
+  grpc::ResourceQuota quota("bsls-processd");
+  quota.SetMaxThreads(options.workers + options.queue + 16);
+  builder.SetResourceQuota(quota);
+  builder.RegisterService(s->service_.get());
+  if (!config.listen.unix_socket.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(config.listen.unix_socket, ec);  // a socket left by a dead replica
+    builder.AddListeningPort("unix:" + config.listen.unix_socket,
+                             grpc::InsecureServerCredentials());
+  }
+  if (!config.listen.tcp.empty()) {
+    rpc::TlsFiles tls{config.listen.tls_client_ca, config.listen.tls_certificate,
+                      config.listen.tls_key, "listen.tls_client_ca", "listen.tls_certificate",
+                      "listen.tls_key"};
+    builder.AddListeningPort(config.listen.tcp,
+                             config.listen.plaintext_loopback
+                                 ? grpc::InsecureServerCredentials()
+                                 : rpc::MutualTlsServerCredentials(tls),
+                             &s->tcp_port_);
+  }
+  s->server_ = builder.BuildAndStart();
+  if (!s->server_ || (!config.listen.tcp.empty() && s->tcp_port_ == 0))
+    throw std::runtime_error(
+        "the gRPC server could not start" +
+        (config.listen.tcp.empty() ? std::string() : " on TCP " + config.listen.tcp) +
+        (config.listen.unix_socket.empty() ? std::string()
+                                           : " (socket " + config.listen.unix_socket + ")"));
+  spdlog::info("serving: {} workers, {} queue places{}{}", options.workers, options.queue,
+               config.listen.unix_socket.empty() ? "" : ", unix:" + config.listen.unix_socket,
+               config.listen.tcp.empty()
+                   ? ""
+                   : ", tcp port " + std::to_string(s->tcp_port_) +
+                         (config.listen.plaintext_loopback ? " (plain, loopback)" : " (mutual TLS)"));
+  return s;
+}
+
+Server::~Server() { Drain(); }
+
+void Server::Drain() {
+  if (drained_) return;
+  drained_ = true;
+  if (service_) service_->BeginDrain();
+  if (server_) {
+    server_->Shutdown(std::chrono::system_clock::now() +
+                      std::chrono::milliseconds(config_.drain_timeout_ms));
+    server_->Wait();
+  }
+  if (!config_.listen.unix_socket.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(config_.listen.unix_socket, ec);
+  }
+}
+
+}  // namespace bsls::processd

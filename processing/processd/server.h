@@ -1,0 +1,50 @@
+// bsls-processd assembled: the processing service on a gRPC server with its
+// size caps, the health service, and the listeners of the configuration (a
+// Unix socket for this machine, TCP with mutual TLS or plain on loopback).
+// main() wraps it with signals and systemd notification; the tests and the
+// benchmark start replicas in-process through the same class.
+#ifndef BSLS_PROCESSD_SERVER_H_
+#define BSLS_PROCESSD_SERVER_H_
+
+#include <grpcpp/grpcpp.h>
+
+#include <memory>
+#include <string>
+
+#include "bsls/processing/processing_service.h"
+#include "config.h"
+
+namespace bsls::processd {
+
+class Server {
+ public:
+  // Starts serving `config` (checked first). Throws ConfigError naming the
+  // key, rpc::TlsFileError for an unusable TLS file, std::runtime_error when
+  // a listener cannot be bound.
+  static std::unique_ptr<Server> Start(const Config& config, const std::string& software_version);
+  // Drains (see Drain) if not done yet.
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Refuses new work, stops work under way at its next stage and gives
+  // calls `drain_timeout_ms` to end; then the server is down.
+  void Drain();
+  // The TCP port bound (0 without TCP).
+  int tcp_port() const { return tcp_port_; }
+  // The service, for tests.
+  processing::ProcessingService& service() { return *service_; }
+
+ private:
+  Server() = default;
+
+  Config config_;
+  std::unique_ptr<processing::ProcessingService> service_;
+  std::unique_ptr<grpc::Server> server_;
+  int tcp_port_ = 0;
+  bool drained_ = false;
+};
+
+}  // namespace bsls::processd
+
+#endif  // BSLS_PROCESSD_SERVER_H_

@@ -1,0 +1,613 @@
+#include "bsls/processing/processing_service.h"
+
+#include <spdlog/spdlog.h>
+#include <stdlib.h>
+
+#include <chrono>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
+
+#include "bsls/calibration/calibration_error.h"
+#include "bsls/calibration/calibration_file.h"
+#include "bsls/calibration/calibration_report.h"
+#include "bsls/calibration/manifest.h"
+#include "bsls/decoder/decode_output.h"
+#include "bsls/io/digest.h"
+#include "bsls/io/surface_file.h"
+#include "bsls/rpc/artifacts.h"
+#include "bsls/rpc/frame_message.h"
+#include "bsls/session/session.h"
+
+namespace bsls::processing {
+namespace {
+
+using grpc::Status;
+using grpc::StatusCode;
+namespace fs = std::filesystem;
+
+constexpr std::size_t kMaxTagBytes = 256;
+constexpr std::size_t kMaxPathBytes = 256;
+constexpr std::size_t kMaxChunkBytes = 4u << 20;
+
+// A request that cannot be served, with the status that says why.
+struct Refusal {
+  Status status;
+};
+
+[[noreturn]] void Refuse(StatusCode code, const std::string& message) {
+  throw Refusal{Status(code, message)};
+}
+
+pattern::Side SideOf(v1::Side side, const std::string& field) {
+  if (side == v1::SIDE_LEFT) return pattern::Side::kLeft;
+  if (side == v1::SIDE_RIGHT) return pattern::Side::kRight;
+  Refuse(StatusCode::INVALID_ARGUMENT, field + ": must be SIDE_LEFT or SIDE_RIGHT");
+}
+
+v1::Side ToProto(pattern::Side side) {
+  return side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT;
+}
+
+void CheckTag(const std::string& tag) {
+  if (tag.size() > kMaxTagBytes)
+    Refuse(StatusCode::INVALID_ARGUMENT,
+           "request_tag: " + std::to_string(tag.size()) + " bytes, at most 256");
+}
+
+cv::Mat FrameOf(const v1::Frame& frame, const std::string& name) {
+  try {
+    return rpc::FrameView(frame, name);
+  } catch (const rpc::FrameMessageError& e) {
+    Refuse(StatusCode::INVALID_ARGUMENT, e.what());
+  }
+}
+
+void FillInfo(const CachedCalibration& c, v1::CalibrationInfo* info) {
+  info->set_id(c.id);
+  info->set_side(ToProto(c.calibration.side));
+  info->set_width(static_cast<std::uint32_t>(c.calibration.width));
+  info->set_height(static_cast<std::uint32_t>(c.calibration.height));
+  info->set_software_version(c.software_version);
+  info->set_has_projector_matrix(c.calibration.projector_matrix.has_value());
+}
+
+reconstruction::SidePipelineParams SideParams(const v1::DecodeOptions& decode,
+                                              const v1::SurfaceOptions& surface) {
+  reconstruction::SidePipelineParams params;
+  params.decode.extraction.method = decode.method() == v1::DecodeOptions::METHOD_THESIS
+                                        ? extraction::ExtractionMethod::kThesis
+                                        : extraction::ExtractionMethod::kModern;
+  params.decode.interpretation.enable_repair = !decode.no_repair();
+  params.planes = surface.plane_model() == v1::SurfaceOptions::PLANE_MODEL_PARALLEL
+                      ? reconstruction::PlaneModelKind::kParallel
+                      : reconstruction::PlaneModelKind::kPerspective;
+  params.reconstruction.smooth_lines = surface.smooth_lines();
+  return params;
+}
+
+Eigen::Vector2d PointOf(const v1::PointXY& p) { return {p.x(), p.y()}; }
+
+measurement::Polygon2d PolygonOf(const v1::Polygon& polygon) {
+  measurement::Polygon2d out;
+  for (const v1::PointXY& p : polygon.points()) out.push_back(PointOf(p));
+  return out;
+}
+
+measurement::MeasurementPlan PlanOf(const v1::MeasurementPlan& m, int max_figures) {
+  const int figures = m.heights_size() + m.distances_size() + m.areas_size() + m.lesions_size();
+  if (figures > max_figures)
+    Refuse(StatusCode::INVALID_ARGUMENT, "measurements: " + std::to_string(figures) +
+                                             " figures, at most " + std::to_string(max_figures));
+  measurement::MeasurementPlan plan;
+  for (const v1::PointXY& h : m.heights()) plan.heights.push_back(PointOf(h));
+  for (int i = 0; i < m.distances_size(); ++i) {
+    if (m.distances(i).points_size() != 2)
+      Refuse(StatusCode::INVALID_ARGUMENT, "measurements.distances[" + std::to_string(i) +
+                                               "]: give exactly two points");
+    plan.distances.push_back({PointOf(m.distances(i).points(0)), PointOf(m.distances(i).points(1))});
+  }
+  for (const v1::Polygon& a : m.areas()) plan.areas.push_back(PolygonOf(a));
+  for (const v1::Polygon& l : m.lesions()) plan.lesions.push_back(PolygonOf(l));
+  switch (m.reference()) {
+    case v1::MeasurementPlan::REFERENCE_PLANE:
+      plan.lesion.reference = measurement::ReferenceKind::kPlane;
+      break;
+    case v1::MeasurementPlan::REFERENCE_QUADRIC:
+      plan.lesion.reference = measurement::ReferenceKind::kQuadric;
+      break;
+    default:
+      plan.lesion.reference = measurement::ReferenceKind::kCubic;
+  }
+  if (m.ring_mm() != 0.0) plan.lesion.ring_width_mm = m.ring_mm();
+  std::string why;
+  if (!plan.IsValid(&why)) Refuse(StatusCode::INVALID_ARGUMENT, "measurements: " + why);
+  return plan;
+}
+
+StatusCode CodeOf(calibration::CalibrationErrorReason reason) {
+  switch (reason) {
+    case calibration::CalibrationErrorReason::kInvalidInput:
+    case calibration::CalibrationErrorReason::kUnreadableInput:
+      return StatusCode::INVALID_ARGUMENT;
+    case calibration::CalibrationErrorReason::kInvalidParams:
+      return StatusCode::INTERNAL;
+    case calibration::CalibrationErrorReason::kCancelled:
+      return StatusCode::CANCELLED;
+    default:
+      return StatusCode::FAILED_PRECONDITION;
+  }
+}
+
+std::string DefaultReplicaName() {
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  return std::string(host) + ":" + std::to_string(::getpid());
+}
+
+// A private folder for one upload, removed with everything in it.
+class ScratchFolder {
+ public:
+  explicit ScratchFolder(const fs::path& parent) {
+    std::string pattern = (parent / "bsls-calibrate-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr)
+      Refuse(StatusCode::INTERNAL, "cannot create a scratch folder in " + parent.string());
+    path_ = pattern;
+  }
+  ~ScratchFolder() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+// A relative path of an upload that stays inside its folder; refused otherwise.
+fs::path UploadPath(const std::string& path) {
+  if (path.empty() || path.size() > kMaxPathBytes || path.find('\0') != std::string::npos)
+    Refuse(StatusCode::INVALID_ARGUMENT,
+           "file.path \"" + path.substr(0, 64) + "\": must be 1..256 bytes");
+  const fs::path p(path);
+  if (p.is_absolute())
+    Refuse(StatusCode::INVALID_ARGUMENT, "file.path \"" + path + "\": must be relative");
+  for (const fs::path& part : p)
+    if (part == ".." || part == "." || part.empty())
+      Refuse(StatusCode::INVALID_ARGUMENT,
+             "file.path \"" + path + "\": must not contain \".\" or \"..\"");
+  if (p == "manifest.yaml")
+    Refuse(StatusCode::INVALID_ARGUMENT, "file.path \"manifest.yaml\": is the manifest's own name");
+  return p;
+}
+
+void FillSide(const reconstruction::SideOutcome& o, pattern::Side side, v1::SideSummary* out) {
+  const decoder::DecodeResult& d = o.decode;
+  out->set_side(ToProto(side));
+  out->set_junctions(static_cast<std::uint32_t>(d.junctions.size()));
+  std::uint32_t interpolated = 0;
+  for (const auto& j : d.junctions) interpolated += j.interpolated;
+  out->set_interpolated_junctions(interpolated);
+  out->set_lines(static_cast<std::uint32_t>(d.lines.size()));
+  out->set_q_absolute(d.q_absolute);
+  out->set_rows_note(o.rows_note);
+  out->set_repairs(static_cast<std::uint32_t>(d.repairs));
+  out->set_vertices(static_cast<std::uint32_t>(o.report.vertices));
+  out->set_triangles(static_cast<std::uint32_t>(o.report.triangles));
+  out->set_bridged_samples(static_cast<std::uint32_t>(o.report.bridged_samples));
+}
+
+// SHA-256 of the frame's packed pixels (width * height bytes, as the
+// capture store hashes them).
+std::string PackedSha256(const cv::Mat& grey) {
+  const cv::Mat packed = grey.isContinuous() ? grey : grey.clone();
+  return io::Sha256Hex(
+      std::string_view(reinterpret_cast<const char*>(packed.data), packed.total()));
+}
+
+}  // namespace
+
+std::shared_ptr<const CachedCalibration> ProcessingService::ResolveCalibration(
+    const v1::CalibrationSource& source, const std::string& field) {
+  switch (source.source_case()) {
+    case v1::CalibrationSource::kId: {
+      auto found = calibrations_.Find(source.id());
+      if (!found)
+        Refuse(StatusCode::NOT_FOUND,
+               field + ".id " + source.id().substr(0, 80) + ": replica " + options_.replica +
+                   " does not hold this calibration; send the file (inline or PutCalibration)");
+      return found;
+    }
+    case v1::CalibrationSource::kYaml:
+      try {
+        return calibrations_.Put(source.yaml(), field + ".yaml");
+      } catch (const calibration::CalibrationFileError& e) {
+        Refuse(StatusCode::INVALID_ARGUMENT, e.what());
+      }
+    default:
+      Refuse(StatusCode::INVALID_ARGUMENT, field + ": give an id or the file");
+  }
+}
+
+// What a work call's body gets: where to send events and how to observe.
+struct ProcessingService::Work {
+  const Emit& emit;
+  session::WorkObserver observer;
+  v1::Result result;
+  std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+
+  // Sends an output file; false when the caller went away.
+  void Artifact(const std::string& name, const std::string& media_type, std::string_view bytes) {
+    if (!rpc::EmitArtifact(name, media_type, bytes, emit))
+      throw session::Cancelled("the caller went away while " + name + " was sent");
+  }
+  void Time(const std::string& stage, double ms) {
+    v1::StageTime* t = result.add_times();
+    t->set_stage(stage);
+    t->set_ms(ms);
+  }
+};
+
+ProcessingService::ProcessingService(ProcessingServiceOptions options)
+    : options_(std::move(options)),
+      pool_(options_.workers, options_.queue),
+      calibrations_(options_.calibration_cache_entries) {
+  if (options_.replica.empty()) options_.replica = DefaultReplicaName();
+}
+
+void ProcessingService::BeginDrain() { draining_ = true; }
+
+Status ProcessingService::RunWork(grpc::ServerContext* context, const std::string& call,
+                                  const Emit& emit, const std::function<void(Work&)>& prepare,
+                                  const std::function<void(Work&)>& work) {
+  if (draining_) return Status(StatusCode::UNAVAILABLE, "the service is shutting down");
+  std::optional<WorkPool::Ticket> ticket = pool_.TryAdmit();
+  if (!ticket) {
+    const WorkPoolStats s = pool_.Stats();
+    return Status(StatusCode::RESOURCE_EXHAUSTED,
+                  "replica " + options_.replica + " is full: " + std::to_string(s.workers) +
+                      " workers and " + std::to_string(s.queue) +
+                      " queue places taken; retry later or on another replica");
+  }
+  const auto deadline = context->deadline();
+  auto gave_up = [this, context, deadline] {
+    return context->IsCancelled() || draining_ || std::chrono::system_clock::now() > deadline;
+  };
+  auto stopped_status = [this, context, deadline, &call] {
+    if (std::chrono::system_clock::now() > deadline)
+      return Status(StatusCode::DEADLINE_EXCEEDED, call + ": the deadline passed; work stopped");
+    if (draining_ && !context->IsCancelled())
+      return Status(StatusCode::UNAVAILABLE, call + ": the service is shutting down; work stopped");
+    return Status(StatusCode::CANCELLED, call + ": cancelled; work stopped");
+  };
+  v1::WorkEvent queued;
+  queued.mutable_progress()->set_stage("queued");
+  if (!emit(queued)) return stopped_status();
+
+  Work w{emit, {}, {}};
+  w.observer.cancelled = gave_up;
+  w.observer.progress = [&emit](std::string_view stage, double fraction) {
+    v1::WorkEvent event;
+    event.mutable_progress()->set_stage(std::string(stage));
+    event.mutable_progress()->set_fraction(fraction);
+    emit(event);
+  };
+  try {
+    if (prepare) prepare(w);
+    if (!ticket->WaitForWorker(gave_up)) return stopped_status();
+    work(w);
+  } catch (const Refusal& r) {
+    return r.status;
+  } catch (const session::Cancelled&) {
+    return stopped_status();
+  } catch (const session::SessionError& e) {
+    return Status(e.reason() == session::SessionErrorReason::kInvalidInput
+                      ? StatusCode::INVALID_ARGUMENT
+                      : StatusCode::FAILED_PRECONDITION,
+                  e.what());
+  } catch (const calibration::CalibrationError& e) {
+    if (e.reason() == calibration::CalibrationErrorReason::kCancelled) return stopped_status();
+    return Status(CodeOf(e.reason()), e.what());
+  } catch (const reconstruction::ReconstructionError& e) {
+    return Status(StatusCode::FAILED_PRECONDITION, e.what());
+  } catch (const std::invalid_argument& e) {
+    return Status(StatusCode::INVALID_ARGUMENT, e.what());
+  } catch (const std::bad_alloc&) {
+    return Status(StatusCode::RESOURCE_EXHAUSTED, call + ": out of memory");
+  } catch (const std::exception& e) {
+    spdlog::error("{}: internal error: {}", call, e.what());
+    return Status(StatusCode::INTERNAL, call + ": internal error: " + e.what());
+  }
+  w.result.set_software_version(options_.software_version);
+  w.result.set_replica(options_.replica);
+  w.Time("total", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
+                                                             w.start)
+                      .count());
+  v1::WorkEvent done;
+  *done.mutable_result() = std::move(w.result);
+  if (!emit(done)) return stopped_status();
+  return Status::OK;
+}
+
+Status ProcessingService::ProcessFrame(grpc::ServerContext* context,
+                                       const v1::ProcessFrameRequest* request,
+                                       grpc::ServerWriter<v1::WorkEvent>* writer) {
+  const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
+  return RunWork(context, "ProcessFrame", emit, {}, [&](Work& w) {
+    // Every field is checked before any work.
+    const cv::Mat grey = FrameOf(request->frame(), "frame");
+    const pattern::Side side = SideOf(request->side(), "side");
+    CheckTag(request->request_tag());
+    std::shared_ptr<const CachedCalibration> cal;
+    if (request->calibration().source_case() != v1::CalibrationSource::SOURCE_NOT_SET)
+      cal = ResolveCalibration(request->calibration(), "calibration");
+    if (request->want_surface() && !cal)
+      Refuse(StatusCode::INVALID_ARGUMENT, "want_surface: needs a calibration");
+    reconstruction::SidePipelineParams params = SideParams(request->decode(), request->surface());
+    params.reconstruct = request->want_surface();
+
+    w.observer.CheckCancelled("the decode");
+    w.observer.Report(request->want_surface() ? "decode and reconstruct" : "decode", 0.0);
+    reconstruction::SideGeometry geometry;
+    if (cal) geometry = &cal->calibration;
+    const reconstruction::SideOutcome outcome =
+        reconstruction::ProcessSide(grey, side, geometry, params);
+    const decoder::DecodeResult& d = outcome.decode;
+    if (!d.ok) Refuse(StatusCode::FAILED_PRECONDITION, "frame: " + d.error);
+    w.observer.CheckCancelled("sending the results");
+    w.observer.Report("results", 0.9);
+    w.Artifact("junctions.json", "application/json", decoder::ToJson(d).dump(1) + "\n");
+    if (request->want_overlay()) {
+      std::vector<unsigned char> png;
+      cv::imencode(".png", decoder::RenderOverlay(grey, d), png);
+      w.Artifact("overlay.png", "image/png",
+                 std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+    }
+    if (outcome.surface)
+      w.Artifact("surface.ply", "application/x-ply",
+                 io::EncodePly(*outcome.surface, request->surface().ascii_ply()
+                                                     ? io::PlyEncoding::kAscii
+                                                     : io::PlyEncoding::kBinaryLittleEndian));
+    FillSide(outcome, side, w.result.add_sides());
+    if (cal) w.result.add_calibration_ids(cal->id);
+    w.result.set_request_tag(request->request_tag());
+    w.result.set_frame_sha256(PackedSha256(grey));
+    w.Time("extraction", d.times.extraction_ms);
+    w.Time("interpretation", d.times.interpretation_ms);
+    w.Time("subpixel", d.times.subpixel_ms);
+    w.Time("decode", d.times.total_ms);
+    if (outcome.surface) w.Time("reconstruct", outcome.report.time_ms);
+  });
+}
+
+Status ProcessingService::ReconstructSession(grpc::ServerContext* context,
+                                             const v1::ReconstructSessionRequest* request,
+                                             grpc::ServerWriter<v1::WorkEvent>* writer) {
+  const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
+  return RunWork(context, "ReconstructSession", emit, {}, [&](Work& w) {
+    const cv::Mat left = FrameOf(request->left(), "left");
+    const cv::Mat right = FrameOf(request->right(), "right");
+    CheckTag(request->request_tag());
+    const auto left_cal = ResolveCalibration(request->left_calibration(), "left_calibration");
+    const auto right_cal = ResolveCalibration(request->right_calibration(), "right_calibration");
+    session::SessionParams params;
+    params.side = SideParams({}, request->surface());
+    switch (request->join()) {
+      case v1::ReconstructSessionRequest::JOIN_SHARED:
+        params.join = session::JoinMode::kShared;
+        break;
+      case v1::ReconstructSessionRequest::JOIN_FEATURES:
+        params.join = session::JoinMode::kFeatures;
+        break;
+      default:
+        params.join = session::JoinMode::kAuto;
+    }
+    params.measurements = PlanOf(request->measurements(), options_.max_measurements);
+
+    const session::SessionOutcome s = session::ReconstructSession(
+        left, left_cal->calibration, right, right_cal->calibration, params, w.observer);
+    w.observer.CheckCancelled("sending the results");
+    w.observer.Report("results", 0.95);
+    const auto encoding = request->surface().ascii_ply() ? io::PlyEncoding::kAscii
+                                                         : io::PlyEncoding::kBinaryLittleEndian;
+    if (request->want_junctions()) {
+      w.Artifact("left.junctions.json", "application/json",
+                 decoder::ToJson(s.left.decode).dump(1) + "\n");
+      w.Artifact("right.junctions.json", "application/json",
+                 decoder::ToJson(s.right.decode).dump(1) + "\n");
+    }
+    if (request->want_side_surfaces()) {
+      w.Artifact("left.ply", "application/x-ply", io::EncodePly(*s.left.surface, encoding));
+      w.Artifact("right.ply", "application/x-ply", io::EncodePly(*s.right.surface, encoding));
+    }
+    nlohmann::json report = session::SessionReport(s, "left", "right");
+    report["calibrations"] = {{"left", left_cal->id}, {"right", right_cal->id}};
+    report["frames_sha256"] = {{"left", PackedSha256(left)}, {"right", PackedSha256(right)}};
+    report["software_version"] = options_.software_version;
+    report["replica"] = options_.replica;
+    w.Artifact("report.json", "application/json", report.dump(2) + "\n");
+    if (s.measurements) {
+      nlohmann::json m = s.measurements->report;
+      m["table"] = measurement::FormatTable(s.measurements->rows, 2);
+      w.Artifact("measurements.json", "application/json", m.dump(2) + "\n");
+    }
+    w.Artifact("surface.ply", "application/x-ply", io::EncodePly(s.joined.mesh, encoding));
+
+    FillSide(s.left, pattern::Side::kLeft, w.result.add_sides());
+    FillSide(s.right, pattern::Side::kRight, w.result.add_sides());
+    w.result.add_calibration_ids(left_cal->id);
+    w.result.add_calibration_ids(right_cal->id);
+    w.result.set_request_tag(request->request_tag());
+    w.result.set_join_method(s.by_features ? "features+icp" : "shared-frame");
+    w.result.set_seam_rms_mm(s.joined.seam.rms_mm);
+    w.result.set_seam_max_mm(s.joined.seam.max_mm);
+    w.result.set_vertices(static_cast<std::uint32_t>(s.joined.mesh.VertexCount()));
+    w.result.set_triangles(static_cast<std::uint32_t>(s.joined.mesh.faces.size()));
+    w.Time("left decode", s.left.decode.times.total_ms);
+    w.Time("left reconstruct", s.left.report.time_ms);
+    w.Time("right decode", s.right.decode.times.total_ms);
+    w.Time("right reconstruct", s.right.report.time_ms);
+    w.Time("session", s.total_ms);
+  });
+}
+
+Status ProcessingService::Calibrate(
+    grpc::ServerContext* context,
+    grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream) {
+  const Emit emit = [stream](const v1::WorkEvent& e) { return stream->Write(e); };
+  // The manifest comes first: without it there is nothing to queue for.
+  v1::CalibrateRequest first;
+  if (!stream->Read(&first))
+    return Status(StatusCode::INVALID_ARGUMENT, "Calibrate: the upload ended before the manifest");
+  if (first.part_case() != v1::CalibrateRequest::kManifest)
+    return Status(StatusCode::INVALID_ARGUMENT, "Calibrate: the first message must be the manifest");
+  if (first.manifest().yaml().size() > options_.max_manifest_bytes)
+    return Status(StatusCode::INVALID_ARGUMENT,
+                  "manifest.yaml: " + std::to_string(first.manifest().yaml().size()) +
+                      " bytes, at most " + std::to_string(options_.max_manifest_bytes));
+  if (first.manifest().request_tag().size() > kMaxTagBytes)
+    return Status(StatusCode::INVALID_ARGUMENT, "manifest.request_tag: at most 256 bytes");
+
+  // The upload is taken while the call holds a queue place, before a worker.
+  std::optional<ScratchFolder> scratch;
+  const auto upload = [&](Work& w) {
+    const ScratchFolder& folder = scratch.emplace(options_.scratch_dir);
+    {
+      std::ofstream manifest(folder.path() / "manifest.yaml", std::ios::binary);
+      manifest << first.manifest().yaml();
+      if (!manifest.flush())
+        Refuse(StatusCode::INTERNAL, "cannot write the manifest to " + folder.path().string());
+    }
+    // The upload: every file in order, chunk by chunk, within the limits.
+    w.observer.Report("upload", 0.0);
+    std::map<fs::path, std::uint64_t> sizes;  // bytes received so far, by file
+    std::map<fs::path, bool> complete;
+    std::uint64_t total = 0;
+    std::optional<fs::path> open_path;
+    std::ofstream out;
+    v1::CalibrateRequest part;
+    while (stream->Read(&part)) {
+      w.observer.CheckCancelled("the upload's end");
+      if (part.part_case() != v1::CalibrateRequest::kFile)
+        Refuse(StatusCode::INVALID_ARGUMENT, "Calibrate: a second manifest in the upload");
+      const v1::FileChunk& chunk = part.file();
+      const fs::path path = UploadPath(chunk.path());
+      const std::string name = "file " + chunk.path();
+      if (chunk.data().size() > kMaxChunkBytes)
+        Refuse(StatusCode::INVALID_ARGUMENT, name + ": a chunk above 4 MiB");
+      if (complete.count(path)) Refuse(StatusCode::INVALID_ARGUMENT, name + ": sent twice");
+      if (open_path != path) {
+        if (open_path)
+          Refuse(StatusCode::INVALID_ARGUMENT,
+                 name + ": begun before file " + open_path->string() + " was complete");
+        if (static_cast<int>(complete.size()) >= options_.max_upload_files)
+          Refuse(StatusCode::INVALID_ARGUMENT,
+                 name + ": more than " + std::to_string(options_.max_upload_files) + " files");
+        fs::create_directories(folder.path() / path.parent_path());
+        out.open(folder.path() / path, std::ios::binary | std::ios::trunc);
+        if (!out) Refuse(StatusCode::INTERNAL, name + ": cannot be written to the scratch folder");
+        open_path = path;
+      }
+      if (chunk.offset() != sizes[path])
+        Refuse(StatusCode::INVALID_ARGUMENT, name + ": a chunk at offset " +
+                                                 std::to_string(chunk.offset()) + " after " +
+                                                 std::to_string(sizes[path]) + " bytes");
+      total += chunk.data().size();
+      if (total > options_.max_upload_bytes)
+        Refuse(StatusCode::RESOURCE_EXHAUSTED,
+               "Calibrate: the upload exceeds " + std::to_string(options_.max_upload_bytes) +
+                   " bytes");
+      out.write(chunk.data().data(), static_cast<std::streamsize>(chunk.data().size()));
+      sizes[path] += chunk.data().size();
+      if (chunk.last()) {
+        out.close();
+        if (!out) Refuse(StatusCode::INTERNAL, name + ": cannot be written to the scratch folder");
+        complete[path] = true;
+        open_path.reset();
+      }
+    }
+    if (open_path)
+      Refuse(StatusCode::INVALID_ARGUMENT,
+             "file " + open_path->string() + ": the upload ended before its last chunk");
+  };
+  return RunWork(context, "Calibrate", emit, upload, [&](Work& w) {
+    const ScratchFolder& folder = *scratch;
+    // Paths in errors are the client's, not the scratch folder's.
+    const std::string prefix = folder.path().string() + "/";
+    auto strip = [&prefix](std::string text) {
+      for (size_t at; (at = text.find(prefix)) != std::string::npos;) text.erase(at, prefix.size());
+      return text;
+    };
+    calibration::Manifest manifest;
+    try {
+      manifest = calibration::LoadManifest(folder.path() / "manifest.yaml");
+    } catch (const calibration::ManifestError& e) {
+      Refuse(StatusCode::INVALID_ARGUMENT, strip(e.what()));
+    }
+    calibration::SideCalibration result;
+    try {
+      result = calibration::CalibrateSide(
+          manifest, {}, [&w](const std::string& view, double fraction) {
+            if (w.observer.cancelled && w.observer.cancelled()) return false;
+            w.observer.Report("calibrate " + view, 0.05 + 0.9 * fraction);
+            return true;
+          });
+    } catch (const calibration::CalibrationError& e) {
+      if (e.reason() == calibration::CalibrationErrorReason::kCancelled) throw;
+      throw calibration::CalibrationError(e.reason(), strip(e.what()));
+    }
+    const std::string yaml = calibration::CalibrationToYaml(result, options_.software_version);
+    const auto cached = calibrations_.Put(yaml, "the new calibration");
+    nlohmann::json report = calibration::CalibrationReport(result);
+    report["calibration_id"] = cached->id;
+    w.Artifact("calibration-report.json", "application/json", report.dump(1) + "\n");
+    w.Artifact("calibration.yaml", "application/yaml", yaml);
+    w.result.set_calibration_id(cached->id);
+    w.result.set_request_tag(first.manifest().request_tag());
+    w.Time("calibrate", result.diagnostics.times.total_ms);
+  });
+}
+
+Status ProcessingService::PutCalibration(grpc::ServerContext*,
+                                         const v1::PutCalibrationRequest* request,
+                                         v1::CalibrationInfo* response) {
+  try {
+    FillInfo(*calibrations_.Put(request->yaml(), "calibration"), response);
+  } catch (const calibration::CalibrationFileError& e) {
+    return Status(StatusCode::INVALID_ARGUMENT, e.what());
+  }
+  return Status::OK;
+}
+
+Status ProcessingService::GetCalibration(grpc::ServerContext*,
+                                         const v1::GetCalibrationRequest* request,
+                                         v1::CalibrationFile* response) {
+  v1::CalibrationSource source;
+  source.set_id(request->id());
+  try {
+    const auto found = ResolveCalibration(source, "id");
+    FillInfo(*found, response->mutable_info());
+    response->set_yaml(found->yaml);
+  } catch (const Refusal& r) {
+    return r.status;
+  }
+  return Status::OK;
+}
+
+Status ProcessingService::GetServerInfo(grpc::ServerContext*, const v1::GetServerInfoRequest*,
+                                        v1::ServerInfo* response) {
+  const WorkPoolStats s = pool_.Stats();
+  response->set_software_version(options_.software_version);
+  response->set_replica(options_.replica);
+  response->set_workers(static_cast<std::uint32_t>(s.workers));
+  response->set_queue(static_cast<std::uint32_t>(s.queue));
+  response->set_busy(static_cast<std::uint32_t>(s.busy));
+  response->set_waiting(static_cast<std::uint32_t>(s.waiting));
+  response->set_completed(s.completed);
+  response->set_rejected(s.rejected);
+  response->set_cached_calibrations(static_cast<std::uint32_t>(calibrations_.size()));
+  return Status::OK;
+}
+
+}  // namespace bsls::processing

@@ -1,0 +1,60 @@
+// bsls-processd's configuration: defaults, overrides, and the network rules
+// (mutual TLS for TCP; plain TCP only on loopback when asked for).
+#include "config.h"
+
+#include <gtest/gtest.h>
+
+#include "bsls/rpc/tls.h"
+
+namespace bsls::processd {
+namespace {
+
+std::string ErrorOf(const std::vector<std::string>& overrides) {
+  try {
+    LoadConfig(std::nullopt, overrides);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ProcessdConfig, DefaultsServeTheLocalSocketOnly) {
+  const Config c = LoadConfig(std::nullopt, {});
+  EXPECT_EQ(c.listen.unix_socket, "/run/bsls-processd/processd.sock");
+  EXPECT_TRUE(c.listen.tcp.empty());
+  EXPECT_GE(Workers(c), 1);
+  EXPECT_EQ(Queue(c), 2 * Workers(c));
+}
+
+TEST(ProcessdConfig, TcpIsMutualTlsUnlessPlainLoopback) {
+  EXPECT_NE(ErrorOf({"listen.tcp=0.0.0.0:7000"}).find("mutual TLS only"), std::string::npos);
+  EXPECT_NE(ErrorOf({"listen.tcp=10.1.2.3:7000", "listen.plaintext_loopback=true"})
+                .find("only for loopback"),
+            std::string::npos);
+  EXPECT_EQ(ErrorOf({"listen.tcp=127.0.0.1:0", "listen.plaintext_loopback=true"}), "");
+  EXPECT_EQ(ErrorOf({"listen.tcp=\"[::1]:0\"", "listen.plaintext_loopback=true"}), "");
+  EXPECT_EQ(ErrorOf({"listen.tcp=localhost:7000", "listen.plaintext_loopback=true"}), "");
+}
+
+TEST(ProcessdConfig, ErrorsNameTheKey) {
+  EXPECT_NE(ErrorOf({"workers=-3"}).find("workers"), std::string::npos);
+  EXPECT_NE(ErrorOf({"listen.tpc=1"}).find("listen.tpc"), std::string::npos);
+  EXPECT_NE(ErrorOf({"log_level=loud"}).find("log_level"), std::string::npos);
+  EXPECT_NE(ErrorOf({"listen.unix_socket=\"\""}).find("listen.unix_socket or listen.tcp"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf({"scratch_dir=/nonexistent/x"}).find("scratch_dir"), std::string::npos);
+}
+
+TEST(RpcTargets, LoopbackIsRecognised) {
+  EXPECT_TRUE(rpc::IsLoopbackTarget("127.0.0.1:7000"));
+  EXPECT_TRUE(rpc::IsLoopbackTarget("ipv4:127.0.0.1:7001,127.0.0.2:7002"));
+  EXPECT_TRUE(rpc::IsLoopbackTarget("[::1]:7000"));
+  EXPECT_TRUE(rpc::IsLoopbackTarget("dns:///localhost:7000"));
+  EXPECT_FALSE(rpc::IsLoopbackTarget("ipv4:127.0.0.1:7001,10.0.0.2:7002"));
+  EXPECT_FALSE(rpc::IsLoopbackTarget("processd.clinic:7000"));
+  EXPECT_FALSE(rpc::IsLoopbackTarget("128.0.0.1:7000"));
+  EXPECT_TRUE(rpc::IsUnixTarget("unix:/run/x.sock"));
+}
+
+}  // namespace
+}  // namespace bsls::processd

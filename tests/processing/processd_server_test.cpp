@@ -1,0 +1,127 @@
+// bsls-processd's server assembly: the Unix socket and plain loopback TCP
+// for one machine, mutual TLS for the network (every handshake without a
+// certificate of the configured CA fails), draining.
+#include "server.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "bsls/processing/processing_client.h"
+#include "bsls/testing/certificates.h"
+
+namespace bsls::processd {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ProcessdServer : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::path(::testing::TempDir()) / ("processd-" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  static grpc::Status Info(const std::shared_ptr<grpc::Channel>& channel, v1::ServerInfo* info) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(5));
+    return v1::Processing::NewStub(channel)->GetServerInfo(&context, {}, info);
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ProcessdServer, ServesTheUnixSocketAndPlainLoopback) {
+  Config config;
+  config.listen.unix_socket = (dir_ / "processd.sock").string();
+  config.listen.tcp = "127.0.0.1:0";
+  config.listen.plaintext_loopback = true;
+  config.workers = 1;
+  config.replica = "r1";
+  auto server = Server::Start(config, "test");
+  ASSERT_GT(server->tcp_port(), 0);
+  for (const std::string target :
+       {"unix:" + config.listen.unix_socket, "127.0.0.1:" + std::to_string(server->tcp_port())}) {
+    processing::ClientOptions options;
+    options.target = target;
+    v1::ServerInfo info;
+    const grpc::Status status = Info(processing::OpenProcessingChannel(options), &info);
+    ASSERT_TRUE(status.ok()) << target << ": " << status.error_message();
+    EXPECT_EQ(info.replica(), "r1");
+    EXPECT_EQ(info.workers(), 1u);
+    EXPECT_EQ(info.queue(), 2u);
+  }
+  server->Drain();
+  EXPECT_FALSE(fs::exists(config.listen.unix_socket));
+}
+
+TEST_F(ProcessdServer, TcpServesOnlyMutualTlsClientsOfItsCa) {
+  testing::TestPki pki(dir_ / "pki", "clinic");
+  const testing::PemFiles server_files = pki.Issue("localhost", true);
+  const testing::PemFiles analyst = pki.Issue("analyst");
+  testing::TestPki rogue(dir_ / "pki", "rogue");
+  const testing::PemFiles forged = rogue.Issue("analyst");
+  ASSERT_TRUE(pki.ok() && rogue.ok());
+  Config config;
+  config.listen.unix_socket = "";
+  config.listen.tcp = "localhost:0";
+  config.listen.tls_certificate = server_files.certificate;
+  config.listen.tls_key = server_files.key;
+  config.listen.tls_client_ca = pki.ca();
+  auto server = Server::Start(config, "test");
+  const std::string target = "localhost:" + std::to_string(server->tcp_port());
+
+  processing::ClientOptions good;
+  good.target = target;
+  good.tls = {pki.ca(), analyst.certificate, analyst.key};
+  v1::ServerInfo info;
+  const grpc::Status ok = Info(processing::OpenProcessingChannel(good), &info);
+  ASSERT_TRUE(ok.ok()) << ok.error_message();
+
+  // 100 handshakes without a certificate and 100 with one of another CA:
+  // every one fails, each on a fresh channel (no connection reuse).
+  int plain_failures = 0, forged_failures = 0;
+  for (int i = 0; i < 100; ++i) {
+    grpc::ChannelArguments args;
+    args.SetInt("bsls.test.fresh", i);  // a distinct channel, never a shared subchannel
+    grpc::SslCredentialsOptions no_cert;
+    no_cert.pem_root_certs = testing::ReadText(pki.ca());
+    plain_failures += !Info(grpc::CreateCustomChannel(target, grpc::SslCredentials(no_cert), args),
+                            &info)
+                           .ok();
+    processing::ClientOptions bad = good;
+    bad.tls = {pki.ca(), forged.certificate, forged.key};
+    grpc::SslCredentialsOptions forged_cert;
+    forged_cert.pem_root_certs = testing::ReadText(pki.ca());
+    forged_cert.pem_cert_chain = testing::ReadText(forged.certificate);
+    forged_cert.pem_private_key = testing::ReadText(forged.key);
+    forged_failures +=
+        !Info(grpc::CreateCustomChannel(target, grpc::SslCredentials(forged_cert), args), &info)
+             .ok();
+  }
+  EXPECT_EQ(plain_failures, 100);
+  EXPECT_EQ(forged_failures, 100);
+  // Plain TCP to a TLS port fails too; and the client refuses plain TCP to
+  // another machine before it tries.
+  EXPECT_FALSE(
+      Info(grpc::CreateChannel(target, grpc::InsecureChannelCredentials()), &info).ok());
+  processing::ClientOptions remote;
+  remote.target = "processd.clinic:7000";
+  EXPECT_THROW(processing::OpenProcessingChannel(remote), std::invalid_argument);
+}
+
+TEST_F(ProcessdServer, RefusesAnUnusableConfiguration) {
+  Config config;
+  config.listen.unix_socket = "";
+  config.listen.tcp = "0.0.0.0:0";  // no TLS files
+  EXPECT_THROW(Server::Start(config, "test"), ConfigError);
+  config.listen.tls_certificate = (dir_ / "missing.pem").string();
+  config.listen.tls_key = config.listen.tls_certificate;
+  config.listen.tls_client_ca = config.listen.tls_certificate;
+  EXPECT_THROW(Server::Start(config, "test"), rpc::TlsFileError);
+}
+
+}  // namespace
+}  // namespace bsls::processd

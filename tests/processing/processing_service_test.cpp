@@ -1,0 +1,410 @@
+// bsls-processd's service through gRPC (in-process channel): the three work
+// calls against the simulator, the calibration cache, the bounded pool,
+// cancellation and deadlines, and every kind of bad request.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <thread>
+
+#include "bsls/io/surface_file.h"
+#include "bsls/simulator/calibration_session.h"
+#include "service_fixture.h"
+
+namespace bsls::processing::test {
+namespace {
+
+namespace fs = std::filesystem;
+using grpc::StatusCode;
+
+v1::ProcessFrameRequest FaceRequest(pattern::Side side, bool with_calibration) {
+  v1::ProcessFrameRequest request;
+  *request.mutable_frame() = FrameMessage(FaceFrame(side));
+  request.set_side(side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
+  if (with_calibration) {
+    *request.mutable_calibration() = ProcessingClient::Inline(CalibrationYaml(side));
+    request.set_want_surface(true);
+  }
+  return request;
+}
+
+v1::ReconstructSessionRequest SessionRequest() {
+  v1::ReconstructSessionRequest request;
+  *request.mutable_left() = FrameMessage(FaceFrame(pattern::Side::kLeft));
+  *request.mutable_right() = FrameMessage(FaceFrame(pattern::Side::kRight));
+  *request.mutable_left_calibration() =
+      ProcessingClient::Inline(CalibrationYaml(pattern::Side::kLeft));
+  *request.mutable_right_calibration() =
+      ProcessingClient::Inline(CalibrationYaml(pattern::Side::kRight));
+  return request;
+}
+
+// The status of a work call made with a plain stub (no client retries).
+template <typename Request>
+grpc::Status CallFrame(InProcessService& s, const Request& request) {
+  ProcessingClient client = s.Client();
+  if constexpr (std::is_same_v<Request, v1::ProcessFrameRequest>)
+    return client.ProcessFrame(request).status;
+  else
+    return client.ReconstructSession(request).status;
+}
+
+TEST(ProcessingService, ProcessFrameDecodesAndReconstructsOneSide) {
+  InProcessService s;
+  v1::ProcessFrameRequest request = FaceRequest(pattern::Side::kLeft, true);
+  request.set_want_overlay(true);
+  request.set_request_tag("bed 3");
+  std::vector<std::string> stages;
+  const WorkOutcome out = s.Client().ProcessFrame(
+      request, [&](const v1::Progress& p) { stages.push_back(p.stage()); });
+  ASSERT_TRUE(out.status.ok()) << out.status.error_message();
+  ASSERT_FALSE(stages.empty());
+  EXPECT_EQ(stages.front(), "queued");
+  ASSERT_EQ(out.result.sides_size(), 1);
+  const v1::SideSummary& side = out.result.sides(0);
+  EXPECT_TRUE(side.q_absolute()) << side.rows_note();
+  EXPECT_GT(side.junctions(), 300u);
+  EXPECT_GT(side.vertices(), 5000u);
+  EXPECT_EQ(out.result.request_tag(), "bed 3");
+  EXPECT_EQ(out.result.replica(), "replica-under-test");
+  ASSERT_EQ(out.result.calibration_ids_size(), 1);
+  EXPECT_EQ(out.result.calibration_ids(0),
+            CalibrationCache::IdOf(CalibrationYaml(pattern::Side::kLeft)));
+  EXPECT_EQ(out.result.frame_sha256().size(), 64u);
+
+  // The files are the contracts' outputs and agree with the summary.
+  ASSERT_TRUE(out.files.count("junctions.json"));
+  const nlohmann::json junctions = nlohmann::json::parse(out.files.at("junctions.json"));
+  EXPECT_EQ(junctions.at("junctions").size(), side.junctions());
+  const geometry::SurfaceMesh mesh = io::DecodePly(out.files.at("surface.ply"), "surface.ply");
+  EXPECT_EQ(mesh.VertexCount(), side.vertices());
+  const std::string& png = out.files.at("overlay.png");
+  const cv::Mat overlay = cv::imdecode(std::vector<unsigned char>(png.begin(), png.end()),
+                                       cv::IMREAD_COLOR);
+  EXPECT_EQ(overlay.cols, FaceFrame(pattern::Side::kLeft).cols);
+  // The calibration sent inline is now cached by its id.
+  EXPECT_EQ(s.service().calibrations().size(), 1u);
+}
+
+TEST(ProcessingService, ProcessFrameWithoutCalibrationDecodesOnly) {
+  InProcessService s;
+  const WorkOutcome out = s.Client().ProcessFrame(FaceRequest(pattern::Side::kRight, false));
+  ASSERT_TRUE(out.status.ok()) << out.status.error_message();
+  EXPECT_FALSE(out.result.sides(0).q_absolute());
+  EXPECT_TRUE(out.files.count("junctions.json"));
+  EXPECT_FALSE(out.files.count("surface.ply"));
+}
+
+TEST(ProcessingService, ReconstructSessionJoinsAndMeasures) {
+  InProcessService s;
+  v1::ReconstructSessionRequest request = SessionRequest();
+  request.set_want_side_surfaces(true);
+  request.set_want_junctions(true);
+  // The nose tip region and a height beside it (world mm, contracts 3).
+  v1::MeasurementPlan* plan = request.mutable_measurements();
+  v1::PointXY* h = plan->add_heights();
+  h->set_x(0);
+  h->set_y(-60);
+  v1::Polygon* area = plan->add_areas();
+  for (auto [x, y] : {std::pair{-10.0, -50.0}, {10.0, -50.0}, {10.0, -70.0}, {-10.0, -70.0}}) {
+    v1::PointXY* p = area->add_points();
+    p->set_x(x);
+    p->set_y(y);
+  }
+  double last_fraction = -1;
+  bool ordered = true;
+  const WorkOutcome out = s.Client().ReconstructSession(request, [&](const v1::Progress& p) {
+    ordered = ordered && p.fraction() >= last_fraction;
+    last_fraction = p.fraction();
+  });
+  ASSERT_TRUE(out.status.ok()) << out.status.error_message();
+  EXPECT_TRUE(ordered);
+  EXPECT_EQ(out.result.join_method(), "shared-frame");
+  EXPECT_LT(out.result.seam_rms_mm(), 0.3);
+  EXPECT_EQ(out.result.sides_size(), 2);
+  for (const char* name : {"surface.ply", "left.ply", "right.ply", "report.json",
+                           "measurements.json", "left.junctions.json", "right.junctions.json"})
+    EXPECT_TRUE(out.files.count(name)) << name;
+  const geometry::SurfaceMesh joined = io::DecodePly(out.files.at("surface.ply"), "surface.ply");
+  EXPECT_EQ(joined.VertexCount(), out.result.vertices());
+  const nlohmann::json report = nlohmann::json::parse(out.files.at("report.json"));
+  EXPECT_EQ(report.at("calibrations").at("left"), out.result.calibration_ids(0));
+  EXPECT_EQ(report.at("software_version"), "test");
+  const nlohmann::json m = nlohmann::json::parse(out.files.at("measurements.json"));
+  ASSERT_EQ(m.at("heights").size(), 1u);
+  EXPECT_GT(m.at("heights")[0].at("height_mm").at("value").get<double>(), 0.0);
+  ASSERT_EQ(m.at("areas").size(), 1u);
+  // A 20 x 20 mm square on a curved face: at least its flat area.
+  EXPECT_GT(m.at("areas")[0].at("area_mm2").at("value").get<double>(), 399.0);
+}
+
+TEST(ProcessingService, BadRequestsAreRefusedWithTheFieldNamed) {
+  InProcessService s;
+  struct Case {
+    std::string name;
+    std::function<void(v1::ProcessFrameRequest&)> damage;
+    StatusCode code;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {"short pixels", [](auto& r) { r.mutable_frame()->mutable_pixels()->resize(100); },
+       StatusCode::INVALID_ARGUMENT, "frame"},
+      {"zero width", [](auto& r) { r.mutable_frame()->set_width(0); },
+       StatusCode::INVALID_ARGUMENT, "frame"},
+      {"huge", [](auto& r) { r.mutable_frame()->set_height(100000); },
+       StatusCode::INVALID_ARGUMENT, "4096"},
+      {"stride below width", [](auto& r) { r.mutable_frame()->set_stride(3); },
+       StatusCode::INVALID_ARGUMENT, "stride"},
+      {"no side", [](auto& r) { r.set_side(v1::SIDE_UNSPECIFIED); },
+       StatusCode::INVALID_ARGUMENT, "side"},
+      {"surface without calibration",
+       [](auto& r) {
+         r.clear_calibration();
+         r.set_want_surface(true);
+       },
+       StatusCode::INVALID_ARGUMENT, "want_surface"},
+      {"unknown calibration id",
+       [](auto& r) { r.mutable_calibration()->set_id("sha256:" + std::string(64, 'a')); },
+       StatusCode::NOT_FOUND, "does not hold"},
+      {"garbage calibration",
+       [](auto& r) { r.mutable_calibration()->set_yaml("format: [unclosed"); },
+       StatusCode::INVALID_ARGUMENT, "calibration"},
+      {"calibration of the other side",
+       [](auto& r) {
+         *r.mutable_calibration() =
+             ProcessingClient::Inline(CalibrationYaml(pattern::Side::kRight));
+       },
+       StatusCode::INVALID_ARGUMENT, "right"},
+      {"all black",
+       [](auto& r) {
+         std::fill(r.mutable_frame()->mutable_pixels()->begin(),
+                   r.mutable_frame()->mutable_pixels()->end(), 0);
+       },
+       StatusCode::FAILED_PRECONDITION, "frame"},
+      {"long tag", [](auto& r) { r.set_request_tag(std::string(300, 'x')); },
+       StatusCode::INVALID_ARGUMENT, "request_tag"},
+  };
+  for (const Case& c : cases) {
+    v1::ProcessFrameRequest request = FaceRequest(pattern::Side::kLeft, true);
+    c.damage(request);
+    const grpc::Status status = CallFrame(s, request);
+    EXPECT_EQ(status.error_code(), c.code) << c.name << ": " << status.error_message();
+    EXPECT_NE(status.error_message().find(c.says), std::string::npos)
+        << c.name << ": " << status.error_message();
+  }
+  // Sessions: swapped calibrations, a distance with three points.
+  v1::ReconstructSessionRequest swapped = SessionRequest();
+  std::swap(*swapped.mutable_left_calibration(), *swapped.mutable_right_calibration());
+  EXPECT_EQ(CallFrame(s, swapped).error_code(), StatusCode::INVALID_ARGUMENT);
+  v1::ReconstructSessionRequest bad_distance = SessionRequest();
+  for (int i = 0; i < 3; ++i) bad_distance.mutable_measurements()->add_distances()->add_points();
+  const grpc::Status status = CallFrame(s, bad_distance);
+  EXPECT_EQ(status.error_code(), StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("distances[0]"), std::string::npos);
+  // Nothing was left running or queued.
+  EXPECT_EQ(s.service().Stats().busy + s.service().Stats().waiting, 0);
+}
+
+TEST(ProcessingService, CalibrationsAreCachedByContentHash) {
+  InProcessService s;
+  ProcessingClient client = s.Client();
+  v1::CalibrationInfo info;
+  ASSERT_TRUE(client.PutCalibration(CalibrationYaml(pattern::Side::kRight), &info).ok());
+  EXPECT_EQ(info.id(), CalibrationCache::IdOf(CalibrationYaml(pattern::Side::kRight)));
+  EXPECT_EQ(info.side(), v1::SIDE_RIGHT);
+  EXPECT_TRUE(info.has_projector_matrix());
+  v1::GetCalibrationRequest get;
+  get.set_id(info.id());
+  v1::CalibrationFile file;
+  grpc::ClientContext context;
+  ASSERT_TRUE(s.stub().GetCalibration(&context, get, &file).ok());
+  EXPECT_EQ(file.yaml(), CalibrationYaml(pattern::Side::kRight));
+  // By id from now on.
+  v1::ProcessFrameRequest request = FaceRequest(pattern::Side::kRight, true);
+  request.mutable_calibration()->set_id(info.id());
+  const WorkOutcome out = client.ProcessFrame(request);
+  ASSERT_TRUE(out.status.ok()) << out.status.error_message();
+  EXPECT_TRUE(out.result.sides(0).q_absolute());
+  // Unknown ids and files that are not calibrations.
+  grpc::ClientContext c2;
+  get.set_id("sha256:0");
+  EXPECT_EQ(s.stub().GetCalibration(&c2, get, &file).error_code(), StatusCode::NOT_FOUND);
+  EXPECT_EQ(client.PutCalibration("not: a calibration", &info).error_code(),
+            StatusCode::INVALID_ARGUMENT);
+  EXPECT_EQ(client.PutCalibration(std::string(5 << 20, 'x'), &info).error_code(),
+            StatusCode::INVALID_ARGUMENT);
+}
+
+TEST(CalibrationCache, KeepsTheMostRecentlyUsed) {
+  CalibrationCache cache(1);
+  const auto left = cache.Put(CalibrationYaml(pattern::Side::kLeft), "left");
+  EXPECT_EQ(cache.Find(left->id), left);
+  const auto right = cache.Put(CalibrationYaml(pattern::Side::kRight), "right");
+  EXPECT_EQ(cache.size(), 1u);
+  EXPECT_EQ(cache.Find(left->id), nullptr);
+  EXPECT_EQ(cache.Find(right->id), right);
+  // An evicted entry stays valid for whoever holds it.
+  EXPECT_EQ(left->calibration.side, pattern::Side::kLeft);
+}
+
+// Opens a Calibrate call and sends only its manifest: the call then holds a
+// place in the pool until the stream is closed (Close). Events are read on a
+// thread of their own, as a real client does.
+struct HeldUpload {
+  grpc::ClientContext context;
+  std::unique_ptr<grpc::ClientReaderWriter<v1::CalibrateRequest, v1::WorkEvent>> stream;
+  std::thread reader;
+
+  explicit HeldUpload(InProcessService& s) {
+    stream = s.stub().Calibrate(&context);
+    v1::CalibrateRequest manifest;
+    manifest.mutable_manifest()->set_yaml("side: left\n");
+    EXPECT_TRUE(stream->Write(manifest));
+    v1::WorkEvent queued;
+    EXPECT_TRUE(stream->Read(&queued));  // admitted
+    EXPECT_EQ(queued.progress().stage(), "queued");
+    reader = std::thread([this] {
+      v1::WorkEvent event;
+      while (stream->Read(&event)) {
+      }
+    });
+  }
+  // Cancels the call and waits for its end.
+  void Close() {
+    context.TryCancel();
+    reader.join();
+    stream->Finish();
+  }
+};
+
+TEST(ProcessingService, AFullPoolRefusesAtOnce) {
+  ProcessingServiceOptions options;
+  options.workers = 1;
+  options.queue = 0;
+  InProcessService s(options);
+  {
+    HeldUpload held(s);
+    const auto start = std::chrono::steady_clock::now();
+    const grpc::Status status = CallFrame(s, FaceRequest(pattern::Side::kLeft, false));
+    EXPECT_EQ(status.error_code(), StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(2));
+    EXPECT_EQ(s.service().Stats().rejected, 1u);
+    held.Close();
+  }
+  // The place is free again.
+  for (int i = 0; i < 50 && s.service().Stats().waiting != 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_TRUE(s.Client().ProcessFrame(FaceRequest(pattern::Side::kLeft, false)).status.ok());
+}
+
+TEST(ProcessingService, ACallPastItsDeadlineStops) {
+  InProcessService s;
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() + std::chrono::milliseconds(5));
+  auto reader = s.stub().ReconstructSession(&context, SessionRequest());
+  v1::WorkEvent event;
+  bool got_result = false;
+  while (reader->Read(&event)) got_result = got_result || event.has_result();
+  const grpc::Status status = reader->Finish();
+  EXPECT_EQ(status.error_code(), StatusCode::DEADLINE_EXCEEDED);
+  EXPECT_FALSE(got_result);
+  // The handler ends soon after: no worker stays busy.
+  for (int i = 0; i < 200 && s.service().Stats().busy != 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  EXPECT_EQ(s.service().Stats().busy, 0);
+}
+
+// The files of a rendered calibration session, relative to its folder.
+std::vector<UploadFile> SessionFiles(const fs::path& folder, std::string* manifest) {
+  std::vector<UploadFile> files;
+  for (const auto& entry : fs::recursive_directory_iterator(folder)) {
+    if (!entry.is_regular_file()) continue;
+    std::ifstream in(entry.path(), std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string rel = fs::relative(entry.path(), folder).string();
+    if (rel == simulator::kSessionManifestName)
+      *manifest = bytes;
+    else if (entry.path().extension() == ".png")
+      files.push_back({rel, std::move(bytes)});
+  }
+  return files;
+}
+
+bool ScratchIsEmpty(const fs::path& scratch) { return fs::is_empty(scratch); }
+
+TEST(ProcessingService, CalibrateFromAnUploadedSession) {
+  const fs::path scratch = fs::path(::testing::TempDir()) / ("scratch-" + std::to_string(getpid()));
+  fs::create_directories(scratch);
+  ProcessingServiceOptions options;
+  options.scratch_dir = scratch;
+  InProcessService s(options);
+  std::string manifest;
+  const std::vector<UploadFile> files =
+      SessionFiles(calibration::testing::SessionFolder(SessionKind::kRightClean), &manifest);
+  ASSERT_FALSE(files.empty());
+  int views = 0;
+  const WorkOutcome out =
+      s.Client().Calibrate(manifest, files, "rig 2", [&](const v1::Progress& p) {
+        views += p.stage().starts_with("calibrate ");
+      });
+  ASSERT_TRUE(out.status.ok()) << out.status.error_message();
+  EXPECT_EQ(views, static_cast<int>(files.size()));
+  ASSERT_TRUE(out.files.count("calibration.yaml"));
+  EXPECT_EQ(out.result.calibration_id(), CalibrationCache::IdOf(out.files.at("calibration.yaml")));
+  EXPECT_NE(s.service().calibrations().Find(out.result.calibration_id()), nullptr);
+  const calibration::CalibrationRecord record =
+      calibration::CalibrationFromYaml(out.files.at("calibration.yaml"), "uploaded");
+  EXPECT_EQ(record.calibration.side, pattern::Side::kRight);
+  EXPECT_TRUE(out.files.count("calibration-report.json"));
+  EXPECT_TRUE(ScratchIsEmpty(scratch));
+
+  // A missing image is named as the client knows it; nothing is left behind.
+  std::vector<UploadFile> missing(files.begin() + 1, files.end());
+  WorkOutcome bad = s.Client().Calibrate(manifest, missing);
+  EXPECT_EQ(bad.status.error_code(), StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(bad.status.error_message().find(files[0].path), std::string::npos)
+      << bad.status.error_message();
+  EXPECT_EQ(bad.status.error_message().find(scratch.string()), std::string::npos);
+  // Paths that leave the folder, and no manifest at all.
+  std::vector<UploadFile> escaping = files;
+  escaping[0].path = "../" + escaping[0].path;
+  bad = s.Client().Calibrate(manifest, escaping);
+  EXPECT_EQ(bad.status.error_code(), StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(bad.status.error_message().find(".."), std::string::npos);
+  escaping[0].path = "/etc/passwd";
+  EXPECT_EQ(s.Client().Calibrate(manifest, escaping).status.error_code(),
+            StatusCode::INVALID_ARGUMENT);
+  grpc::ClientContext context;
+  auto stream = s.stub().Calibrate(&context);
+  stream->WritesDone();
+  v1::WorkEvent event;
+  while (stream->Read(&event)) {
+  }
+  EXPECT_EQ(stream->Finish().error_code(), StatusCode::INVALID_ARGUMENT);
+  // A client that gives up in the middle of its upload.
+  {
+    HeldUpload held(s);
+    v1::CalibrateRequest part;
+    part.mutable_file()->set_path("a.png");
+    part.mutable_file()->set_data("1234");
+    held.stream->Write(part);
+    held.Close();
+  }
+  for (int i = 0; i < 100 && !ScratchIsEmpty(scratch); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_TRUE(ScratchIsEmpty(scratch));
+  fs::remove_all(scratch);
+}
+
+TEST(ProcessingService, DrainingRefusesNewWork) {
+  InProcessService s;
+  s.service().BeginDrain();
+  EXPECT_EQ(CallFrame(s, FaceRequest(pattern::Side::kLeft, false)).error_code(),
+            StatusCode::UNAVAILABLE);
+}
+
+}  // namespace
+}  // namespace bsls::processing::test
