@@ -12,6 +12,7 @@
 
 #include "bsls/io/frame_file.h"
 #include "bsls/v1/capture.grpc.pb.h"
+#include "bsls/rpc/frame_message.h"
 #include "command.h"
 #include "daemon_connection.h"
 
@@ -49,13 +50,13 @@ void MakeFolder(const std::string& dir) {
 }
 
 // The frame's pixels as an image (no copy); CommandError (exit 7) naming
-// `what` when the message holds fewer bytes than its size says.
+// `what` when the message does not hold the frame its size says.
 cv::Mat FrameImage(const v1::Frame& frame, const std::string& what) {
-  if (frame.stride() < frame.width() ||
-      frame.pixels().size() < static_cast<std::size_t>(frame.stride()) * frame.height())
-    throw CommandError(kExitServiceFailed, what + ": a frame arrived shorter than its size says");
-  return cv::Mat(static_cast<int>(frame.height()), static_cast<int>(frame.width()), CV_8UC1,
-                 const_cast<char*>(frame.pixels().data()), frame.stride());
+  try {
+    return rpc::FrameView(frame, what);
+  } catch (const rpc::FrameMessageError& e) {
+    throw CommandError(kExitServiceFailed, std::string(e.what()) + " (damaged in transit?)");
+  }
 }
 
 // The message as one line of JSON with the proto's field names.

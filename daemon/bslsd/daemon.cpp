@@ -3,9 +3,9 @@
 #include <grp.h>
 #include <spdlog/spdlog.h>
 
-#include <fstream>
 #include <grpcpp/security/server_credentials.h>
-#include <sstream>
+
+#include "bsls/rpc/tls.h"
 
 #ifndef BSLS_VERSION
 #define BSLS_VERSION "unknown"
@@ -18,14 +18,6 @@ using framestore::Result;
 using framestore::Status;
 
 namespace {
-
-Result<std::string> ReadPem(const std::string& path, const char* key) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status(ErrorCode::kInvalidArgument, std::string(key) + ": cannot read " + path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return buffer.str();
-}
 
 v1::Camera ToProto(framestore::Camera camera) {
   return static_cast<v1::Camera>(static_cast<int>(camera) + 1);
@@ -97,16 +89,15 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   builder.RegisterService(d->service_.get());
   if (!config.listen.tcp.empty()) {
     // Mutual TLS only: a client without a certificate signed by the CA fails the handshake.
-    grpc::SslServerCredentialsOptions tls(
-        GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
-    Result<std::string> ca = ReadPem(config.listen.tls_client_ca, "listen.tls_client_ca");
-    Result<std::string> key = ReadPem(config.listen.tls_key, "listen.tls_key");
-    Result<std::string> cert = ReadPem(config.listen.tls_certificate, "listen.tls_certificate");
-    for (const Result<std::string>* pem : {&ca, &key, &cert})
-      if (!pem->ok()) return pem->status();
-    tls.pem_root_certs = *ca;
-    tls.pem_key_cert_pairs.push_back({*key, *cert});
-    builder.AddListeningPort(config.listen.tcp, grpc::SslServerCredentials(tls), &d->tcp_port_);
+    std::shared_ptr<grpc::ServerCredentials> tls;
+    try {
+      tls = rpc::MutualTlsServerCredentials(
+          {config.listen.tls_client_ca, config.listen.tls_certificate, config.listen.tls_key,
+           "listen.tls_client_ca", "listen.tls_certificate", "listen.tls_key"});
+    } catch (const rpc::TlsFileError& e) {
+      return Status(ErrorCode::kInvalidArgument, e.what());
+    }
+    builder.AddListeningPort(config.listen.tcp, tls, &d->tcp_port_);
   }
   d->server_ = builder.BuildAndStart();
   if (!d->server_ || (!config.listen.tcp.empty() && d->tcp_port_ == 0))

@@ -10,12 +10,14 @@ import struct
 import subprocess
 import sys
 import tempfile
+import time
 import unittest
 import zlib
 
 BSLS = None
 
 EXIT_OK, EXIT_NOT_PROCESSED, EXIT_USAGE, EXIT_INPUT, EXIT_OUTPUT = 0, 1, 2, 3, 4
+EXIT_UNAVAILABLE = 5
 
 
 def run(*args):
@@ -518,6 +520,70 @@ class SurfaceCliTest(unittest.TestCase):
     def test_reconstruct_refuses_swapped_calibrations(self):
         out = self.path("swapped.ply")
         r = self.reconstruct(out, left_cal=self.right_calibration, right_cal=self.calibration)
+        self.assertEqual(r.returncode, EXIT_INPUT, r.stderr)
+        self.assertIn("right side", r.stderr)
+        self.assertFalse(os.path.exists(out))
+
+    def start_processd(self):
+        """A bsls-processd on a Unix socket in the test folder; stopped at cleanup."""
+        processd = os.environ.get("BSLS_PROCESSD")
+        if not processd:
+            self.skipTest("BSLS_PROCESSD is not set")
+        sock = self.path("processd-%d.sock" % len(os.listdir(self.dir.name)))
+        proc = subprocess.Popen([processd, "--socket", sock, "--workers", "1",
+                                 "--replica", "cli-test", "--set", "scratch_dir=" + self.dir.name],
+                                stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+        self.addCleanup(lambda: (proc.terminate(), proc.wait(30), proc.stderr.close()))
+        for _ in range(200):
+            if os.path.exists(sock):
+                return "unix:" + sock
+            if proc.poll() is not None:
+                self.fail("bsls-processd ended: " + proc.stderr.read())
+            time.sleep(0.05)
+        self.fail("bsls-processd did not open its socket")
+
+    def test_process_on_the_service_gives_the_same_files(self):
+        server = self.start_processd()
+        junctions, surface = self.path("remote_j.json"), self.path("remote_plane.ply")
+        r = run("process", self.frame, "--side", "left", "--calibration", self.calibration,
+                "--junctions", junctions, "--surface", surface, "--ascii", "--json",
+                "--server", server)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        summary = json.loads(r.stdout)
+        self.assertEqual(summary["replica"], "cli-test")
+        self.assertTrue(summary["q_absolute"])
+        with open(junctions) as f, open(self.path("j.json")) as g:
+            self.assertEqual(json.load(f)["junctions"], json.load(g)["junctions"])
+        with open(surface, "rb") as f, open(self.surface, "rb") as g:
+            self.assertEqual(f.read(), g.read())
+
+    def test_reconstruct_on_the_service(self):
+        server = self.start_processd()
+        out, report = self.path("remote_face.obj"), self.path("remote_face.json")
+        r = self.reconstruct(out, "--report", report, "--server", server)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertIn("shared world frame", r.stdout)
+        self.assertIn("%", r.stderr)  # progress
+        with open(report) as f:
+            rep = json.load(f)
+        self.assertEqual(rep["left"]["image"], self.faces["left"])
+        self.assertLess(rep["join"]["seam_rms_mm"], 0.3)
+        with open(out) as f:
+            vertices = sum(1 for line in f if line.startswith("v "))
+        self.assertEqual(vertices, rep["vertices"])
+
+    def test_service_errors_have_exit_codes(self):
+        out = self.path("never.ply")
+        r = run("process", self.frame, "--side", "left", "--junctions", out,
+                "--server", "unix:" + self.path("nobody.sock"), "--timeout", "2")
+        self.assertEqual(r.returncode, EXIT_UNAVAILABLE, r.stderr)
+        r = run("process", self.frame, "--side", "left", "--junctions", out,
+                "--server", "processd.clinic:7000")
+        self.assertEqual(r.returncode, EXIT_USAGE, r.stderr)
+        self.assertIn("mutual TLS", r.stderr)
+        server = self.start_processd()
+        r = self.reconstruct(out, "--server", server, left_cal=self.right_calibration,
+                             right_cal=self.calibration)
         self.assertEqual(r.returncode, EXIT_INPUT, r.stderr)
         self.assertIn("right side", r.stderr)
         self.assertFalse(os.path.exists(out))
