@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "bsls/io/config_document.h"
+#include "bsls/rpc/tls.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -197,15 +198,34 @@ void ParseSlides(const YAML::Node& node, SlidesConfig& out) {
   ReadInRange(node, "slides", "initial_slide", c.initial_slide, 1, 3);
 }
 
+void ParseProcessing(const YAML::Node& node, ProcessingConfig& out) {
+  OnlyKeys(node, "processing",
+           {"server", "tls_ca", "tls_certificate", "tls_key", "calibration_left",
+            "calibration_right", "timeout_ms", "retry_initial_ms", "retry_max_ms"});
+  if (!node) return;
+  Read(node, "processing", "server", out.server);
+  Read(node, "processing", "tls_ca", out.tls_ca);
+  Read(node, "processing", "tls_certificate", out.tls_certificate);
+  Read(node, "processing", "tls_key", out.tls_key);
+  Read(node, "processing", "calibration_left", out.calibration_left);
+  Read(node, "processing", "calibration_right", out.calibration_right);
+  ReadInRange(node, "processing", "timeout_ms", out.timeout_ms, 100, 3600000);
+  ReadInRange(node, "processing", "retry_initial_ms", out.retry_initial_ms, 10, 600000);
+  ReadInRange(node, "processing", "retry_max_ms", out.retry_max_ms, 10, 3600000);
+}
+
 Config Parse(const YAML::Node& root) {
   Config config = DefaultConfig();
   if (!root || root.IsNull()) return config;
-  OnlyKeys(root, "", {"framestore", "store", "listen", "roles", "slides", "limits", "log_level"});
+  OnlyKeys(root, "",
+           {"framestore", "store", "listen", "roles", "slides", "processing", "limits",
+            "log_level"});
   ParseFramestore(root["framestore"], config.framestore);
   ParseStore(root["store"], config.store);
   ParseListen(root["listen"], config.listen);
   ParseRoles(root["roles"], config.roles);
   ParseSlides(root["slides"], config.slides);
+  ParseProcessing(root["processing"], config.processing);
   ParseLimits(root["limits"], config);
   Read(root, "", "log_level", config.log_level);
   return config;
@@ -259,6 +279,17 @@ Status Validate(const Config& config) {
     if (Status status = slides::Validate(config.slides.controller); !status.ok())
       return fail("slides: " + status.message());
   }
+  const ProcessingConfig& p = config.processing;
+  const bool tls = !p.tls_ca.empty() || !p.tls_certificate.empty() || !p.tls_key.empty();
+  if (tls && (p.tls_ca.empty() || p.tls_certificate.empty() || p.tls_key.empty()))
+    return fail("processing: give all of tls_ca, tls_certificate and tls_key, or none");
+  if (!p.server.empty() && !tls && !rpc::IsUnixTarget(p.server) &&
+      !rpc::IsLoopbackTarget(p.server))
+    return fail("processing.server " + p.server +
+                " is another machine: mutual TLS only (give processing.tls_ca, "
+                "processing.tls_certificate and processing.tls_key)");
+  if (p.retry_initial_ms > p.retry_max_ms)
+    return fail("processing.retry_initial_ms is above processing.retry_max_ms");
   return {};
 }
 
@@ -356,6 +387,18 @@ std::string Dump(const Config& config) {
     out << YAML::Key << std::string(service::ToString(role)) << YAML::Value << YAML::Flow
         << members;
   out << YAML::Key << "others" << YAML::Value << std::string(service::ToString(config.roles.others));
+  out << YAML::EndMap;
+  const ProcessingConfig& p = config.processing;
+  out << YAML::Key << "processing" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "server" << YAML::Value << p.server;
+  out << YAML::Key << "tls_ca" << YAML::Value << p.tls_ca;
+  out << YAML::Key << "tls_certificate" << YAML::Value << p.tls_certificate;
+  out << YAML::Key << "tls_key" << YAML::Value << p.tls_key;
+  out << YAML::Key << "calibration_left" << YAML::Value << p.calibration_left;
+  out << YAML::Key << "calibration_right" << YAML::Value << p.calibration_right;
+  out << YAML::Key << "timeout_ms" << YAML::Value << p.timeout_ms;
+  out << YAML::Key << "retry_initial_ms" << YAML::Value << p.retry_initial_ms;
+  out << YAML::Key << "retry_max_ms" << YAML::Value << p.retry_max_ms;
   out << YAML::EndMap;
   out << YAML::Key << "limits" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "max_preview_streams" << YAML::Value << config.limits.max_preview_streams;

@@ -58,12 +58,28 @@ struct SlidesConfig {
   slides::SlideControllerConfig controller;  // lines and timing (gpio and simulated)
 };
 
+// The processing service every acknowledged grab is handed to (issue 5).
+struct ProcessingConfig {
+  // "unix:PATH", "host:port", "ipv4:h:p,h:p" or "dns:///name:port" (round
+  // robin over replicas); "" : no processing.
+  std::string server;
+  std::string tls_ca;  // mutual TLS (required for a server on another machine)
+  std::string tls_certificate;
+  std::string tls_key;
+  std::string calibration_left;   // calibration files (bsls calibrate); "" : none
+  std::string calibration_right;
+  int timeout_ms = 120000;        // deadline of one call
+  int retry_initial_ms = 1000;    // back-off after a failed attempt, doubled
+  int retry_max_ms = 60000;       // up to this
+};
+
 struct Config {
   FramestoreConfig framestore;
   store::CaptureStoreOptions store;
   ListenConfig listen;
   RolesConfig roles;
   SlidesConfig slides;
+  ProcessingConfig processing;
   service::ServiceLimits limits;
   std::chrono::milliseconds drain_timeout{5000};  // SIGTERM: in-flight calls get this long
   std::string log_level = "info";

@@ -3,8 +3,11 @@
 #include <grp.h>
 #include <spdlog/spdlog.h>
 
+#include <fstream>
 #include <grpcpp/security/server_credentials.h>
+#include <tuple>
 
+#include "bsls/calibration/calibration_file.h"
 #include "bsls/rpc/tls.h"
 
 #ifndef BSLS_VERSION
@@ -76,9 +79,48 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   };
   d->device_ =
       std::make_unique<service::CaptureDevice>(std::move(framestore).value(), std::move(callbacks));
+  // The processing queue: captures of earlier runs first, then every new grab.
+  service::ProcessingQueueOptions processing;
+  const ProcessingConfig& p = config.processing;
+  processing.client.target = p.server;
+  processing.client.tls = {p.tls_ca, p.tls_certificate, p.tls_key, "processing.tls_ca",
+                           "processing.tls_certificate", "processing.tls_key"};
+  processing.client.timeout = std::chrono::milliseconds(p.timeout_ms);
+  processing.retry_initial = std::chrono::milliseconds(p.retry_initial_ms);
+  processing.retry_max = std::chrono::milliseconds(p.retry_max_ms);
+  processing.daemon_version = BSLS_VERSION;
+  for (const auto& [file, key, side, out] :
+       {std::tuple{p.calibration_left, "processing.calibration_left", pattern::Side::kLeft,
+                   &processing.left_calibration},
+        std::tuple{p.calibration_right, "processing.calibration_right", pattern::Side::kRight,
+                   &processing.right_calibration}}) {
+    if (file.empty()) continue;
+    try {
+      const calibration::CalibrationRecord record = calibration::LoadCalibration(file);
+      if (record.calibration.side != side)
+        return Status(ErrorCode::kInvalidArgument,
+                      std::string(key) + " " + file + ": is a calibration of the other side");
+      std::ifstream in(file, std::ios::binary);
+      out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    } catch (const calibration::CalibrationFileError& e) {
+      return Status(ErrorCode::kInvalidArgument, std::string(key) + ": " + e.what());
+    }
+  }
+  d->processing_ =
+      std::make_unique<service::ProcessingQueue>(d->store_.get(), &d->events_, processing);
+  try {
+    d->processing_->Start();
+  } catch (const rpc::TlsFileError& e) {
+    return Status(ErrorCode::kInvalidArgument, e.what());
+  } catch (const std::invalid_argument& e) {
+    return Status(ErrorCode::kInvalidArgument, std::string("processing.server: ") + e.what());
+  }
+  if (d->processing_->enabled())
+    spdlog::info("processing: every grab goes to {}", p.server);
+
   d->service_ = std::make_unique<service::CaptureService>(
       d->device_.get(), d->store_.get(), d->slides_.get(), &d->events_, &d->peers_, &d->policy_,
-      config.limits, BSLS_VERSION);
+      config.limits, BSLS_VERSION, d->processing_.get());
 
   grpc::ServerBuilder builder;
   builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
@@ -133,6 +175,8 @@ void Daemon::Drain() {
   drained_ = true;
   if (service_) service_->BeginDrain();
   if (listener_) listener_->Stop();
+  // The call under way is cancelled; its capture stays pending for the next start.
+  if (processing_) processing_->Stop();
   events_.Close();
   if (server_) {
     // Calls under way (a grab being stored) finish; then the rest are cancelled.

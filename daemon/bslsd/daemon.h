@@ -16,6 +16,7 @@
 #include "bsls/service/capture_device.h"
 #include "bsls/service/capture_service.h"
 #include "bsls/service/event_hub.h"
+#include "bsls/service/processing_queue.h"
 #include "bsls/service/unix_listener.h"
 #include "config.h"
 
@@ -43,6 +44,8 @@ class Daemon {
 
   // The TCP port bound (0 without TCP).
   int tcp_port() const { return tcp_port_; }
+  // The processing queue (disabled without processing.server).
+  service::ProcessingQueue& processing() { return *processing_; }
   // Grabs acknowledged since start.
   std::uint64_t grabs_acknowledged() const { return service_->grabs_acknowledged(); }
   // The parts, for tests and the fuzz target.
@@ -58,6 +61,7 @@ class Daemon {
   service::EventHub events_;
   std::unique_ptr<slides::SlideController> slides_;
   std::unique_ptr<service::CaptureDevice> device_;
+  std::unique_ptr<service::ProcessingQueue> processing_;
   service::PeerRegistry peers_;
   std::unique_ptr<service::CaptureService> service_;
   std::unique_ptr<grpc::Server> server_;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 
+#include "bsls/rpc/artifacts.h"
 #include "bsls/store/sha256.h"
 
 namespace bsls::service {
@@ -170,7 +171,8 @@ grpc::Status CheckText(const std::string& value, const char* field) {
 CaptureService::CaptureService(CaptureDevice* device, store::CaptureStore* store,
                                slides::SlideController* slides, EventHub* events,
                                const PeerRegistry* peers, const RolePolicy* policy,
-                               ServiceLimits limits, std::string software_version)
+                               ServiceLimits limits, std::string software_version,
+                               ProcessingQueue* processing)
     : device_(device),
       store_(store),
       slides_(slides),
@@ -178,7 +180,19 @@ CaptureService::CaptureService(CaptureDevice* device, store::CaptureStore* store
       peers_(peers),
       policy_(policy),
       limits_(limits),
-      software_version_(std::move(software_version)) {}
+      software_version_(std::move(software_version)),
+      processing_(processing) {}
+
+void CaptureService::FillCapture(const store::CaptureInfo& info, v1::CaptureInfo* reply) {
+  FillInfo(info, reply);
+  framestore::Result<std::optional<store::ProcessingRecord>> record =
+      store_->Processing(info.id.str());
+  if (record.ok())
+    FillProcessingStatus(*record, processing_ != nullptr && processing_->enabled(),
+                         reply->mutable_processing());
+  else
+    reply->mutable_processing()->set_last_error(record.status().message());
+}
 
 grpc::Status CaptureService::Authorize(grpc::ServerContext* context, std::string_view method,
                                        Caller* caller) {
@@ -360,8 +374,34 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
   if (grpc::Status s = CheckText(request->patient_reference(), "patient_reference"); !s.ok())
     return s;
 
+  // Contracts section 1: each side has its own brick slide (2 left, 3
+  // right). With a brick slide in place, a grab of both sides puts each
+  // side's slide in place before its frame (the right one stays in); with
+  // the reference cross (slide 1) both cameras see the cross (calibration).
   framestore::Result<std::vector<framestore::GreyFrame>> frames =
-      device_->Grab(sides, Deadline(context));
+      std::vector<framestore::GreyFrame>{};
+  int slide = slides_ ? slides_->State().slide : 0;
+  if (sides == GrabSides::kBoth && (slide == 2 || slide == 3)) {
+    for (const auto& [one, side_slide] : {std::pair{GrabSides::kLeft, 2}, {GrabSides::kRight, 3}}) {
+      if (framestore::Status changed = slides_->ChangeTo(side_slide, Deadline(context));
+          !changed.ok()) {
+        frames = framestore::Status(changed.code(), "slide " + std::to_string(side_slide) +
+                                                        " for the grab of both sides: " +
+                                                        changed.message());
+        break;
+      }
+      framestore::Result<std::vector<framestore::GreyFrame>> grabbed =
+          device_->Grab(one, Deadline(context));
+      if (!grabbed.ok()) {
+        frames = grabbed.status();
+        break;
+      }
+      for (framestore::GreyFrame& frame : *grabbed) frames->push_back(std::move(frame));
+    }
+    slide = 0;  // per frame: 2 for the left, 3 for the right
+  } else {
+    frames = device_->Grab(sides, Deadline(context));
+  }
   if (!frames.ok()) {
     spdlog::error("grab {} for {} failed: {}", store::ToString(side), caller.Describe(),
                   frames.status().ToString());
@@ -371,7 +411,7 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
   capture.session_id = request->session_id();
   capture.patient_reference = request->patient_reference();
   capture.side = side;
-  capture.slide = slides_ ? slides_->State().slide : 0;
+  capture.slide = slide;
   capture.software_version = software_version_;
   capture.requested_by = {caller.uid, caller.name};
   capture.frames = std::move(frames).value();
@@ -384,7 +424,8 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
   ++grabs_acknowledged_;
   spdlog::info("grab {} stored as {} for {}", store::ToString(side), stored->id.str(),
                caller.Describe());
-  FillInfo(*stored, reply->mutable_capture());
+  if (processing_) processing_->Enqueue(stored->id.str());
+  FillCapture(*stored, reply->mutable_capture());
   if (request->include_frames())
     for (std::size_t i = 0; i < capture.frames.size(); ++i)
       reply->mutable_capture()->mutable_frames(static_cast<int>(i))->set_pixels(
@@ -415,7 +456,7 @@ grpc::Status CaptureService::ListCaptures(grpc::ServerContext* context,
   filter.page_token = request->page_token();
   framestore::Result<store::CapturePage> page = store_->List(filter);
   if (!page.ok()) return ToGrpc(page.status());
-  for (const store::CaptureInfo& info : page->captures) FillInfo(info, reply->add_captures());
+  for (const store::CaptureInfo& info : page->captures) FillCapture(info, reply->add_captures());
   reply->set_next_page_token(page->next_page_token);
   return grpc::Status::OK;
 }
@@ -427,11 +468,29 @@ grpc::Status CaptureService::GetCapture(grpc::ServerContext* context,
   if (grpc::Status s = Authorize(context, "GetCapture", &caller); !s.ok()) return s;
   framestore::Result<store::Capture> capture = store_->Get(request->capture_id());
   if (!capture.ok()) return ToGrpc(capture.status());
-  FillInfo(capture->info, reply);
+  FillCapture(capture->info, reply);
   for (std::size_t i = 0; i < capture->frames.size(); ++i) {
     const framestore::GreyFrame& frame = capture->frames[i];
     reply->mutable_frames(static_cast<int>(i))->set_pixels(frame.pixels.data(),
                                                            frame.pixels.size());
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status CaptureService::GetCaptureResult(grpc::ServerContext* context,
+                                              const v1::GetCaptureResultRequest* request,
+                                              grpc::ServerWriter<v1::Artifact>* writer) {
+  Caller caller;
+  if (grpc::Status s = Authorize(context, "GetCaptureResult", &caller); !s.ok()) return s;
+  if (request->name().size() > 64) return Invalid("name: at most 64 bytes");
+  framestore::Result<std::map<std::string, std::string>> files =
+      store_->ReadProcessingFiles(request->capture_id(), request->name());
+  if (!files.ok()) return ToGrpc(files.status());
+  for (const auto& [name, bytes] : *files) {
+    const bool sent = rpc::EmitArtifact(
+        name, name.ends_with(".json") ? "application/json" : "application/octet-stream", bytes,
+        [writer](const v1::WorkEvent& event) { return writer->Write(event.artifact()); });
+    if (!sent) return grpc::Status(grpc::StatusCode::CANCELLED, "the caller went away");
   }
   return grpc::Status::OK;
 }

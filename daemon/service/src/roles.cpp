@@ -66,11 +66,12 @@ Role RolePolicy::RoleOfCertificate(std::string_view common_name) const {
 }
 
 Role RequiredRole(std::string_view method) {
-  static constexpr std::array<std::pair<std::string_view, Role>, 13> kTable{{
+  static constexpr std::array<std::pair<std::string_view, Role>, 14> kTable{{
       {"GetStatus", Role::kViewer},
       {"StreamPreview", Role::kViewer},
       {"ListCaptures", Role::kViewer},
       {"GetCapture", Role::kViewer},
+      {"GetCaptureResult", Role::kViewer},
       {"GetSlideState", Role::kViewer},
       {"WatchEvents", Role::kViewer},
       {"SelectCamera", Role::kOperator},

@@ -47,6 +47,20 @@ CREATE TABLE frames (
   PRIMARY KEY (capture_id, camera)
 ) WITHOUT ROWID;
 )sql",
+    // 1 -> 2: the processing queue (issue 5). A capture without a row has not
+    // been tried; `files` lists "name sha256" lines of the stored results.
+    R"sql(
+CREATE TABLE processing (
+  capture_id       TEXT PRIMARY KEY NOT NULL REFERENCES captures (id) ON DELETE CASCADE,
+  state            INTEGER NOT NULL,            -- ProcessingState: 1 pending, 2 done, 3 failed
+  attempts         INTEGER NOT NULL,
+  last_error       TEXT NOT NULL,
+  replica          TEXT NOT NULL,
+  software_version TEXT NOT NULL,
+  files            TEXT NOT NULL,
+  updated_wall_ns  INTEGER NOT NULL
+) WITHOUT ROWID;
+)sql",
 };
 constexpr int kLatestVersion = static_cast<int>(std::size(kMigrations));
 
@@ -523,6 +537,75 @@ Result<IndexTotals> CaptureIndex::Totals() {
   if (rc != SQLITE_ROW) return DbError(reader_, rc, what);
   return IndexTotals{static_cast<std::uint64_t>(select.Int(0)),
                      static_cast<std::uint64_t>(select.Int(1))};
+}
+
+Status CaptureIndex::PutProcessing(const CaptureId& id, const ProcessingRecord& record) {
+  std::lock_guard lock(write_mutex_);
+  const std::string what = "recording the processing of capture " + id.str() + " in " + path_;
+  std::string files;
+  for (const auto& [name, sha256] : record.files) files += name + " " + sha256 + "\n";
+  Statement upsert(writer_,
+                   "INSERT OR REPLACE INTO processing (capture_id, state, attempts, last_error,"
+                   " replica, software_version, files, updated_wall_ns)"
+                   " SELECT id, ?, ?, ?, ?, ?, ?, ? FROM captures WHERE id = ?");
+  if (!upsert.prepared()) return DbError(writer_, upsert.prepare_rc(), what);
+  upsert.Bind(1, static_cast<std::int64_t>(record.state));
+  upsert.Bind(2, static_cast<std::int64_t>(record.attempts));
+  upsert.Bind(3, record.last_error);
+  upsert.Bind(4, record.replica);
+  upsert.Bind(5, record.software_version);
+  upsert.Bind(6, files);
+  upsert.Bind(7, Nanos(record.updated));
+  upsert.Bind(8, id.str());
+  if (const int rc = upsert.Step(); rc != SQLITE_DONE) return DbError(writer_, rc, what);
+  if (sqlite3_changes(writer_) == 0)
+    return Status(ErrorCode::kNotFound, "no capture with id " + id.str());
+  return {};
+}
+
+Result<std::optional<ProcessingRecord>> CaptureIndex::FindProcessing(const CaptureId& id) {
+  std::lock_guard lock(read_mutex_);
+  const std::string what = "looking up the processing of capture " + id.str() + " in " + path_;
+  Statement select(reader_,
+                   "SELECT state, attempts, last_error, replica, software_version, files,"
+                   " updated_wall_ns FROM processing WHERE capture_id = ?");
+  if (!select.prepared()) return DbError(reader_, select.prepare_rc(), what);
+  select.Bind(1, id.str());
+  const int rc = select.Step();
+  if (rc == SQLITE_DONE) return std::optional<ProcessingRecord>();
+  if (rc != SQLITE_ROW) return DbError(reader_, rc, what);
+  ProcessingRecord record;
+  record.state = static_cast<ProcessingState>(select.Int(0));
+  record.attempts = static_cast<int>(select.Int(1));
+  record.last_error = select.Text(2);
+  record.replica = select.Text(3);
+  record.software_version = select.Text(4);
+  const std::string files = select.Text(5);
+  for (size_t at = 0; at < files.size();) {
+    const size_t end = files.find('\n', at);
+    const std::string line = files.substr(at, end - at);
+    const size_t space = line.find(' ');
+    if (space != std::string::npos) record.files[line.substr(0, space)] = line.substr(space + 1);
+    if (end == std::string::npos) break;
+    at = end + 1;
+  }
+  record.updated = WallAt(select.Int(6));
+  return std::optional<ProcessingRecord>(std::move(record));
+}
+
+Result<std::vector<CaptureId>> CaptureIndex::Unprocessed() {
+  std::lock_guard lock(read_mutex_);
+  const std::string what = "listing unprocessed captures in " + path_;
+  Statement select(reader_,
+                   "SELECT c.id FROM captures c LEFT JOIN processing p ON p.capture_id = c.id"
+                   " WHERE p.state IS NULL OR p.state = 1 ORDER BY c.taken_wall_ns, c.id");
+  if (!select.prepared()) return DbError(reader_, select.prepare_rc(), what);
+  std::vector<CaptureId> ids;
+  int rc;
+  while ((rc = select.Step()) == SQLITE_ROW)
+    if (auto id = CaptureId::Parse(select.Text(0))) ids.push_back(*id);
+  if (rc != SQLITE_DONE) return DbError(reader_, rc, what);
+  return ids;
 }
 
 }  // namespace bsls::store

@@ -5,10 +5,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cassert>
 #include <cerrno>
 #include <cstring>
+#include <map>
 #include <numeric>
+#include <set>
 
 #include "bsls/store/frame_file.h"
 #include "bsls/store/sha256.h"
@@ -97,10 +100,13 @@ Result<std::unique_ptr<CaptureStore>> CaptureStore::Open(const CaptureStoreOptio
   if (*root_created) {
     if (Status s = fs->FsyncDirectory(ParentOf(opts.root)); !s.ok()) return WithContext(s, context);
   }
-  const std::string frames_dir = opts.root + "/frames";
-  auto frames_created = EnsureDirectory(*fs, frames_dir);
-  if (!frames_created.ok()) return WithContext(frames_created.status(), context);
-  if (*frames_created) {
+  bool created_any = false;
+  for (const std::string& dir : {opts.root + "/frames", opts.root + "/results"}) {
+    auto created = EnsureDirectory(*fs, dir);
+    if (!created.ok()) return WithContext(created.status(), context);
+    created_any = created_any || *created;
+  }
+  if (created_any) {
     if (Status s = fs->FsyncDirectory(opts.root); !s.ok()) return WithContext(s, context);
   }
 
@@ -133,7 +139,8 @@ CaptureStore::CaptureStore(const CaptureStoreOptions& options, std::unique_ptr<F
       owned_fs_(std::move(owned_fs)),
       fs_(fs),
       lock_fd_(lock_fd),
-      frames_dir_(options.root + "/frames") {}
+      frames_dir_(options.root + "/frames"),
+      results_dir_(options.root + "/results") {}
 
 CaptureStore::~CaptureStore() {
   index_.reset();     // closes SQLite (checkpoints the WAL) before the lock goes
@@ -190,6 +197,39 @@ Status CaptureStore::Recover() {
   if (removed_any) {
     if (Status status = fs_.FsyncDirectory(frames_dir_); !status.ok()) return status;
   }
+  return RecoverResults();
+}
+
+// Result files of a capture whose record never said done (a crash between
+// the files and the record), or of deleted captures, and temporary files.
+Status CaptureStore::RecoverResults() {
+  auto names = fs_.ListDirectory(results_dir_);
+  if (!names.ok()) return names.status();
+  std::map<std::string, std::set<std::string>> kept;  // capture id -> file names of its record
+  bool removed_any = false;
+  for (const std::string& name : *names) {
+    bool keep = false;
+    const auto dash = name.find('-');
+    if (name.rfind(kTempFilePrefix, 0) != 0 && dash != std::string::npos) {
+      const std::string id_text = name.substr(0, dash);
+      if (!kept.count(id_text)) {
+        kept[id_text];
+        if (auto id = CaptureId::Parse(id_text)) {
+          auto record = index_->FindProcessing(*id);
+          if (!record.ok()) return record.status();
+          if (*record && (*record)->state == ProcessingState::kDone)
+            for (const auto& [file, sha256] : (*record)->files) kept[id_text].insert(file);
+        }
+      }
+      keep = kept[id_text].count(name.substr(dash + 1)) > 0;
+    }
+    if (keep) continue;
+    if (Status status = fs_.Unlink(results_dir_ + "/" + name); !status.ok())
+      return WithContext(status, "removing the leftover result " + name);
+    removed_any = true;
+    ++recovery_.result_files_removed;
+  }
+  if (removed_any) return fs_.FsyncDirectory(results_dir_);
   return {};
 }
 
@@ -380,6 +420,8 @@ Result<Capture> CaptureStore::Get(std::string_view text) {
 Result<CapturePage> CaptureStore::List(const CaptureFilter& filter) { return index_->List(filter); }
 
 Status CaptureStore::RemoveCapture(const CaptureInfo& info) {
+  auto record = index_->FindProcessing(info.id);
+  if (!record.ok()) return record.status();
   // Row first: a crash after this commit leaves files without a row, which
   // recovery removes; the other order could leave a row without its files.
   if (Status status = index_->Remove(info.id); !status.ok()) return status;
@@ -388,7 +430,130 @@ Status CaptureStore::RemoveCapture(const CaptureInfo& info) {
     fs_.Unlink(frames_dir_ + "/" + frame.file_name);
   }
   fs_.FsyncDirectory(frames_dir_);
+  if (*record) {
+    for (const auto& [name, sha256] : (*record)->files)
+      fs_.Unlink(results_dir_ + "/" + info.id.str() + "-" + name);
+    fs_.FsyncDirectory(results_dir_);
+  }
   return {};
+}
+
+Result<std::vector<CaptureId>> CaptureStore::Unprocessed() { return index_->Unprocessed(); }
+
+Result<std::optional<ProcessingRecord>> CaptureStore::Processing(std::string_view text) {
+  auto id = ParseId(text);
+  if (!id.ok()) return id.status();
+  return index_->FindProcessing(*id);
+}
+
+Status CaptureStore::NoteProcessingAttempt(std::string_view text, const std::string& error) {
+  auto id = ParseId(text);
+  if (!id.ok()) return id.status();
+  auto old = index_->FindProcessing(*id);
+  if (!old.ok()) return old.status();
+  ProcessingRecord record;
+  record.attempts = (*old ? (*old)->attempts : 0) + 1;
+  record.last_error = error;
+  record.updated = std::chrono::system_clock::now();
+  return index_->PutProcessing(*id, record);
+}
+
+Status CaptureStore::PutProcessingFailure(std::string_view text, const std::string& error) {
+  auto id = ParseId(text);
+  if (!id.ok()) return id.status();
+  auto old = index_->FindProcessing(*id);
+  if (!old.ok()) return old.status();
+  ProcessingRecord record;
+  record.state = ProcessingState::kFailed;
+  record.attempts = (*old ? (*old)->attempts : 0) + 1;
+  record.last_error = error;
+  record.updated = std::chrono::system_clock::now();
+  return index_->PutProcessing(*id, record);
+}
+
+namespace {
+
+bool IsResultFileName(std::string_view name) {
+  if (name.empty() || name.size() > 64 || name.front() == '.') return false;
+  return std::all_of(name.begin(), name.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+  });
+}
+
+std::string Sha256Hex(const std::string& bytes) {
+  return Sha256(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
+}
+
+}  // namespace
+
+Status CaptureStore::PutProcessingResult(std::string_view text,
+                                         const std::map<std::string, std::string>& files,
+                                         const std::string& replica,
+                                         const std::string& software_version) {
+  auto id = ParseId(text);
+  if (!id.ok()) return id.status();
+  const std::string context = "storing the results of capture " + id->str();
+  ProcessingRecord record;
+  record.state = ProcessingState::kDone;
+  record.replica = replica;
+  record.software_version = software_version;
+  record.updated = std::chrono::system_clock::now();
+  std::uint64_t bytes = 0;
+  for (const auto& [name, content] : files) {
+    if (!IsResultFileName(name))
+      return Status(ErrorCode::kInvalidArgument, context + ": \"" + name.substr(0, 64) +
+                                                     "\" is not a result file name");
+    bytes += content.size();
+  }
+  if (Status status = CheckFreeSpace(*id, bytes); !status.ok()) return WithContext(status, context);
+  {
+    std::lock_guard lock(mutex_);
+    if (deleting_.count(id->str()))
+      return Status(ErrorCode::kNotFound, context + ": the capture is being deleted");
+  }
+  // Files first (each durable under its final name), then the record that
+  // makes them part of the capture: a crash in between leaves files that
+  // recovery removes and a capture that is processed again.
+  for (const auto& [name, content] : files) {
+    const std::string file = id->str() + "-" + name;
+    if (Status status = WriteFileDurably(fs_, results_dir_, file, {content}, kFileMode);
+        !status.ok())
+      return WithContext(status, context);
+    record.files[name] = Sha256Hex(content);
+  }
+  if (Status status = fs_.FsyncDirectory(results_dir_); !status.ok())
+    return WithContext(status, context);
+  if (Status status = index_->PutProcessing(*id, record); !status.ok())
+    return WithContext(status, context);
+  return {};
+}
+
+Result<std::map<std::string, std::string>> CaptureStore::ReadProcessingFiles(
+    std::string_view text, const std::string& only) {
+  auto id = ParseId(text);
+  if (!id.ok()) return id.status();
+  auto record = index_->FindProcessing(*id);
+  if (!record.ok()) return record.status();
+  if (!*record || (*record)->state != ProcessingState::kDone)
+    return Status(ErrorCode::kNotFound, "capture " + id->str() + " has no stored results (yet)");
+  std::map<std::string, std::string> out;
+  for (const auto& [name, sha256] : (*record)->files) {
+    if (!only.empty() && name != only) continue;
+    const std::string path = results_dir_ + "/" + id->str() + "-" + name;
+    auto content = ReadWholeFile(fs_, path, std::uint64_t{1} << 32);
+    if (!content.ok()) {
+      if (content.status().code() == ErrorCode::kNotFound)
+        return Status(ErrorCode::kDataLoss, "result file " + path + " is missing");
+      return content.status();
+    }
+    if (Sha256Hex(*content) != sha256)
+      return Status(ErrorCode::kDataLoss, "result file " + path + " does not match its SHA-256");
+    out[name] = std::move(*content);
+  }
+  if (!only.empty() && out.empty())
+    return Status(ErrorCode::kNotFound, "capture " + id->str() + " has no result \"" +
+                                            only.substr(0, 64) + "\"");
+  return out;
 }
 
 Status CaptureStore::Delete(std::string_view text) {

@@ -138,4 +138,74 @@ class PosixFileSystem final : public FileSystem {
 
 std::unique_ptr<FileSystem> MakePosixFileSystem() { return std::make_unique<PosixFileSystem>(); }
 
+namespace {
+
+Status Prefixed(const Status& status, const std::string& what) {
+  return Status(status.code(), what + ": " + status.message());
+}
+
+}  // namespace
+
+Status WriteFileDurably(FileSystem& fs, const std::string& directory, const std::string& name,
+                        const std::vector<std::string_view>& pieces, mode_t mode) {
+  const std::string final_path = directory + "/" + name;
+  const std::string temp_path = directory + "/" + std::string(kTempFilePrefix) + name;
+  auto fd = fs.Open(temp_path, O_WRONLY | O_CREAT | O_EXCL, mode);
+  if (!fd.ok()) return Prefixed(fd.status(), "creating " + temp_path);
+  Status status;
+  for (std::string_view piece : pieces) {
+    while (status.ok() && !piece.empty()) {
+      auto written = fs.Write(*fd, piece.data(), piece.size());
+      if (!written.ok()) {
+        status = Prefixed(written.status(), "writing " + temp_path);
+      } else if (*written == 0) {
+        status = Status(ErrorCode::kUnavailable, "writing " + temp_path + ": write returned 0 bytes");
+      } else {
+        piece.remove_prefix(*written);
+      }
+    }
+  }
+  // The data must be on disk before the rename can make the name point at it.
+  if (status.ok()) {
+    if (Status synced = fs.Fsync(*fd); !synced.ok()) status = Prefixed(synced, "fsync of " + temp_path);
+  }
+  if (Status closed = fs.Close(*fd); !closed.ok() && status.ok())
+    status = Prefixed(closed, "closing " + temp_path);
+  if (status.ok()) {
+    if (Status renamed = fs.Rename(temp_path, final_path); !renamed.ok())
+      status = Prefixed(renamed, "publishing " + final_path);
+  }
+  if (!status.ok()) fs.Unlink(temp_path);  // best effort; recovery removes what is left
+  return status;
+}
+
+Result<std::string> ReadWholeFile(FileSystem& fs, const std::string& path,
+                                  std::uint64_t max_bytes) {
+  auto fd = fs.Open(path, O_RDONLY, 0);
+  if (!fd.ok()) return Prefixed(fd.status(), "opening " + path);
+  std::string bytes;
+  Status status;
+  constexpr std::size_t kChunk = 1 << 20;
+  while (status.ok()) {
+    const std::size_t old_size = bytes.size();
+    if (old_size > max_bytes) {
+      status = Status(ErrorCode::kDataLoss, path + " is larger than " + std::to_string(max_bytes) +
+                                                " bytes");
+      break;
+    }
+    bytes.resize(old_size + kChunk);
+    auto got = fs.Read(*fd, bytes.data() + old_size, kChunk);
+    if (!got.ok()) {
+      status = Prefixed(got.status(), "reading " + path);
+      bytes.resize(old_size);
+      break;
+    }
+    bytes.resize(old_size + *got);
+    if (*got == 0) break;
+  }
+  fs.Close(*fd);  // read-only: nothing to lose on a failed close
+  if (!status.ok()) return status;
+  return bytes;
+}
+
 }  // namespace bsls::store

@@ -10,26 +10,9 @@ namespace bsls::store {
 namespace {
 
 constexpr std::string_view kSuffix = ".pgm";
-constexpr mode_t kFileMode = 0640;
+
 // The largest file ReadFrameFile accepts: the biggest frame plus a header.
 constexpr std::uint64_t kMaxFileBytes = static_cast<std::uint64_t>(8192) * 8192 + 4096;
-
-// Writes all `size` bytes, continuing after short writes.
-Status WriteAll(FileSystem& fs, int fd, const std::uint8_t* data, std::size_t size,
-                const std::string& path) {
-  while (size > 0) {
-    auto written = fs.Write(fd, data, size);
-    if (!written.ok()) {
-      return Status(written.status().code(), "writing " + path + ": " + written.status().message());
-    }
-    if (*written == 0) {
-      return Status(ErrorCode::kUnavailable, "writing " + path + ": write returned 0 bytes");
-    }
-    data += *written;
-    size -= *written;
-  }
-  return {};
-}
 
 Status Prefixed(const Status& status, const std::string& what) {
   return Status(status.code(), what + ": " + status.message());
@@ -66,43 +49,19 @@ std::uint64_t FrameFileBytes(const CaptureId& id, framestore::Camera camera, int
 Result<std::uint64_t> WriteFrameFile(FileSystem& fs, const std::string& directory,
                                      const std::string& name, const CaptureId& id,
                                      const framestore::GreyFrame& frame) {
-  const std::string final_path = directory + "/" + name;
-  const std::string temp_path = directory + "/" + std::string(kTempFilePrefix) + name;
-  auto fd = fs.Open(temp_path, O_WRONLY | O_CREAT | O_EXCL, kFileMode);
-  if (!fd.ok()) return Prefixed(fd.status(), "creating " + temp_path);
-
   const std::string header = FrameFileHeader(id, frame.camera, frame.width, frame.height);
-  Status status = WriteAll(fs, *fd, reinterpret_cast<const std::uint8_t*>(header.data()),
-                           header.size(), temp_path);
-  if (status.ok() && frame.stride == frame.width) {
-    status = WriteAll(fs, *fd, frame.pixels.data(),
-                      static_cast<std::size_t>(frame.width) * frame.height, temp_path);
+  std::vector<std::string_view> pieces = {header};
+  const auto* pixels = reinterpret_cast<const char*>(frame.pixels.data());
+  const std::size_t width = static_cast<std::size_t>(frame.width);
+  if (frame.stride == frame.width) {
+    pieces.emplace_back(pixels, width * frame.height);
   } else {
-    for (int row = 0; status.ok() && row < frame.height; ++row) {
-      status = WriteAll(fs, *fd, frame.pixels.data() + static_cast<std::size_t>(row) * frame.stride,
-                        static_cast<std::size_t>(frame.width), temp_path);
-    }
+    for (int row = 0; row < frame.height; ++row)
+      pieces.emplace_back(pixels + static_cast<std::size_t>(row) * frame.stride, width);
   }
-  if (status.ok()) {
-    // The data must be on disk before the rename can make the name point at it.
-    if (Status synced = fs.Fsync(*fd); !synced.ok()) {
-      status = Prefixed(synced, "fsync of " + temp_path);
-    }
-  }
-  if (Status closed = fs.Close(*fd); !closed.ok() && status.ok()) {
-    status = Prefixed(closed, "closing " + temp_path);
-  }
-  if (status.ok()) {
-    if (Status renamed = fs.Rename(temp_path, final_path); !renamed.ok()) {
-      status = Prefixed(renamed, "publishing " + final_path);
-    }
-  }
-  if (!status.ok()) {
-    fs.Unlink(temp_path);  // best effort; recovery removes what is left
+  if (Status status = WriteFileDurably(fs, directory, name, pieces, kFileMode); !status.ok())
     return status;
-  }
-  return static_cast<std::uint64_t>(header.size()) +
-         static_cast<std::uint64_t>(frame.width) * frame.height;
+  return static_cast<std::uint64_t>(header.size()) + width * frame.height;
 }
 
 namespace {
@@ -138,31 +97,14 @@ std::optional<int> ParseInt(std::optional<std::string_view> token) {
 }  // namespace
 
 Result<FrameFileContent> ReadFrameFile(FileSystem& fs, const std::string& path) {
-  auto fd = fs.Open(path, O_RDONLY, 0);
-  if (!fd.ok()) return Prefixed(fd.status(), "opening frame file");
-  std::vector<std::uint8_t> bytes;
-  Status status;
-  constexpr std::size_t kChunk = 1 << 20;
-  while (status.ok()) {
-    const std::size_t old_size = bytes.size();
-    if (old_size > kMaxFileBytes) {
-      status = Status(ErrorCode::kDataLoss, path + " is larger than any frame file");
-      break;
-    }
-    bytes.resize(old_size + kChunk);
-    auto got = fs.Read(*fd, bytes.data() + old_size, kChunk);
-    if (!got.ok()) {
-      status = Prefixed(got.status(), "reading " + path);
-      bytes.resize(old_size);
-      break;
-    }
-    bytes.resize(old_size + *got);
-    if (*got == 0) break;
+  auto read = ReadWholeFile(fs, path, kMaxFileBytes);
+  if (!read.ok()) {
+    if (read.status().code() == ErrorCode::kDataLoss)
+      return Status(ErrorCode::kDataLoss, path + " is larger than any frame file");
+    return read.status();
   }
-  fs.Close(*fd);  // read-only: nothing to lose on a failed close
-  if (!status.ok()) return status;
-
-  const std::string_view data(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+  const std::string& bytes = *read;
+  const std::string_view data(bytes);
   std::size_t pos = 0;
   const auto magic = NextToken(data, pos);
   const auto width = ParseInt(NextToken(data, pos));

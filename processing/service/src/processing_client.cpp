@@ -95,6 +95,12 @@ std::unique_ptr<grpc::ClientContext> ProcessingClient::Context() const {
   return context;
 }
 
+void ProcessingClient::CancelAll() {
+  std::lock_guard lock(mutex_);
+  cancelled_ = true;
+  for (grpc::ClientContext* context : live_) context->TryCancel();
+}
+
 WorkOutcome ProcessingClient::WithRetries(const Attempt& attempt) {
   WorkOutcome out;
   auto backoff = options_.backoff;
@@ -102,7 +108,19 @@ WorkOutcome ProcessingClient::WithRetries(const Attempt& attempt) {
     out = WorkOutcome{};
     out.attempts = i;
     const std::unique_ptr<grpc::ClientContext> context = Context();
+    {
+      std::lock_guard lock(mutex_);
+      if (cancelled_) {
+        out.status = grpc::Status(grpc::StatusCode::CANCELLED, "the client was stopped");
+        break;
+      }
+      live_.insert(context.get());
+    }
     out.status = attempt(context.get(), &out);
+    {
+      std::lock_guard lock(mutex_);
+      live_.erase(context.get());
+    }
     if (out.status.ok() || !IsRetryable(out.status) || i == options_.attempts) break;
     std::this_thread::sleep_for(backoff);
     backoff *= 2;

@@ -18,6 +18,7 @@
 #include "bsls/framestore/status.h"
 #include "bsls/service/capture_device.h"
 #include "bsls/service/event_hub.h"
+#include "bsls/service/processing_queue.h"
 #include "bsls/service/roles.h"
 #include "bsls/service/unix_listener.h"
 #include "bsls/slides/slide_controller.h"
@@ -44,10 +45,12 @@ grpc::Status ToGrpc(const framestore::Status& status);
 class CaptureService final : public v1::CaptureDaemon::Service {
  public:
   // Everything is borrowed and must outlive the service; `slides` may be
-  // nullptr (no slide controller configured: slide calls fail UNAVAILABLE).
+  // nullptr (no slide controller configured: slide calls fail UNAVAILABLE),
+  // `processing` too (captures are then reported STATE_DISABLED).
   CaptureService(CaptureDevice* device, store::CaptureStore* store,
                  slides::SlideController* slides, EventHub* events, const PeerRegistry* peers,
-                 const RolePolicy* policy, ServiceLimits limits, std::string software_version);
+                 const RolePolicy* policy, ServiceLimits limits, std::string software_version,
+                 ProcessingQueue* processing = nullptr);
 
   // From now on new calls that change anything fail UNAVAILABLE ("shutting
   // down") and open streams end; calls under way finish.
@@ -69,6 +72,9 @@ class CaptureService final : public v1::CaptureDaemon::Service {
                             v1::ListCapturesResponse* reply) override;
   grpc::Status GetCapture(grpc::ServerContext* context, const v1::GetCaptureRequest* request,
                           v1::CaptureInfo* reply) override;
+  grpc::Status GetCaptureResult(grpc::ServerContext* context,
+                                const v1::GetCaptureResultRequest* request,
+                                grpc::ServerWriter<v1::Artifact>* writer) override;
   grpc::Status DeleteCapture(grpc::ServerContext* context,
                              const v1::DeleteCaptureRequest* request,
                              v1::DeleteCaptureResponse* reply) override;
@@ -90,6 +96,8 @@ class CaptureService final : public v1::CaptureDaemon::Service {
   Clock::time_point Deadline(const grpc::ServerContext* context) const;
   void FillStatus(const Caller& caller, v1::DeviceStatus* reply);
   void FillSlideState(v1::SlideState* reply) const;
+  // The capture's metadata and its processing status.
+  void FillCapture(const store::CaptureInfo& info, v1::CaptureInfo* reply);
 
   CaptureDevice* device_;
   store::CaptureStore* store_;
@@ -99,6 +107,7 @@ class CaptureService final : public v1::CaptureDaemon::Service {
   const RolePolicy* policy_;
   ServiceLimits limits_;
   std::string software_version_;
+  ProcessingQueue* processing_;
   std::atomic<bool> draining_{false};
   std::atomic<int> preview_streams_{0};
   std::atomic<int> event_streams_{0};

@@ -17,6 +17,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -90,6 +91,25 @@ struct CaptureInfo {
   std::chrono::system_clock::time_point stored_wall;  // when Put acknowledged it
   std::uint64_t total_bytes = 0;                      // sum of the frame files' sizes
   std::vector<StoredFrameInfo> frames;                // in camera order
+};
+
+// Where a capture is in bslsd's processing queue (issue 5). Values are
+// stored. A capture without a record has not been tried yet.
+enum class ProcessingState : int {
+  kPending = 1,  // tried, will be tried again (attempts, last_error)
+  kDone = 2,     // results stored beside the capture
+  kFailed = 3,   // the service cannot process it; not tried again
+};
+
+// The processing record of one capture.
+struct ProcessingRecord {
+  ProcessingState state = ProcessingState::kPending;
+  int attempts = 0;
+  std::string last_error;
+  std::string replica;           // of the processing service that did it
+  std::string software_version;  // of that service
+  std::map<std::string, std::string> files;  // result file name -> hex SHA-256 (kDone)
+  std::chrono::system_clock::time_point updated;
 };
 
 // A capture with its frames, as Get returns it: frames[i] matches

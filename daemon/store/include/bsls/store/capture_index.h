@@ -1,6 +1,6 @@
 // The SQLite index of the capture store: one row per acknowledged capture in
-// `captures`, one row per frame file in `frames` (foreign key, ON DELETE
-// CASCADE). docs/capture-store.md lists the schema.
+// `captures`, one row per frame file in `frames` and at most one processing
+// record per capture in `processing` (foreign keys, ON DELETE CASCADE). docs/capture-store.md lists the schema.
 //
 // Durability: the database runs in WAL mode with synchronous=FULL, so a
 // successful Insert or Remove has synced the WAL before it returns.
@@ -96,6 +96,13 @@ class CaptureIndex {
   Result<std::vector<RetentionCandidate>> OldestFirst();
   // The number of captures and their bytes.
   Result<IndexTotals> Totals();
+  // Writes (replaces) the processing record of a capture in one committed
+  // transaction; kNotFound when the capture is not indexed.
+  Status PutProcessing(const CaptureId& id, const ProcessingRecord& record);
+  // The processing record of a capture; nullopt when it has none yet.
+  Result<std::optional<ProcessingRecord>> FindProcessing(const CaptureId& id);
+  // Captures not yet done or failed (no record, or pending), oldest first.
+  Result<std::vector<CaptureId>> Unprocessed();
 
  private:
   CaptureIndex(sqlite3* writer, sqlite3* reader, std::string path);

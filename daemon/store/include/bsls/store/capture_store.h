@@ -5,6 +5,7 @@
 //   <root>/LOCK            flock(2)ed by the one process that has the store open
 //   <root>/index.sqlite    the index (+ -wal, -shm while open)
 //   <root>/frames/<id>-<camera>.pgm
+//   <root>/results/<id>-<name>   processing results (issue 5)
 //
 // Put returns only when the capture is durable -- that return is the
 // acknowledgement: each frame file is written to a temporary name, fsynced,
@@ -81,6 +82,7 @@ struct RecoveryReport {
   std::vector<CaptureProblem> problems;    // acknowledged captures lost or corrupt
   int temp_files_removed = 0;              // leftovers of puts interrupted mid-file
   int orphan_files_removed = 0;            // frame files whose put never committed
+  int result_files_removed = 0;            // results without a committed record, temporaries
   std::vector<std::string> unknown_files;  // names in frames/ not made by the store; kept
 
   // True when every acknowledged capture is intact.
@@ -156,10 +158,33 @@ class CaptureStore {
   // The store's root directory.
   const std::string& root() const { return options_.root; }
 
+  // Processing (issue 5): every capture is processed once by the processing
+  // service; its results are stored beside it as <root>/results/<id>-<name>,
+  // each written durably, then the record (state done, each file's SHA-256)
+  // is committed. Captures not yet done or failed, oldest first.
+  Result<std::vector<CaptureId>> Unprocessed();
+  // The processing record of a capture; nullopt when it was never tried.
+  Result<std::optional<ProcessingRecord>> Processing(std::string_view id);
+  // Counts a failed attempt (the capture stays pending) with its reason.
+  Status NoteProcessingAttempt(std::string_view id, const std::string& error);
+  // Marks a capture as not processable (not tried again) with the reason.
+  Status PutProcessingFailure(std::string_view id, const std::string& error);
+  // Stores the result files (name -> bytes; names of [A-Za-z0-9._-], at
+  // most 64 bytes) and marks the capture done. kResourceExhausted when the
+  // disk reserve would be broken; nothing is committed on failure.
+  Status PutProcessingResult(std::string_view id, const std::map<std::string, std::string>& files,
+                             const std::string& replica, const std::string& software_version);
+  // The stored result files (or only `only` when not empty), each verified
+  // against its SHA-256; kNotFound before the capture is done, kDataLoss for
+  // a missing or damaged file.
+  Result<std::map<std::string, std::string>> ReadProcessingFiles(std::string_view id,
+                                                                 const std::string& only = "");
+
  private:
   CaptureStore(const CaptureStoreOptions& options, std::unique_ptr<FileSystem> owned_fs,
                FileSystem& fs, int lock_fd);
   Status Recover();
+  Status RecoverResults();
   // Reads and verifies one indexed frame; `out` receives the pixels if given.
   Status VerifyFrame(const CaptureInfo& info, const StoredFrameInfo& frame,
                      framestore::GreyFrame* out);
@@ -175,6 +200,7 @@ class CaptureStore {
   FileSystem& fs_;
   int lock_fd_;
   std::string frames_dir_;
+  std::string results_dir_;
   std::unique_ptr<CaptureIndex> index_;
   CaptureIdGenerator ids_;
   RecoveryReport recovery_;

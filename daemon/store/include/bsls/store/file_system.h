@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bsls/framestore/status.h"
@@ -72,6 +73,24 @@ class FileSystem {
   // The names in a directory (without "." and ".."), in no particular order.
   virtual Result<std::vector<std::string>> ListDirectory(const std::string& path) = 0;
 };
+
+// Permissions of the store's files: the daemon's group may read them.
+inline constexpr mode_t kFileMode = 0640;
+
+// Prefix of files being written (WriteFileDurably); such files are never
+// part of a capture or a result.
+inline constexpr std::string_view kTempFilePrefix = ".tmp-";
+
+// Writes the concatenated `pieces` to directory/<temp prefix>name, fsyncs it
+// and renames it to directory/name: a reader sees no file or the whole file.
+// The directory itself is not fsynced (the caller does, once per batch).
+// On failure the temporary file is removed (best effort) and the error names
+// the step and the file.
+Status WriteFileDurably(FileSystem& fs, const std::string& directory, const std::string& name,
+                        const std::vector<std::string_view>& pieces, mode_t mode);
+
+// The whole file at `path`; kDataLoss when it is larger than `max_bytes`.
+Result<std::string> ReadWholeFile(FileSystem& fs, const std::string& path, std::uint64_t max_bytes);
 
 // The real thing: the POSIX calls themselves. Stateless, thread-safe.
 std::unique_ptr<FileSystem> MakePosixFileSystem();

@@ -31,8 +31,6 @@
 
 namespace bsls::store {
 
-// Prefix of files being written; such files are never part of a capture.
-inline constexpr std::string_view kTempFilePrefix = ".tmp-";
 
 // "<id>-<camera>.pgm".
 std::string FrameFileName(const CaptureId& id, framestore::Camera camera);

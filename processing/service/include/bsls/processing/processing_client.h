@@ -9,7 +9,8 @@
 // Work calls gather the streamed artifacts (checked: order, size, SHA-256)
 // and return them with the Result; progress goes to an optional callback.
 //
-// Thread-safety: a ProcessingClient may be used from several threads at once.
+// Thread-safety: a ProcessingClient may be used from several threads at once
+// (it is neither copyable nor movable: hold it by pointer to share it).
 #ifndef BSLS_PROCESSING_PROCESSING_CLIENT_H_
 #define BSLS_PROCESSING_PROCESSING_CLIENT_H_
 
@@ -19,6 +20,8 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -62,6 +65,8 @@ struct UploadFile {
 class ProcessingClient {
  public:
   ProcessingClient(std::shared_ptr<grpc::Channel> channel, ClientOptions options);
+  ProcessingClient(const ProcessingClient&) = delete;
+  ProcessingClient& operator=(const ProcessingClient&) = delete;
 
   // ProcessFrame (see processing.proto), with retries.
   WorkOutcome ProcessFrame(const v1::ProcessFrameRequest& request,
@@ -78,6 +83,10 @@ class ProcessingClient {
   // GetServerInfo of whichever replica answers.
   grpc::Status GetServerInfo(v1::ServerInfo* info);
 
+  // Cancels every call under way and makes later calls fail CANCELLED at
+  // once (shutdown).
+  void CancelAll();
+
   // A CalibrationSource carrying the file itself, which any replica can use
   // (it caches it on the way).
   static v1::CalibrationSource Inline(const std::string& yaml);
@@ -90,6 +99,9 @@ class ProcessingClient {
   std::shared_ptr<grpc::Channel> channel_;
   std::unique_ptr<v1::Processing::Stub> stub_;
   ClientOptions options_;
+  std::mutex mutex_;
+  std::set<grpc::ClientContext*> live_;  // contexts of calls under way
+  bool cancelled_ = false;
 };
 
 // True for the statuses a retry (on another replica) may cure.
