@@ -15,13 +15,22 @@
 #   face.ply, face.stl               both sides joined (open in MeshLab, ParaView, a slicer...)
 #   face_report.json                 per-side figures and the seam error of the join
 #   face_measurements.json           heights and a distance on the face, with uncertainties
+# Then the same through the services, as a clinic runs it (issue 5): the
+# capture daemon bslsd on its simulated framestore and one processing service
+# bsls-processd on this machine, driven by the Python automation example
+# (clients/python/examples/scripted_session.py), which grabs both sides,
+# waits for the reconstruction and writes into OUT_DIR/session/:
+#   surface.ply, left.ply, right.ply the joined and per-side surfaces
+#   report.json, record.json         the session report; the sealed record (frames,
+#                                    calibrations, every file by SHA-256, versions)
+#   measurements.json/.txt           heights and a distance measured by the service
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/demo}
 
 bash scripts/install-deps.sh
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build build/release -j "$(nproc)" --target bsls
+cmake --build build/release -j "$(nproc)" --target bsls bslsd bsls-processd bsls_python_stubs
 bsls=build/release/clients/cli/bsls
 
 mkdir -p "$out"
@@ -47,4 +56,45 @@ done
 # sits centred under the rig, so the face's midline is near x = 22.75 mm.
 "$bsls" measure "$out/face.ply" --height "22.75,-22.75" --height "0,0" \
   --distance "0,-20 45,-20" --json "$out/face_measurements.json"
-echo "demo: results in $out"
+
+# The services: one processing replica and the daemon, on sockets in $run.
+run=$(mktemp -d)
+calibrations=$(cd "$out" && pwd)
+session="$out/session"
+rm -rf "$session"
+cleanup() {
+  kill "${daemon_pid:-}" "${processd_pid:-}" 2>/dev/null || true
+  wait 2>/dev/null || true
+  rm -rf "$run"
+}
+trap cleanup EXIT
+build/release/processing/processd/bsls-processd --socket "$run/processd.sock" \
+  --set "scratch_dir=$run" --replica demo 2>"$run/processd.log" &
+processd_pid=$!
+cat >"$run/bslsd.yaml" <<EOF
+store:
+  root: $run/store
+listen:
+  unix_socket: $run/bslsd.sock
+roles:
+  admin: [$(id -un)]
+slides:
+  backend: simulated
+processing:
+  server: unix:$run/processd.sock
+  calibration_left: $calibrations/calibration_left.yaml
+  calibration_right: $calibrations/calibration_right.yaml
+log_level: warn
+EOF
+build/release/daemon/bslsd/bslsd --config "$run/bslsd.yaml" 2>"$run/bslsd.log" &
+daemon_pid=$!
+for _ in $(seq 300); do
+  [ -S "$run/bslsd.sock" ] && [ -S "$run/processd.sock" ] && break
+  kill -0 "$daemon_pid" "$processd_pid" 2>/dev/null || break
+  sleep 0.1
+done
+PYTHONPATH=build/release/clients/python/stubs:clients/python \
+  /usr/bin/python3 clients/python/examples/scripted_session.py --socket "$run/bslsd.sock" \
+  --session demo --patient DEMO-0001 --out "$session" --processd "unix:$run/processd.sock" ||
+  { cat "$run/bslsd.log" "$run/processd.log" >&2; exit 1; }
+echo "demo: results in $out (the services' run in $session)"

@@ -20,6 +20,7 @@
 #include "bsls/measurement/measurement_error.h"
 #include "bsls/measurement/plan.h"
 #include "command.h"
+#include "daemon_connection.h"
 
 namespace bsls::cli {
 namespace {
@@ -36,6 +37,7 @@ struct MeasureOptions {
   bool register_baseline = true;
   std::string json;
   int decimals = 2;
+  ServiceAddress server;  // target empty: measured here
 };
 
 // Parses "X,Y X,Y ..." (commas between coordinates, spaces or semicolons
@@ -74,6 +76,52 @@ measurement::ReferenceKind ParseReference(const std::string& name) {
   throw CommandError(kExitUsage, "--reference " + name + ": must be plane, quadric or cubic");
 }
 
+void AddPoint(const Eigen::Vector2d& p, v1::PointXY* out) {
+  out->set_x(p.x());
+  out->set_y(p.y());
+}
+
+void AddPolygon(const measurement::Polygon2d& polygon, v1::Polygon* out) {
+  for (const Eigen::Vector2d& p : polygon) AddPoint(p, out->add_points());
+}
+
+// The same figures measured by the processing service: the surface (and
+// baseline) go up, measurements.json comes back.
+void RunMeasureRemote(const MeasureOptions& o, const measurement::MeasurementPlan& plan) {
+  v1::MeasureRequest request;
+  request.set_surface_ply(ReadInputFile(o.surface, "surface"));
+  if (!o.baseline.empty()) request.set_baseline_ply(ReadInputFile(o.baseline, "--baseline"));
+  request.set_baseline_shares_frame(!o.register_baseline);
+  v1::MeasurementPlan* m = request.mutable_measurements();
+  for (const Eigen::Vector2d& h : plan.heights) AddPoint(h, m->add_heights());
+  for (const auto& d : plan.distances) AddPolygon({d[0], d[1]}, m->add_distances());
+  for (const auto& a : plan.areas) AddPolygon(a, m->add_areas());
+  for (const auto& l : plan.lesions) AddPolygon(l, m->add_lesions());
+  m->set_reference(plan.lesion.reference == measurement::ReferenceKind::kPlane
+                       ? v1::MeasurementPlan::REFERENCE_PLANE
+                   : plan.lesion.reference == measurement::ReferenceKind::kQuadric
+                       ? v1::MeasurementPlan::REFERENCE_QUADRIC
+                       : v1::MeasurementPlan::REFERENCE_CUBIC);
+  m->set_ring_mm(plan.lesion.ring_width_mm);
+  request.set_request_tag(o.surface.substr(0, 256));
+  processing::ProcessingClient client = OpenProcessingClient(o.server);
+  const processing::WorkOutcome out = client.Measure(request, ProgressPrinter(true));
+  CheckWork(out.status, o.surface, o.server);
+  nlohmann::json report = {{"surface", o.surface},
+                           {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
+  nlohmann::json measured = nlohmann::json::parse(out.files.at("measurements.json"));
+  // The service's table has 2 decimals; the rows give the figures for ours.
+  std::vector<measurement::ReportRow> rows;
+  for (const nlohmann::json& row : measured.at("rows"))
+    rows.push_back({row.at("name"),
+                    {row.at("value").get<double>(), row.at("uncertainty").get<double>()},
+                    row.at("unit")});
+  measured.erase("table");
+  report.update(measured);
+  if (!o.json.empty()) io::WriteFileAtomically(o.json, report.dump(2) + "\n");
+  std::cout << measurement::FormatTable(rows, o.decimals);
+}
+
 // Every requested figure, measured; a table on stdout and the JSON report.
 void RunMeasure(const MeasureOptions& o) {
   if (o.heights.empty() && o.distances.empty() && o.areas.empty() && o.lesions.empty())
@@ -107,6 +155,7 @@ void RunMeasure(const MeasureOptions& o) {
                                            "\": a region needs at least 3 points");
     }
   plan.baseline_params.register_rigidly = o.register_baseline;
+  if (!o.server.target.empty()) return RunMeasureRemote(o, plan);
   const geometry::SurfaceMesh mesh = io::ReadPly(o.surface);
   if (!o.baseline.empty()) {
     plan.baseline = io::ReadPly(o.baseline);
@@ -155,6 +204,7 @@ void AddMeasureCommand(CLI::App& app) {
   cmd->add_option("--decimals", options->decimals, "Decimals in the table")
       ->check(CLI::Range(0, 6))
       ->capture_default_str();
+  AddServerOptions(*cmd, options->server);
   cmd->callback([options] { RunMeasure(*options); });
 }
 

@@ -2,6 +2,7 @@
 // configuration errors exit 78 (EX_CONFIG) so systemd does not restart into
 // the same mistake.
 #include <signal.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 #include <systemd/sd-daemon.h>
 
@@ -62,6 +63,8 @@ int Run(const bsls::processd::Config& config) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Logs on stderr: stdout carries only the tcp_port=N line scripts read.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("bsls-processd"));
   CLI::App app{"bsls-processd: the BSLS processing service (frames to junctions, surfaces, "
                "measurements and calibrations)"};
   std::string config_path;

@@ -66,6 +66,12 @@ bool IsLoopbackHost(std::string_view host) {
 
 }  // namespace
 
+std::string TlsServerName(std::string_view target) {
+  if (!target.starts_with("ipv4:") && !target.starts_with("ipv6:")) return "";
+  target.remove_prefix(5);
+  return std::string(HostOf(target.substr(0, target.find(','))));
+}
+
 bool IsLoopbackTarget(std::string_view target) {
   std::vector<std::string_view> addresses;
   if (target.starts_with("ipv4:") || target.starts_with("ipv6:")) {

@@ -139,6 +139,27 @@ TEST(ProcessingService, ReconstructSessionJoinsAndMeasures) {
   ASSERT_EQ(m.at("areas").size(), 1u);
   // A 20 x 20 mm square on a curved face: at least its flat area.
   EXPECT_GT(m.at("areas")[0].at("area_mm2").at("value").get<double>(), 399.0);
+
+  // Measure: the same figures on the returned surface agree.
+  v1::MeasureRequest measure;
+  measure.set_surface_ply(out.files.at("surface.ply"));
+  *measure.mutable_measurements() = request.measurements();
+  const WorkOutcome measured = s.Client().Measure(measure);
+  ASSERT_TRUE(measured.status.ok()) << measured.status.error_message();
+  const nlohmann::json again = nlohmann::json::parse(measured.files.at("measurements.json"));
+  EXPECT_NEAR(again.at("heights")[0].at("height_mm").at("value").get<double>(),
+              m.at("heights")[0].at("height_mm").at("value").get<double>(),
+              1e-4);  // mm: the PLY holds float32
+  EXPECT_FALSE(again.at("table").get<std::string>().empty());
+  measure.set_surface_ply("ply\nnonsense");
+  EXPECT_EQ(s.Client().Measure(measure).status.error_code(), StatusCode::INVALID_ARGUMENT);
+  measure.set_surface_ply(out.files.at("surface.ply"));
+  measure.clear_measurements();
+  EXPECT_EQ(s.Client().Measure(measure).status.error_code(), StatusCode::INVALID_ARGUMENT);
+  v1::PointXY* far = measure.mutable_measurements()->add_heights();
+  far->set_x(5000);
+  far->set_y(5000);
+  EXPECT_EQ(s.Client().Measure(measure).status.error_code(), StatusCode::FAILED_PRECONDITION);
 }
 
 TEST(ProcessingService, BadRequestsAreRefusedWithTheFieldNamed) {
@@ -360,6 +381,20 @@ TEST(ProcessingService, CalibrateFromAnUploadedSession) {
   EXPECT_EQ(record.calibration.side, pattern::Side::kRight);
   EXPECT_TRUE(out.files.count("calibration-report.json"));
   EXPECT_TRUE(ScratchIsEmpty(scratch));
+  // The same upload gives the same file, so the same id (no scratch paths inside).
+  EXPECT_EQ(out.files.at("calibration.yaml").find(scratch.string()), std::string::npos);
+  const WorkOutcome again = s.Client().Calibrate(manifest, files);
+  ASSERT_TRUE(again.status.ok()) << again.status.error_message();
+  EXPECT_EQ(again.result.calibration_id(), out.result.calibration_id());
+
+  // A manifest naming files outside the upload is refused, whether they exist or not.
+  std::string outside = manifest;
+  const std::string first_image = files[0].path;
+  outside.replace(outside.find(first_image), first_image.size(), "/etc/passwd");
+  WorkOutcome escaped = s.Client().Calibrate(outside, files);
+  EXPECT_EQ(escaped.status.error_code(), StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(escaped.status.error_message().find("not one of the uploaded files"), std::string::npos)
+      << escaped.status.error_message();
 
   // A missing image is named as the client knows it; nothing is left behind.
   std::vector<UploadFile> missing(files.begin() + 1, files.end());

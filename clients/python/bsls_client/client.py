@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-from typing import Iterator, List, Optional
+import time
+from typing import Dict, Iterator, List, Optional
 
 import grpc
 import numpy as np
@@ -19,10 +20,17 @@ _CAMERA_NAMES = {v: k for k, v in _CAMERAS.items()}
 class CaptureError(Exception):
     """A call the daemon refused or could not complete: `code` is the grpc.StatusCode."""
 
-    def __init__(self, method: str, error: grpc.RpcError):
-        self.code = error.code()
-        self.details = error.details()
+    def __init__(self, method: str, error: Optional[grpc.RpcError],
+                 code: grpc.StatusCode = grpc.StatusCode.DATA_LOSS, details: str = ""):
+        self.code = error.code() if error is not None else code
+        self.details = error.details() if error is not None else details
         super().__init__(f"{method}: {self.code.name}: {self.details}")
+
+    @staticmethod
+    def local(method: str, details: str,
+              code: grpc.StatusCode = grpc.StatusCode.DATA_LOSS) -> "CaptureError":
+        """An error found on this side (a damaged reply, a wait that timed out)."""
+        return CaptureError(method, None, code, details)
 
 
 @dataclasses.dataclass
@@ -60,12 +68,37 @@ class Capture:
     slide: int
     requested_by: str
     frames: List[Frame]
+    processing: "Processing"
 
     @staticmethod
     def from_proto(info: pb.CaptureInfo) -> "Capture":
         side = {v: k for k, v in _SIDES.items()}.get(info.side, str(info.side))
         return Capture(info.capture_id, info.session_id, info.patient_reference, side,
-                       info.slide, info.requested_by, [Frame.from_proto(f) for f in info.frames])
+                       info.slide, info.requested_by, [Frame.from_proto(f) for f in info.frames],
+                       Processing.from_proto(info.processing))
+
+
+_STATES = {pb.ProcessingStatus.STATE_PENDING: "pending", pb.ProcessingStatus.STATE_DONE: "done",
+           pb.ProcessingStatus.STATE_FAILED: "failed",
+           pb.ProcessingStatus.STATE_DISABLED: "disabled"}
+
+
+@dataclasses.dataclass
+class Processing:
+    """Where a capture is in the daemon's processing queue: state is "pending",
+    "done", "failed" or "disabled" (no processing service configured)."""
+    state: str
+    attempts: int
+    last_error: str
+    replica: str
+    files: List[str]
+    record_sha256: str
+
+    @staticmethod
+    def from_proto(status: pb.ProcessingStatus) -> "Processing":
+        return Processing(_STATES.get(status.state, "unknown"), status.attempts,
+                          status.last_error, status.replica, list(status.files),
+                          status.record_sha256)
 
 
 class CaptureClient:
@@ -138,6 +171,40 @@ class CaptureClient:
     def capture(self, capture_id: str) -> Capture:
         """One stored capture with its frames."""
         return Capture.from_proto(self._call("GetCapture", pb.GetCaptureRequest(capture_id=capture_id)))
+
+    def results(self, capture_id: str, name: str = "") -> Dict[str, bytes]:
+        """The stored processing results of a capture (or only `name`), each
+        checked against the SHA-256 the daemon sent with it."""
+        request = pb.GetCaptureResultRequest(capture_id=capture_id, name=name)
+        files: Dict[str, bytearray] = {}
+        try:
+            for chunk in self._stub.GetCaptureResult(request, timeout=self.timeout):
+                data = files.setdefault(chunk.name, bytearray())
+                if chunk.offset != len(data):
+                    raise CaptureError.local("GetCaptureResult", f"{chunk.name}: chunk out of order")
+                data += chunk.data
+                if chunk.last and hashlib.sha256(data).hexdigest() != chunk.sha256:
+                    raise CaptureError.local("GetCaptureResult", f"{chunk.name}: SHA-256 mismatch")
+        except grpc.RpcError as error:
+            raise CaptureError("GetCaptureResult", error) from None
+        return {name: bytes(data) for name, data in files.items()}
+
+    def wait_processed(self, capture_id: str, timeout: float = 300.0,
+                       poll: float = 0.25) -> Capture:
+        """Waits until the capture is no longer pending (done, failed or
+        disabled) and returns it; CaptureError DEADLINE_EXCEEDED after `timeout`."""
+        deadline = time.monotonic() + timeout
+        while True:
+            capture = Capture.from_proto(self._call(
+                "GetCapture", pb.GetCaptureRequest(capture_id=capture_id)))
+            if capture.processing.state != "pending":
+                return capture
+            if time.monotonic() > deadline:
+                raise CaptureError.local(
+                    "wait_processed", f"capture {capture_id} still pending after {timeout} s "
+                    f"({capture.processing.attempts} attempts: {capture.processing.last_error})",
+                    grpc.StatusCode.DEADLINE_EXCEEDED)
+            time.sleep(poll)
 
     def delete(self, capture_id: str) -> None:
         """Deletes a stored capture (admin role)."""

@@ -68,9 +68,14 @@ std::shared_ptr<grpc::Channel> OpenProcessingChannel(const ClientOptions& option
   // A replica that went away is tried again soon after it comes back.
   args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 200);
   args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 2000);
-  if (options.tls.complete())
+  if (options.tls.complete()) {
+    // A list of addresses has no one host name: the certificate is checked
+    // against the first address's host (replicas share one name).
+    const std::string name = rpc::TlsServerName(options.target);
+    if (!name.empty()) args.SetSslTargetNameOverride(name);
     return grpc::CreateCustomChannel(options.target, rpc::MutualTlsChannelCredentials(options.tls),
                                      args);
+  }
   if (!rpc::IsUnixTarget(options.target) && !rpc::IsLoopbackTarget(options.target))
     throw std::invalid_argument(options.target +
                                 ": a remote processing service is mutual TLS only: give the CA, "
@@ -140,6 +145,14 @@ WorkOutcome ProcessingClient::ReconstructSession(const v1::ReconstructSessionReq
                                                  const ProgressCallback& progress) {
   return WithRetries([&](grpc::ClientContext* context, WorkOutcome* out) {
     auto reader = stub_->ReconstructSession(context, request);
+    return ReadWork(reader.get(), progress, out);
+  });
+}
+
+WorkOutcome ProcessingClient::Measure(const v1::MeasureRequest& request,
+                                      const ProgressCallback& progress) {
+  return WithRetries([&](grpc::ClientContext* context, WorkOutcome* out) {
+    auto reader = stub_->Measure(context, request);
     return ReadWork(reader.get(), progress, out);
   });
 }

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 #include <stdlib.h>
 
+#include <algorithm>
 #include <chrono>
 #include <fstream>
 #include <map>
@@ -16,6 +17,7 @@
 #include "bsls/decoder/decode_output.h"
 #include "bsls/io/digest.h"
 #include "bsls/io/surface_file.h"
+#include "bsls/measurement/measurement_error.h"
 #include "bsls/rpc/artifacts.h"
 #include "bsls/rpc/frame_message.h"
 #include "bsls/session/session.h"
@@ -452,6 +454,42 @@ Status ProcessingService::ReconstructSession(grpc::ServerContext* context,
   });
 }
 
+Status ProcessingService::Measure(grpc::ServerContext* context, const v1::MeasureRequest* request,
+                                  grpc::ServerWriter<v1::WorkEvent>* writer) {
+  const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
+  return RunWork(context, "Measure", emit, {}, [&](Work& w) {
+    CheckTag(request->request_tag());
+    measurement::MeasurementPlan plan = PlanOf(request->measurements(), options_.max_measurements);
+    if (plan.empty()) Refuse(StatusCode::INVALID_ARGUMENT, "measurements: give at least one figure");
+    geometry::SurfaceMesh surface;
+    try {
+      surface = io::DecodePly(request->surface_ply(), "surface_ply");
+      if (!request->baseline_ply().empty()) {
+        plan.baseline = io::DecodePly(request->baseline_ply(), "baseline_ply");
+        plan.baseline_name = "baseline_ply";
+        plan.baseline_params.register_rigidly = !request->baseline_shares_frame();
+      }
+    } catch (const io::InputError& e) {
+      Refuse(StatusCode::INVALID_ARGUMENT, e.what());
+    }
+    std::string why;
+    if (!plan.IsValid(&why)) Refuse(StatusCode::INVALID_ARGUMENT, "measurements: " + why);
+    w.observer.CheckCancelled("the measurements");
+    w.observer.Report("measure", 0.0);
+    measurement::MeasurementOutcome m;
+    try {
+      m = measurement::MeasurePlan(surface, plan);
+    } catch (const measurement::MeasurementError& e) {
+      Refuse(StatusCode::FAILED_PRECONDITION, std::string("surface_ply: ") + e.what());
+    }
+    m.report["table"] = measurement::FormatTable(m.rows, 2);
+    w.Artifact("measurements.json", "application/json", m.report.dump(2) + "\n");
+    w.result.set_request_tag(request->request_tag());
+    w.result.set_vertices(static_cast<std::uint32_t>(surface.VertexCount()));
+    w.result.set_triangles(static_cast<std::uint32_t>(surface.faces.size()));
+  });
+}
+
 Status ProcessingService::Calibrate(
     grpc::ServerContext* context,
     grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream) {
@@ -515,7 +553,7 @@ Status ProcessingService::Calibrate(
                                                  std::to_string(sizes[path]) + " bytes");
       total += chunk.data().size();
       if (total > options_.max_upload_bytes)
-        Refuse(StatusCode::RESOURCE_EXHAUSTED,
+        Refuse(StatusCode::INVALID_ARGUMENT,
                "Calibrate: the upload exceeds " + std::to_string(options_.max_upload_bytes) +
                    " bytes");
       out.write(chunk.data().data(), static_cast<std::streamsize>(chunk.data().size()));
@@ -545,6 +583,19 @@ Status ProcessingService::Calibrate(
     } catch (const calibration::ManifestError& e) {
       Refuse(StatusCode::INVALID_ARGUMENT, strip(e.what()));
     }
+    // The manifest may only name files of the upload.
+    const fs::path root = fs::weakly_canonical(folder.path());
+    for (const auto* views : {&manifest.camera_views, &manifest.screen_views,
+                              &manifest.reference_views})
+      for (const calibration::ManifestView& view : *views) {
+        const fs::path image = fs::weakly_canonical(view.image);
+        const auto [end, _] = std::mismatch(root.begin(), root.end(), image.begin(), image.end());
+        if (end != root.end())
+          Refuse(StatusCode::INVALID_ARGUMENT,
+                 "manifest: image " + strip(view.image.string()) +
+                     " is not one of the uploaded files (paths must stay inside the manifest's "
+                     "folder)");
+      }
     calibration::SideCalibration result;
     try {
       result = calibration::CalibrateSide(
@@ -557,6 +608,11 @@ Status ProcessingService::Calibrate(
       if (e.reason() == calibration::CalibrationErrorReason::kCancelled) throw;
       throw calibration::CalibrationError(e.reason(), strip(e.what()));
     }
+    // Image paths as the client named them (relative to the manifest), so an
+    // upload gives the same file, and the same id, on every replica.
+    for (auto& v : result.camera_views) v.image = fs::relative(v.image, folder.path());
+    for (auto& v : result.screen_views) v.image = fs::relative(v.image, folder.path());
+    for (auto& v : result.reference_views) v.image = fs::relative(v.image, folder.path());
     const std::string yaml = calibration::CalibrationToYaml(result, options_.software_version);
     const auto cached = calibrations_.Put(yaml, "the new calibration");
     nlohmann::json report = calibration::CalibrationReport(result);

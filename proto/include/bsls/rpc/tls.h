@@ -52,6 +52,11 @@ std::shared_ptr<grpc::ChannelCredentials> MutualTlsChannelCredentials(const TlsF
 // True for "unix:..." and "unix-abstract:..." targets.
 bool IsUnixTarget(std::string_view target);
 
+// The host name a server certificate must carry for an "ipv4:"/"ipv6:"
+// list of addresses (the first one's host); "" for other targets, whose
+// host gRPC checks itself.
+std::string TlsServerName(std::string_view target);
+
 // True when every address of a "host:port" target (or an "ipv4:"/"ipv6:"
 // list) is on this machine's loopback: localhost, 127.0.0.0/8, [::1].
 bool IsLoopbackTarget(std::string_view target);

@@ -74,6 +74,8 @@ class ProcessingClient {
   // ReconstructSession, with retries.
   WorkOutcome ReconstructSession(const v1::ReconstructSessionRequest& request,
                                  const ProgressCallback& progress = {});
+  // Measure, with retries.
+  WorkOutcome Measure(const v1::MeasureRequest& request, const ProgressCallback& progress = {});
   // Calibrate: the manifest, then every file in 1 MiB chunks; with retries.
   WorkOutcome Calibrate(const std::string& manifest_yaml, const std::vector<UploadFile>& files,
                         const std::string& request_tag = "",

@@ -59,6 +59,8 @@ class ProcessingService final : public v1::Processing::Service {
   grpc::Status ReconstructSession(grpc::ServerContext* context,
                                   const v1::ReconstructSessionRequest* request,
                                   grpc::ServerWriter<v1::WorkEvent>* writer) override;
+  grpc::Status Measure(grpc::ServerContext* context, const v1::MeasureRequest* request,
+                       grpc::ServerWriter<v1::WorkEvent>* writer) override;
   grpc::Status Calibrate(grpc::ServerContext* context,
                          grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream)
       override;
