@@ -47,10 +47,12 @@ class Bslsd:
     """A running bslsd in a fresh temporary folder: `socket`, `port`, `pki(name)`.
 
     `roles` is the YAML under `roles:` (two-space indented lines);
-    `certificates` the client certificate names to make. `ready(socket)` is
-    called until it returns True (the caller's own client probing the socket)."""
+    `certificates` the client certificate names to make; `extra` more
+    top-level YAML (e.g. a processing: section). `ready(socket)` is called
+    until it returns True (the caller's own client probing the socket)."""
 
-    def __init__(self, bslsd, ready, roles, certificates=("station",), prefix="bslsd_"):
+    def __init__(self, bslsd, ready, roles, certificates=("station",), prefix="bslsd_",
+                 extra=""):
         self.dir = tempfile.mkdtemp(prefix=prefix)
         self.socket = os.path.join(self.dir, "bslsd.sock")
         self.pki = make_pki(self.dir, clients=certificates)
@@ -65,7 +67,7 @@ class Bslsd:
                       f"  tls_client_ca: {self.pki('ca.pem')}\n"
                       f"roles:\n{roles}"
                       "framestore:\n  simulated_breathing_mm: 0\n"
-                      "slides:\n  backend: simulated\nlog_level: warn\n")
+                      "slides:\n  backend: simulated\nlog_level: warn\n" + extra)
         self._log = open(os.path.join(self.dir, "bslsd.log"), "w")
         self.process = subprocess.Popen([bslsd, "--config", config], stdout=self._log,
                                         stderr=subprocess.STDOUT)
