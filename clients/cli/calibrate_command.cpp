@@ -1,6 +1,7 @@
 // bsls calibrate: calibrate one side (camera, light planes, projector) from a
 // session manifest (contracts section 4) and write its calibration file.
 #include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -10,6 +11,7 @@
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/io/frame_file.h"
 #include "command.h"
+#include "daemon_connection.h"
 
 namespace bsls::cli {
 namespace {
@@ -18,7 +20,52 @@ struct CalibrateOptions {
   std::string manifest;
   std::string output;
   std::string report;
+  bool quiet = false;
+  ServiceAddress server;  // target empty: calibrated here
 };
+
+// The same calibration on the processing service: the manifest and every
+// image it names are uploaded; the calibration file and report come back.
+void RunCalibrateRemote(const CalibrateOptions& o) {
+  namespace fs = std::filesystem;
+  calibration::Manifest manifest;
+  try {
+    manifest = calibration::LoadManifest(o.manifest);  // checks it and that every image exists
+  } catch (const calibration::ManifestError& e) {
+    throw CommandError(kExitInput, e.what());
+  }
+  const fs::path folder = fs::weakly_canonical(fs::path(o.manifest).parent_path().empty()
+                                                   ? fs::path(".")
+                                                   : fs::path(o.manifest).parent_path());
+  std::vector<processing::UploadFile> files;
+  for (const auto* views : {&manifest.camera_views, &manifest.screen_views,
+                            &manifest.reference_views})
+    for (const calibration::ManifestView& view : *views) {
+      const fs::path image = fs::weakly_canonical(view.image);
+      const fs::path relative = image.lexically_relative(folder);
+      if (relative.empty() || *relative.begin() == "..")
+        throw CommandError(kExitInput, o.manifest + ": image " + view.image.string() +
+                                           " is outside the manifest's folder; --server uploads "
+                                           "only what is inside it");
+      files.push_back({relative.generic_string(), ReadInputFile(image.string(), "image")});
+    }
+  processing::ProcessingClient client = OpenProcessingClient(o.server);
+  const processing::WorkOutcome out = client.Calibrate(
+      ReadInputFile(o.manifest, "manifest"), files, o.manifest.substr(0, 256),
+      ProgressPrinter(o.quiet));
+  CheckWork(out.status, o.manifest, o.server);
+  const nlohmann::json report = nlohmann::json::parse(out.files.at("calibration-report.json"));
+  if (!o.report.empty()) io::WriteFileAtomically(o.report, out.files.at("calibration-report.json"));
+  io::WriteFileAtomically(o.output, out.files.at("calibration.yaml"));
+  std::printf("%s: %s side, %d x %d px, id %s (calibrated by %s)\n", o.output.c_str(),
+              report.at("side").get<std::string>().c_str(), report.at("width").get<int>(),
+              report.at("height").get<int>(), out.result.calibration_id().c_str(),
+              out.result.replica().c_str());
+  std::printf("camera: RMS %.3f px, %.4f mm; light planes: perspective RMS %.4f mm\n",
+              report.at("camera").at("rms_px").get<double>(),
+              report.at("camera").at("rms_mm").get<double>(),
+              report.at("planes").at("perspective_rms_mm").get<double>());
+}
 
 // Input problems (a file missing or unusable) are exit 3; images that were
 // read but do not give a calibration are exit 1.
@@ -35,6 +82,7 @@ ExitCode ExitCodeOf(calibration::CalibrationErrorReason reason) {
 }
 
 void RunCalibrate(const CalibrateOptions& o) {
+  if (!o.server.target.empty()) return RunCalibrateRemote(o);
   calibration::Manifest manifest;
   try {
     manifest = calibration::LoadManifest(o.manifest);
@@ -90,6 +138,8 @@ void AddCalibrateCommand(CLI::App& app) {
       ->required();
   cmd->add_option("-o,--output", opts->output, "Output calibration file (YAML)")->required();
   cmd->add_option("--report", opts->report, "Also write the figures as JSON");
+  cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
+  AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunCalibrate(*opts); });
 }
 

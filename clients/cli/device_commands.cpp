@@ -8,11 +8,13 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "bsls/io/frame_file.h"
-#include "bsls/v1/capture.grpc.pb.h"
+#include "bsls/rpc/artifacts.h"
 #include "bsls/rpc/frame_message.h"
+#include "bsls/v1/capture.grpc.pb.h"
 #include "command.h"
 #include "daemon_connection.h"
 
@@ -135,6 +137,21 @@ void PrintCapture(const v1::CaptureInfo& info, const std::vector<std::string>& f
     std::cout << "  " << CameraName(frame.camera()) << ": " << frame.width() << " x "
               << frame.height() << ", gain " << frame.gain() << ", sha256 " << frame.sha256()
               << "\n";
+  if (info.has_processing()) {
+    static const std::map<int, std::string> kStates = {
+        {v1::ProcessingStatus::STATE_PENDING, "pending"},
+        {v1::ProcessingStatus::STATE_DONE, "done"},
+        {v1::ProcessingStatus::STATE_FAILED, "failed"},
+        {v1::ProcessingStatus::STATE_DISABLED, "not configured"}};
+    const v1::ProcessingStatus& p = info.processing();
+    const auto state = kStates.find(p.state());
+    std::cout << "  processing: " << (state != kStates.end() ? state->second : "unknown");
+    if (p.attempts() > 0) std::cout << ", " << p.attempts() << " attempts";
+    if (!p.replica().empty()) std::cout << ", by " << p.replica();
+    if (p.files_size() > 0) std::cout << ", " << p.files_size() << " result files";
+    if (!p.last_error().empty()) std::cout << ": " << p.last_error();
+    std::cout << "\n";
+  }
   for (const std::string& file : files) std::cout << "  wrote " << file << "\n";
 }
 
@@ -308,6 +325,43 @@ void AddDeviceCommands(CLI::App& app) {
     std::vector<std::string> files;
     if (!get_args->out.empty()) files = WriteFrames(info, get_args->out);
     PrintCapture(info, files, options->json);
+  });
+
+  // bsls captures results ID -o DIR: the processing results kept with the capture.
+  auto results_args = std::make_shared<GetArgs>();
+  CLI::App* results = AddDeviceCommand(
+      *captures, "results", "the processing results kept with a capture (surface, reports, record)",
+      *options);
+  results->add_option("CAPTURE_ID", results_args->id, "32 hex digits")->required();
+  results->add_option("-o,--out", results_args->out, "folder for the files")->required();
+  results->callback([options, results_args] {
+    v1::GetCaptureResultRequest request;
+    request.set_capture_id(results_args->id);
+    auto context = CallContext(options->address);
+    auto reader = Connect(*options)->GetCaptureResult(context.get(), request);
+    rpc::ArtifactAssembler assembler;
+    v1::Artifact chunk;
+    std::string damage;
+    while (reader->Read(&chunk)) {
+      if (!damage.empty()) continue;
+      try {
+        assembler.Add(chunk);
+      } catch (const rpc::ArtifactError& e) {
+        damage = e.what();
+      }
+    }
+    CheckCall(reader->Finish(), "GetCaptureResult", options->address);
+    if (!damage.empty())
+      throw CommandError(kExitServiceFailed, "GetCaptureResult: " + damage);
+    MakeFolder(results_args->out);
+    for (const auto& [name, bytes] : assembler.files()) {
+      const std::string path = results_args->out + "/" + name;
+      io::WriteFileAtomically(path, bytes);
+      if (options->json)
+        std::cout << nlohmann::json{{"file", path}, {"bytes", bytes.size()}}.dump() << "\n";
+      else
+        std::cout << "wrote " << path << " (" << bytes.size() << " bytes)\n";
+    }
   });
 
   auto delete_id = std::make_shared<std::string>();

@@ -572,6 +572,33 @@ class SurfaceCliTest(unittest.TestCase):
             vertices = sum(1 for line in f if line.startswith("v "))
         self.assertEqual(vertices, rep["vertices"])
 
+    def test_calibrate_on_the_service(self):
+        server = self.start_processd()
+        out, report = self.path("remote_left.yaml"), self.path("remote_left.json")
+        r = run("calibrate", os.path.join(self.dir.name, "left", "session.yaml"), "-o", out,
+                "--report", report, "--server", server, "-q")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertIn("id sha256:", r.stdout)
+        with open(out) as f:
+            self.assertIn("format: bsls-calibration\n", f.read())
+        with open(report) as f:
+            self.assertLess(json.load(f)["camera"]["rms_px"], 0.5)
+        # The service's calibration serves like the local one.
+        r = run("process", self.frame, "--side", "left", "--calibration", out,
+                "--junctions", self.path("remote_cal_j.json"), "--json")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertTrue(json.loads(r.stdout)["q_absolute"])
+
+    def test_measure_on_the_service(self):
+        server = self.start_processd()
+        report = self.path("remote_measure.json")
+        r = run("measure", self.surface, "--height", "0,0", "--json", report, "--server", server)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        local = run("measure", self.surface, "--height", "0,0")
+        self.assertEqual(r.stdout, local.stdout)
+        r = run("measure", self.surface, "--height", "5000,5000", "--server", server)
+        self.assertEqual(r.returncode, EXIT_NOT_PROCESSED, r.stderr)
+
     def test_service_errors_have_exit_codes(self):
         out = self.path("never.ply")
         r = run("process", self.frame, "--side", "left", "--junctions", out,

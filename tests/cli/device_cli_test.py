@@ -89,6 +89,12 @@ class DeviceCliTest(unittest.TestCase):
         listed = [json.loads(line) for line in
                   self.ok("captures", "list", "--session", "cli-1", "--json").stdout.splitlines()]
         self.assertEqual([c["capture_id"] for c in listed], [cid])
+        # No processing service is configured: nothing to fetch, and it says so.
+        shown = self.ok("captures", "get", cid).stdout
+        self.assertIn("processing: not configured", shown)
+        r = self.bsls("captures", "results", cid, "-o", os.path.join(self.dir, "results"))
+        self.assertEqual(r.returncode, 3, r.stderr)
+        self.assertIn("no stored results", r.stderr)
         again = os.path.join(self.dir, "again")
         self.ok("captures", "get", cid, "-o", again)
         with open(os.path.join(out, f"{cid}_left.png"), "rb") as a, \
