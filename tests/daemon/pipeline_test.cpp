@@ -11,6 +11,7 @@
 #include "bsls/io/digest.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/testing/calibration_sessions.h"
+#include "bsls/v1/processing.grpc.pb.h"
 #include "daemon_process.h"
 
 namespace bsls::testing {
@@ -19,39 +20,71 @@ namespace {
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 
-// bsls-processd on a Unix socket in `dir`; killed when it goes out of scope.
+// bsls-processd on a Unix socket in `dir` (or, with `tcp`, on a loopback
+// port it reports); stopped when it goes out of scope.
 class ProcessdProcess {
  public:
-  explicit ProcessdProcess(const fs::path& dir) : socket_(dir / "processd.sock") {
-    std::vector<std::string> argv = {BSLS_PROCESSD_PATH, "--socket", socket_.string(),
-                                     "--workers", "1", "--replica", "pipeline-test",
+  explicit ProcessdProcess(const fs::path& dir, bool tcp = false, const std::string& name = "p")
+      : socket_(dir / (name + ".sock")) {
+    std::vector<std::string> argv = {BSLS_PROCESSD_PATH, "--workers", "1", "--replica", name,
                                      "--set", "scratch_dir=" + dir.string()};
-    const std::string log = (dir / "processd.log").string();
+    if (tcp) {
+      for (const char* a : {"--socket", "", "--tcp", "127.0.0.1:0", "--set",
+                            "listen.plaintext_loopback=true"})
+        argv.push_back(a);
+    } else {
+      argv.insert(argv.end(), {"--socket", socket_.string()});
+    }
+    const std::string log = (dir / (name + ".log")).string();
+    int out[2];
+    if (::pipe(out) != 0) return;
     pid_ = ::fork();
     if (pid_ == 0) {
       const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      ::dup2(fd, 1);
+      ::dup2(out[1], 1);
       ::dup2(fd, 2);
+      ::close(out[0]);
       std::vector<char*> raw;
       for (std::string& a : argv) raw.push_back(a.data());
       raw.push_back(nullptr);
       ::execv(raw[0], raw.data());
       ::_exit(127);
     }
-    for (int i = 0; i < 400 && !fs::exists(socket_); ++i)
-      std::this_thread::sleep_for(milliseconds(25));
+    ::close(out[1]);
+    if (tcp) {
+      // "tcp_port=N" once it serves.
+      std::string line;
+      char c;
+      while (::read(out[0], &c, 1) == 1 && c != '\n') line += c;
+      if (line.rfind("tcp_port=", 0) == 0) port_ = std::stoi(line.substr(9));
+    } else {
+      for (int i = 0; i < 400 && !fs::exists(socket_); ++i)
+        std::this_thread::sleep_for(milliseconds(25));
+    }
+    ::close(out[0]);
   }
   ~ProcessdProcess() {
+    if (pid_ <= 0) return;
     ::kill(pid_, SIGTERM);
     int status = 0;
     ::waitpid(pid_, &status, 0);
   }
-  std::string target() const { return "unix:" + socket_.string(); }
-  bool ready() const { return fs::exists(socket_); }
+  // SIGKILL now (a replica dying mid-call).
+  void Kill() {
+    ::kill(pid_, SIGKILL);
+    int status = 0;
+    ::waitpid(pid_, &status, 0);
+    pid_ = -1;
+  }
+  std::string target() const {
+    return port_ ? "127.0.0.1:" + std::to_string(port_) : "unix:" + socket_.string();
+  }
+  bool ready() const { return port_ > 0 || fs::exists(socket_); }
 
  private:
   fs::path socket_;
   pid_t pid_ = -1;
+  int port_ = 0;
 };
 
 class Pipeline : public ::testing::Test {
@@ -148,7 +181,7 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
   const v1::CaptureInfo info = WaitProcessed(id);
   ASSERT_EQ(info.processing().state(), v1::ProcessingStatus::STATE_DONE)
       << info.processing().last_error() << "\n" << daemon_->Log();
-  EXPECT_EQ(info.processing().replica(), "pipeline-test");
+  EXPECT_EQ(info.processing().replica(), "p");
   const std::map<std::string, std::string> files = Results(id);
   ASSERT_TRUE(last_status_.ok()) << last_status_.error_message();
   for (const char* name : {"surface.ply", "left.ply", "right.ply", "report.json", "record.json",
@@ -196,7 +229,7 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
 }
 
 TEST_F(Pipeline, CapturesWaitThroughAnOutageAndARestartOfTheDaemon) {
-  const std::string target = "unix:" + (dir_ / "processd.sock").string();
+  const std::string target = "unix:" + (dir_ / "p.sock").string();
   StartDaemon(target);  // nobody listens there yet
   const std::string first = Grab(v1::GRAB_SIDE_BOTH);
   const std::string second = Grab(v1::GRAB_SIDE_BOTH);
@@ -224,6 +257,36 @@ TEST_F(Pipeline, CapturesWaitThroughAnOutageAndARestartOfTheDaemon) {
     EXPECT_EQ(done.processing().state(), v1::ProcessingStatus::STATE_DONE)
         << done.processing().last_error() << "\n" << daemon_->Log();
   }
+}
+
+TEST_F(Pipeline, AReplicaKilledMidCallLosesNoCapture) {
+  // Two replicas behind one round_robin address list.
+  auto first = std::make_unique<ProcessdProcess>(dir_, true, "r1");
+  ProcessdProcess second(dir_, true, "r2");
+  ASSERT_TRUE(first->ready() && second.ready());
+  StartDaemon("ipv4:" + first->target() + "," + second.target());
+  std::vector<std::string> ids;
+  for (int i = 0; i < 4; ++i) ids.push_back(Grab(v1::GRAB_SIDE_BOTH));
+  // Kill r1 while it works on one of them.
+  auto r1 = v1::Processing::NewStub(
+      grpc::CreateChannel(first->target(), grpc::InsecureChannelCredentials()));
+  bool busy = false;
+  const auto until = std::chrono::steady_clock::now() + seconds(120);
+  while (!busy && std::chrono::steady_clock::now() < until) {
+    v1::ServerInfo info;
+    busy = r1->GetServerInfo(Deadline(milliseconds(2000)).get(), {}, &info).ok() &&
+           info.busy() > 0;
+    if (!busy) std::this_thread::sleep_for(milliseconds(5));
+  }
+  ASSERT_TRUE(busy) << "r1 never got work";
+  first->Kill();
+  for (const std::string& id : ids) {
+    const v1::CaptureInfo done = WaitProcessed(id);
+    EXPECT_EQ(done.processing().state(), v1::ProcessingStatus::STATE_DONE)
+        << done.processing().last_error() << "\n" << daemon_->Log();
+  }
+  // After the kill every capture still waiting went to the survivor.
+  EXPECT_EQ(Get(ids.back()).processing().replica(), "r2");
 }
 
 }  // namespace
