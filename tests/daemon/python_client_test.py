@@ -16,7 +16,7 @@ import grpc
 from bsls_client import CaptureClient, CaptureError
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from bslsd_harness import Bslsd  # noqa: E402
+from bslsd_harness import Bslsd, answers  # noqa: E402
 
 BSLSD = None
 
@@ -24,13 +24,7 @@ BSLSD = None
 class DaemonTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        def ready(socket):
-            try:
-                CaptureClient.unix(socket, timeout=5).status()
-                return True
-            except CaptureError:
-                return False
-        cls.daemon = Bslsd(BSLSD, ready,
+        cls.daemon = Bslsd(BSLSD, answers,
                            "  admin: [root]\n  others: admin\n"
                            "  certificates:\n    analyst: viewer\n",
                            certificates=("analyst",), prefix="bslsd_python_")

@@ -19,7 +19,7 @@ import unittest
 from bsls_client import CaptureClient, CaptureError
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from bslsd_harness import Bslsd  # noqa: E402
+from bslsd_harness import Bslsd, answers  # noqa: E402
 
 BSLSD = PROCESSD = BSLS = None
 EXAMPLE = os.path.join(os.path.dirname(__file__), "..", "..", "clients", "python", "examples",
@@ -55,13 +55,7 @@ class PythonPipelineTest(unittest.TestCase):
                 break
             time.sleep(0.05)
 
-        def ready(socket):
-            try:
-                CaptureClient.unix(socket, timeout=5).status()
-                return True
-            except CaptureError:
-                return False
-        cls.daemon = Bslsd(BSLSD, ready, "  admin: [root]\n  others: admin\n",
+        cls.daemon = Bslsd(BSLSD, answers, "  admin: [root]\n  others: admin\n",
                            prefix="bslsd_pipeline_",
                            extra=f"processing:\n  server: unix:{cls.processd_socket}\n"
                                  f"  calibration_left: {calibrations['left']}\n"

@@ -20,15 +20,10 @@ namespace {
 
 using framestore::Camera;
 using testing::RandomFrame;
+using testing::OpenStore;
 using testing::RandomRequest;
 using testing::TempDir;
 using testing::TestOptions;
-
-std::unique_ptr<CaptureStore> OpenStore(const CaptureStoreOptions& options) {
-  auto store = CaptureStore::Open(options);
-  EXPECT_TRUE(store.ok()) << store.status().ToString();
-  return store.ok() ? std::move(*store) : nullptr;
-}
 
 void FlipByte(const std::string& path, std::uintmax_t offset_from_end) {
   std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);

@@ -15,15 +15,10 @@ namespace bsls::store {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::OpenStore;
 using testing::RandomRequest;
 using testing::TempDir;
 using testing::TestOptions;
-
-std::unique_ptr<CaptureStore> OpenStore(const CaptureStoreOptions& options) {
-  auto store = CaptureStore::Open(options);
-  EXPECT_TRUE(store.ok()) << store.status().ToString();
-  return store.ok() ? std::move(*store) : nullptr;
-}
 
 std::vector<std::string> Ids(const Result<std::vector<CaptureId>>& ids) {
   std::vector<std::string> out;

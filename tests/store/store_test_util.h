@@ -35,6 +35,13 @@ class TempDir {
   std::string path_;
 };
 
+// Opens a store; a failed test (and nullptr) when it cannot be opened.
+inline std::unique_ptr<CaptureStore> OpenStore(const CaptureStoreOptions& options) {
+  auto store = CaptureStore::Open(options);
+  EXPECT_TRUE(store.ok()) << store.status().ToString();
+  return store.ok() ? std::move(*store) : nullptr;
+}
+
 // A frame of seeded random pixels; stride may exceed width.
 inline framestore::GreyFrame RandomFrame(std::mt19937& rng, framestore::Camera camera,
                                          int width = 64, int height = 48, int stride = 0) {

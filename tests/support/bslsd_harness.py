@@ -43,6 +43,18 @@ def free_port():
         return s.getsockname()[1]
 
 
+def answers(socket):
+    """True when a daemon answers GetStatus on `socket` (the Bslsd ready probe
+    of the Python client tests)."""
+    from bsls_client import CaptureClient, CaptureError
+    try:
+        with CaptureClient.unix(socket, timeout=5) as client:
+            client.status()
+        return True
+    except CaptureError:
+        return False
+
+
 class Bslsd:
     """A running bslsd in a fresh temporary folder: `socket`, `port`, `pki(name)`.
 
