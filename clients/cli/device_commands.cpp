@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/highgui.hpp>
 
 #include "bsls/io/frame_file.h"
 #include "bsls/rpc/artifacts.h"
@@ -383,17 +384,27 @@ void AddDeviceCommands(CLI::App& app) {
   struct PreviewArgs {
     std::string camera, out;
     int frames = 25;
+    bool show = false;
   };
   auto preview_args = std::make_shared<PreviewArgs>();
   CLI::App* preview =
-      AddDeviceCommand(app, "preview", "live frames of one camera, written as PNG files", *options);
+      AddDeviceCommand(app, "preview",
+                       "live frames of one camera, written as PNG files or shown in a window",
+                       *options);
   preview->add_option("--camera", preview_args->camera, "left, right or third (default: selected)")
       ->check(CLI::IsMember({"left", "right", "third"}));
   preview->add_option("--frames", preview_args->frames, "how many frames to take")
       ->check(CLI::Range(1, 100000));
-  preview->add_option("-o,--out", preview_args->out, "folder for preview_NNNNN.png")->required();
+  preview->add_option("-o,--out", preview_args->out, "folder for preview_NNNNN.png");
+  preview->add_flag("--show", preview_args->show,
+                    "show the frames in a window (positioning the patient); q or Esc ends");
   preview->callback([options, preview_args] {
-    MakeFolder(preview_args->out);
+    if (preview_args->out.empty() && !preview_args->show)
+      throw CommandError(kExitUsage, "preview: give -o DIR (write the frames) or --show");
+    if (preview_args->show && std::getenv("DISPLAY") == nullptr &&
+        std::getenv("WAYLAND_DISPLAY") == nullptr)
+      throw CommandError(kExitUsage, "preview --show: no display (DISPLAY is not set); use -o DIR");
+    if (!preview_args->out.empty()) MakeFolder(preview_args->out);
     v1::PreviewRequest request;
     if (!preview_args->camera.empty()) request.set_camera(kCameras.at(preview_args->camera));
     // The stream's deadline covers every frame asked for, at 25 Hz, plus the timeout.
@@ -407,11 +418,18 @@ void AddDeviceCommands(CLI::App& app) {
     const auto start = std::chrono::steady_clock::now();
     while (taken < preview_args->frames && reader->Read(&message)) {
       const cv::Mat view = FrameImage(message.frame(), "preview");
-      char name[32];
-      std::snprintf(name, sizeof name, "preview_%05d.png", taken);
-      io::WritePngAtomically((fs::path(preview_args->out) / name).string(), view);
+      if (!preview_args->out.empty()) {
+        char name[32];
+        std::snprintf(name, sizeof name, "preview_%05d.png", taken);
+        io::WritePngAtomically((fs::path(preview_args->out) / name).string(), view);
+      }
       dropped += message.dropped();
       ++taken;
+      if (preview_args->show) {
+        cv::imshow("bsls preview", view);
+        const int key = cv::waitKey(1);
+        if (key == 'q' || key == 27) break;
+      }
     }
     context->TryCancel();
     const grpc::Status finished = reader->Finish();
@@ -421,9 +439,12 @@ void AddDeviceCommands(CLI::App& app) {
     if (options->json)
       std::cout << "{\"frames\":" << taken << ",\"dropped\":" << dropped
                 << ",\"seconds\":" << seconds << "}\n";
-    else
+    else if (!preview_args->out.empty())
       std::cout << "wrote " << taken << " frames to " << preview_args->out << " in " << seconds
                 << " s (" << dropped << " skipped while writing)\n";
+    else
+      std::cout << "showed " << taken << " frames in " << seconds << " s (" << dropped
+                << " skipped)\n";
   });
 }
 

@@ -76,6 +76,16 @@ class DeviceCliTest(unittest.TestCase):
         self.ok("gain", str(status["gain_range"]["nominal"]))
         self.ok("camera", "left")
 
+    def test_preview_needs_a_folder_or_a_display(self):
+        r = self.bsls("preview", "--frames", "2")
+        self.assertEqual(r.returncode, 2, r.stderr)
+        env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+        r = subprocess.run([BSLS, "preview", "--show", "--frames", "2", "--daemon",
+                            "unix:" + self.daemon.socket], capture_output=True, text=True,
+                           timeout=60, env=env)
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("no display", r.stderr)
+
     def test_grab_stores_the_frames_and_captures_finds_them(self):
         out = os.path.join(self.dir, "grab")
         capture = json.loads(self.ok("grab", "--side", "both", "--session", "cli-1",
