@@ -271,14 +271,16 @@ TEST_F(Pipeline, AReplicaKilledMidCallLosesNoCapture) {
   auto r1 = v1::Processing::NewStub(
       grpc::CreateChannel(first->target(), grpc::InsecureChannelCredentials()));
   bool busy = false;
-  const auto until = std::chrono::steady_clock::now() + seconds(120);
+  v1::ServerInfo info;
+  grpc::Status asked;
+  const auto until = std::chrono::steady_clock::now() + seconds(300);
   while (!busy && std::chrono::steady_clock::now() < until) {
-    v1::ServerInfo info;
-    busy = r1->GetServerInfo(Deadline(milliseconds(2000)).get(), {}, &info).ok() &&
-           info.busy() > 0;
+    asked = r1->GetServerInfo(Deadline(milliseconds(2000)).get(), {}, &info);
+    busy = asked.ok() && info.busy() > 0;
     if (!busy) std::this_thread::sleep_for(milliseconds(5));
   }
-  ASSERT_TRUE(busy) << "r1 never got work";
+  ASSERT_TRUE(busy) << "r1 never got work: " << asked.error_message() << " "
+                    << info.ShortDebugString() << "\n" << daemon_->Log();
   first->Kill();
   for (const std::string& id : ids) {
     const v1::CaptureInfo done = WaitProcessed(id);

@@ -66,12 +66,12 @@ TEST_F(ProcessdServer, TcpServesOnlyMutualTlsClientsOfItsCa) {
   ASSERT_TRUE(pki.ok() && rogue.ok());
   Config config;
   config.listen.unix_socket = "";
-  config.listen.tcp = "localhost:0";
+  config.listen.tcp = "127.0.0.1:0";
   config.listen.tls_certificate = server_files.certificate;
   config.listen.tls_key = server_files.key;
   config.listen.tls_client_ca = pki.ca();
   auto server = Server::Start(config, "test");
-  const std::string target = "localhost:" + std::to_string(server->tcp_port());
+  const std::string target = "127.0.0.1:" + std::to_string(server->tcp_port());
 
   processing::ClientOptions good;
   good.target = target;
