@@ -2,7 +2,10 @@
 // framestore hands every acknowledged grab to a real bsls-processd and keeps
 // what comes back beside the capture as a sealed record; the queue survives
 // an absent service and a restart of the daemon.
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -13,6 +16,7 @@
 #include "bsls/testing/calibration_sessions.h"
 #include "bsls/v1/processing.grpc.pb.h"
 #include "daemon_process.h"
+#include "processd_process.h"
 
 namespace bsls::testing {
 namespace {
@@ -20,72 +24,29 @@ namespace {
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 
-// bsls-processd on a Unix socket in `dir` (or, with `tcp`, on a loopback
-// port it reports); stopped when it goes out of scope.
-class ProcessdProcess {
- public:
-  explicit ProcessdProcess(const fs::path& dir, bool tcp = false, const std::string& name = "p")
-      : socket_(dir / (name + ".sock")) {
-    std::vector<std::string> argv = {BSLS_PROCESSD_PATH, "--workers", "1", "--replica", name,
-                                     "--set", "scratch_dir=" + dir.string()};
-    if (tcp) {
-      for (const char* a : {"--socket", "", "--tcp", "127.0.0.1:0", "--set",
-                            "listen.plaintext_loopback=true"})
-        argv.push_back(a);
-    } else {
-      argv.insert(argv.end(), {"--socket", socket_.string()});
-    }
-    const std::string log = (dir / (name + ".log")).string();
-    int out[2];
-    if (::pipe(out) != 0) return;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      ::dup2(out[1], 1);
-      ::dup2(fd, 2);
-      ::close(out[0]);
-      std::vector<char*> raw;
-      for (std::string& a : argv) raw.push_back(a.data());
-      raw.push_back(nullptr);
-      ::execv(raw[0], raw.data());
-      ::_exit(127);
-    }
-    ::close(out[1]);
-    if (tcp) {
-      // "tcp_port=N" once it serves.
-      std::string line;
-      char c;
-      while (::read(out[0], &c, 1) == 1 && c != '\n') line += c;
-      if (line.rfind("tcp_port=", 0) == 0) port_ = std::stoi(line.substr(9));
-    } else {
-      for (int i = 0; i < 400 && !fs::exists(socket_); ++i)
-        std::this_thread::sleep_for(milliseconds(25));
-    }
-    ::close(out[0]);
-  }
-  ~ProcessdProcess() {
-    if (pid_ <= 0) return;
-    ::kill(pid_, SIGTERM);
-    int status = 0;
-    ::waitpid(pid_, &status, 0);
-  }
-  // SIGKILL now (a replica dying mid-call).
-  void Kill() {
-    ::kill(pid_, SIGKILL);
-    int status = 0;
-    ::waitpid(pid_, &status, 0);
-    pid_ = -1;
-  }
-  std::string target() const {
-    return port_ ? "127.0.0.1:" + std::to_string(port_) : "unix:" + socket_.string();
-  }
-  bool ready() const { return port_ > 0 || fs::exists(socket_); }
+using processing::test::ProcessdProcess;
 
- private:
-  fs::path socket_;
-  pid_t pid_ = -1;
-  int port_ = 0;
-};
+// A replica of bsls-processd in `dir` on loopback TCP (`tcp`: where).
+std::unique_ptr<ProcessdProcess> StartReplica(const fs::path& dir, const std::string& name,
+                                              const std::string& tcp = "127.0.0.1:0") {
+  return std::make_unique<ProcessdProcess>(
+      BSLS_PROCESSD_PATH, dir, name, 1,
+      std::vector<std::string>{"--set", "scratch_dir=" + dir.string()},
+      std::chrono::seconds(120), tcp);
+}
+
+// A loopback TCP port nothing listens on right now.
+int FreePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t size = sizeof address;
+  ::bind(fd, reinterpret_cast<sockaddr*>(&address), size);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
+  ::close(fd);
+  return ntohs(address.sin_port);
+}
 
 class Pipeline : public ::testing::Test {
  protected:
@@ -163,9 +124,9 @@ class Pipeline : public ::testing::Test {
 };
 
 TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
-  ProcessdProcess processd(dir_);
-  ASSERT_TRUE(processd.ready());
-  StartDaemon(processd.target());
+  const auto processd = StartReplica(dir_, "p");
+  ASSERT_TRUE(processd->ready()) << processd->Log();
+  StartDaemon(processd->address());
   // Someone watching hears of the result.
   grpc::ClientContext watch;
   auto events = daemon_->Stub()->WatchEvents(&watch, {});
@@ -229,7 +190,7 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
 }
 
 TEST_F(Pipeline, CapturesWaitThroughAnOutageAndARestartOfTheDaemon) {
-  const std::string target = "unix:" + (dir_ / "p.sock").string();
+  const std::string target = "127.0.0.1:" + std::to_string(FreePort());
   StartDaemon(target);  // nobody listens there yet
   const std::string first = Grab(v1::GRAB_SIDE_BOTH);
   const std::string second = Grab(v1::GRAB_SIDE_BOTH);
@@ -250,8 +211,8 @@ TEST_F(Pipeline, CapturesWaitThroughAnOutageAndARestartOfTheDaemon) {
   EXPECT_EQ(Get(second).processing().state(), v1::ProcessingStatus::STATE_PENDING);
 
   // The service comes: both are processed, oldest first.
-  ProcessdProcess processd(dir_);
-  ASSERT_TRUE(processd.ready());
+  const auto processd = StartReplica(dir_, "p", target);
+  ASSERT_TRUE(processd->ready()) << processd->Log();
   for (const std::string& id : {first, second}) {
     const v1::CaptureInfo done = WaitProcessed(id);
     EXPECT_EQ(done.processing().state(), v1::ProcessingStatus::STATE_DONE)
@@ -261,15 +222,15 @@ TEST_F(Pipeline, CapturesWaitThroughAnOutageAndARestartOfTheDaemon) {
 
 TEST_F(Pipeline, AReplicaKilledMidCallLosesNoCapture) {
   // Two replicas behind one round_robin address list.
-  auto first = std::make_unique<ProcessdProcess>(dir_, true, "r1");
-  ProcessdProcess second(dir_, true, "r2");
-  ASSERT_TRUE(first->ready() && second.ready());
-  StartDaemon("ipv4:" + first->target() + "," + second.target());
+  auto first = StartReplica(dir_, "r1");
+  const auto second = StartReplica(dir_, "r2");
+  ASSERT_TRUE(first->ready() && second->ready()) << first->Log() << second->Log();
+  StartDaemon("ipv4:" + first->address() + "," + second->address());
   std::vector<std::string> ids;
   for (int i = 0; i < 4; ++i) ids.push_back(Grab(v1::GRAB_SIDE_BOTH));
   // Kill r1 while it works on one of them.
   auto r1 = v1::Processing::NewStub(
-      grpc::CreateChannel(first->target(), grpc::InsecureChannelCredentials()));
+      grpc::CreateChannel(first->address(), grpc::InsecureChannelCredentials()));
   bool busy = false;
   v1::ServerInfo info;
   grpc::Status asked;

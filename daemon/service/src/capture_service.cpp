@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <tuple>
 
 #include "bsls/rpc/artifacts.h"
 #include "bsls/store/sha256.h"
@@ -450,6 +451,15 @@ grpc::Status CaptureService::ListCaptures(grpc::ServerContext* context,
   store::CaptureFilter filter;
   if (!request->session_id().empty()) filter.session_id = request->session_id();
   if (!request->patient_reference().empty()) filter.patient_reference = request->patient_reference();
+  // Times the store can hold: nanoseconds since 1970 in 64 bits (until 2262).
+  for (const auto& [field, has, t] :
+       {std::tuple{"taken_from", request->has_taken_from(), &request->taken_from()},
+        std::tuple{"taken_before", request->has_taken_before(), &request->taken_before()}})
+    if (has && (t->seconds() < 0 || t->seconds() > 9'000'000'000LL || t->nanos() < 0 ||
+                t->nanos() > 999'999'999))
+      return Invalid(std::string(field) + ": seconds " + std::to_string(t->seconds()) +
+                     ", nanos " + std::to_string(t->nanos()) +
+                     " is not a time between 1970 and 2255");
   if (request->has_taken_from()) filter.taken_from = FromProto(request->taken_from());
   if (request->has_taken_before()) filter.taken_before = FromProto(request->taken_before());
   filter.page_size = request->page_size();

@@ -432,9 +432,27 @@ geometry::SurfaceMesh DecodePly(std::string_view bytes, const std::string& name)
         mesh.positions[v] = {values[ix], values[iy], values[iz]};
         if (!mesh.positions[v].allFinite()) body.Fail("non-finite position in " + what);
         if (normals) mesh.normals[v] = {values[inx], values[iny], values[inz]};
-        if (isig >= 0) mesh.uncertainty_mm[v] = static_cast<float>(values[isig]);
-        if (iline >= 0) mesh.line[v] = static_cast<std::int32_t>(values[iline]);
-        if (iflags >= 0) mesh.flags[v] = static_cast<std::uint8_t>(values[iflags]);
+        // Values the types below cannot hold are input errors, never casts.
+        if (isig >= 0) {
+          const double sigma = values[isig];
+          if (!(sigma >= 0.0 && sigma <= std::numeric_limits<float>::max()))
+            body.Fail("uncertainty_mm is not a finite value >= 0 in " + what);
+          mesh.uncertainty_mm[v] = static_cast<float>(sigma);
+        }
+        if (iline >= 0) {
+          const double line = values[iline];
+          if (!(line >= std::numeric_limits<std::int32_t>::min() &&
+                line <= std::numeric_limits<std::int32_t>::max()) ||
+              line != std::floor(line))
+            body.Fail("line is not a 32-bit integer in " + what);
+          mesh.line[v] = static_cast<std::int32_t>(line);
+        }
+        if (iflags >= 0) {
+          const double flags = values[iflags];
+          if (!(flags >= 0.0 && flags <= 255.0) || flags != std::floor(flags))
+            body.Fail("flags is not a byte in " + what);
+          mesh.flags[v] = static_cast<std::uint8_t>(flags);
+        }
       }
     } else if (e.name == "face") {
       int index_list = -1;

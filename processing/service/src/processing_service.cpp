@@ -1,6 +1,8 @@
 #include "bsls/processing/processing_service.h"
 
 #include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+#include <malloc.h>
 #include <stdlib.h>
 
 #include <algorithm>
@@ -208,6 +210,37 @@ std::string PackedSha256(const cv::Mat& grey) {
       std::string_view(reinterpret_cast<const char*>(packed.data), packed.total()));
 }
 
+// Refuses a manifest whose `image:` entries (at any depth) are not relative
+// paths inside its folder; a manifest that is not YAML is left to LoadManifest.
+void ConfineManifestImages(const std::string& yaml) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml);
+  } catch (const YAML::Exception&) {
+    return;
+  }
+  std::function<void(const YAML::Node&)> visit = [&](const YAML::Node& node) {
+    if (node.IsMap()) {
+      for (const auto& item : node) {
+        if (item.first.IsScalar() && item.first.Scalar() == "image" && item.second.IsScalar()) {
+          const fs::path image(item.second.Scalar());
+          bool inside = !image.empty() && image.is_relative();
+          for (const fs::path& part : image) inside = inside && part != "..";
+          if (!inside)
+            Refuse(StatusCode::INVALID_ARGUMENT,
+                   "manifest: image " + item.second.Scalar().substr(0, 256) +
+                       " is not one of the uploaded files (paths must stay inside the "
+                       "manifest's folder)");
+        }
+        visit(item.second);
+      }
+    } else if (node.IsSequence()) {
+      for (const auto& item : node) visit(item);
+    }
+  };
+  visit(root);
+}
+
 }  // namespace
 
 std::shared_ptr<const CachedCalibration> ProcessingService::ResolveCalibration(
@@ -265,6 +298,15 @@ Status ProcessingService::RunWork(grpc::ServerContext* context, const std::strin
                                   const std::function<void(Work&)>& work) {
   if (draining_) return Status(StatusCode::UNAVAILABLE, "the service is shutting down");
   std::optional<WorkPool::Ticket> ticket = pool_.TryAdmit();
+  // What an admitted call allocated goes back to the system when it ends
+  // (glibc keeps freed blocks otherwise; a burst of calls would leave the
+  // replica large).
+  struct TrimOnExit {
+    bool admitted;
+    ~TrimOnExit() {
+      if (admitted) ::malloc_trim(0);
+    }
+  } trim{ticket.has_value()};
   if (!ticket) {
     const WorkPoolStats s = pool_.Stats();
     return Status(StatusCode::RESOURCE_EXHAUSTED,
@@ -542,9 +584,14 @@ Status ProcessingService::Calibrate(
         if (static_cast<int>(complete.size()) >= options_.max_upload_files)
           Refuse(StatusCode::INVALID_ARGUMENT,
                  name + ": more than " + std::to_string(options_.max_upload_files) + " files");
-        fs::create_directories(folder.path() / path.parent_path());
-        out.open(folder.path() / path, std::ios::binary | std::ios::trunc);
-        if (!out) Refuse(StatusCode::INTERNAL, name + ": cannot be written to the scratch folder");
+        // A path whose folder is an uploaded file, or a file named like an
+        // uploaded folder, cannot be made: the upload contradicts itself.
+        std::error_code ec;
+        fs::create_directories(folder.path() / path.parent_path(), ec);
+        if (!ec) out.open(folder.path() / path, std::ios::binary | std::ios::trunc);
+        if (ec || !out)
+          Refuse(StatusCode::INVALID_ARGUMENT,
+                 name + ": clashes with another uploaded path (a file and a folder of one name)");
         open_path = path;
       }
       if (chunk.offset() != sizes[path])
@@ -577,6 +624,9 @@ Status ProcessingService::Calibrate(
       for (size_t at; (at = text.find(prefix)) != std::string::npos;) text.erase(at, prefix.size());
       return text;
     };
+    // Image paths are checked before the manifest is read: reading it asks
+    // whether each image exists, which must not be asked of the server's disk.
+    ConfineManifestImages(first.manifest().yaml());
     calibration::Manifest manifest;
     try {
       manifest = calibration::LoadManifest(folder.path() / "manifest.yaml");
