@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <thread>
 
 #include "bsls/rpc/tls.h"
 
@@ -72,8 +73,17 @@ void Server::Drain() {
   drained_ = true;
   if (service_) service_->BeginDrain();
   if (server_) {
-    server_->Shutdown(std::chrono::system_clock::now() +
-                      std::chrono::milliseconds(config_.drain_timeout_ms));
+    // Work under way stops at its next stage; wait for that (at most the
+    // drain timeout), then shut down at once: gRPC's own deadline would also
+    // wait for idle client connections (a daemon's channel) to go away.
+    const auto until = std::chrono::steady_clock::now() +
+                       std::chrono::milliseconds(config_.drain_timeout_ms);
+    while (std::chrono::steady_clock::now() < until) {
+      const processing::WorkPoolStats s = service_->Stats();
+      if (s.busy == 0 && s.waiting == 0) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    server_->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(100));
     server_->Wait();
   }
   if (!config_.listen.unix_socket.empty()) {
