@@ -20,6 +20,7 @@
 #include <thread>
 #include <vector>
 
+#include "bsls/testing/spawn.h"
 #include "bsls/v1/capture.grpc.pb.h"
 
 namespace bsls::testing {
@@ -62,18 +63,7 @@ class DaemonProcess {
       : dir_(dir), socket_(dir / "bslsd.sock") {
     std::vector<std::string> argv = {BSLSD_PATH, "--config", config.string()};
     argv.insert(argv.end(), args.begin(), args.end());
-    const std::string log = (dir / "bslsd.log").string();
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int fd = ::open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      std::vector<char*> raw;
-      for (std::string& a : argv) raw.push_back(a.data());
-      raw.push_back(nullptr);
-      ::execv(raw[0], raw.data());
-      ::_exit(127);
-    }
+    pid_ = SpawnLogged(std::move(argv), (dir / "bslsd.log").string());
     const auto until = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < until && !exited()) {
       if (fs::exists(socket_)) {

@@ -24,6 +24,8 @@
 #include <thread>
 #include <vector>
 
+#include "bsls/testing/spawn.h"
+
 namespace bsls::processing::test {
 
 namespace fs = std::filesystem;
@@ -107,17 +109,7 @@ class ProcessdProcess {
                                      "--set",
                                      "listen.plaintext_loopback=true"};
     argv.insert(argv.end(), extra.begin(), extra.end());
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      ::dup2(fd, 1);
-      ::dup2(fd, 2);
-      std::vector<char*> raw;
-      for (std::string& a : argv) raw.push_back(a.data());
-      raw.push_back(nullptr);
-      ::execv(raw[0], raw.data());
-      ::_exit(127);
-    }
+    pid_ = bsls::testing::SpawnLogged(std::move(argv), log_.string(), /*truncate=*/true);
     const auto until = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < until && !exited()) {
       const std::string text = Log();

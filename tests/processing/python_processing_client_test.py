@@ -35,7 +35,7 @@ except ImportError:
 from bsls_client import ProcessingClient, ProcessingError, WorkResult, calibration_id
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "support"))
-from bslsd_harness import free_port, make_pki  # noqa: E402
+from bslsd_harness import ServiceProcess, free_port, make_pki  # noqa: E402
 
 PROCESSD = os.environ.get("BSLS_PROCESSD")
 BSLS = os.environ.get("BSLS")
@@ -104,7 +104,7 @@ def run_bsls(*args):
     return r
 
 
-class Processd:
+class Processd(ServiceProcess):
     """A running bsls-processd: `args` are its options after the common ones."""
 
     def __init__(self, folder, replica, *args, socket_path=None, tcp=False):
@@ -125,16 +125,6 @@ class Processd:
                 self.port = int(ports[0].split("=")[1])
             time.sleep(0.05)
 
-    def log(self):
-        with open(self._log.name) as f:
-            return f.read()
-
-    def stop(self):
-        """SIGTERM; the exit code (0 when it drained cleanly)."""
-        self.process.terminate()
-        code = self.process.wait(60)
-        self._log.close()
-        return code
 
 
 class ProcessingClientTest(unittest.TestCase):

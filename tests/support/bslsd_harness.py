@@ -55,7 +55,24 @@ def answers(socket):
         return False
 
 
-class Bslsd:
+class ServiceProcess:
+    """A service started by a test with its output in `self._log` (an open
+    file) and its process in `self.process`: what it wrote, and SIGTERM."""
+
+    def log(self):
+        """What the service wrote so far."""
+        with open(self._log.name) as f:
+            return f.read()
+
+    def stop(self):
+        """SIGTERM; the exit code (0 when it drained cleanly)."""
+        self.process.terminate()
+        code = self.process.wait(60)
+        self._log.close()
+        return code
+
+
+class Bslsd(ServiceProcess):
     """A running bslsd in a fresh temporary folder: `socket`, `port`, `pki(name)`.
 
     `roles` is the YAML under `roles:` (two-space indented lines);
@@ -89,14 +106,3 @@ class Bslsd:
                 raise RuntimeError("bslsd did not start: " + self.log())
             time.sleep(0.1)
 
-    def log(self):
-        """What the daemon wrote so far."""
-        with open(os.path.join(self.dir, "bslsd.log")) as f:
-            return f.read()
-
-    def stop(self):
-        """SIGTERM; the exit code (0 when it drained cleanly)."""
-        self.process.terminate()
-        code = self.process.wait(60)
-        self._log.close()
-        return code
