@@ -2,6 +2,7 @@
 // session manifest (contracts section 4) and write its calibration file.
 #include <cstdio>
 #include <filesystem>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -21,6 +22,7 @@ struct CalibrateOptions {
   std::string output;
   std::string report;
   bool quiet = false;
+  bool json = false;      // the report on stdout instead of the summary
   ServiceAddress server;  // target empty: calibrated here
 };
 
@@ -57,6 +59,13 @@ void RunCalibrateRemote(const CalibrateOptions& o) {
   const nlohmann::json report = nlohmann::json::parse(out.files.at("calibration-report.json"));
   if (!o.report.empty()) io::WriteFileAtomically(o.report, out.files.at("calibration-report.json"));
   io::WriteFileAtomically(o.output, out.files.at("calibration.yaml"));
+  if (o.json) {
+    nlohmann::json summary = report;
+    summary["calibration_id"] = out.result.calibration_id();
+    summary["replica"] = out.result.replica();
+    std::cout << summary.dump() << "\n";
+    return;
+  }
   std::printf("%s: %s side, %d x %d px, id %s (calibrated by %s)\n", o.output.c_str(),
               report.at("side").get<std::string>().c_str(), report.at("width").get<int>(),
               report.at("height").get<int>(), out.result.calibration_id().c_str(),
@@ -100,6 +109,10 @@ void RunCalibrate(const CalibrateOptions& o) {
   const std::string report = calibration::CalibrationReport(result).dump(1) + "\n";
   if (!o.report.empty()) io::WriteFileAtomically(o.report, report);
   io::WriteFileAtomically(o.output, yaml);
+  if (o.json) {
+    std::cout << calibration::CalibrationReport(result).dump() << "\n";
+    return;
+  }
 
   const auto& cr = result.camera.report;
   std::printf("%s: %s side, %d x %d px, %zu camera, %zu screen, %zu cross views\n",
@@ -139,6 +152,7 @@ void AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", opts->output, "Output calibration file (YAML)")->required();
   cmd->add_option("--report", opts->report, "Also write the figures as JSON");
   cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
+  cmd->add_flag("--json", opts->json, "Print the figures as one JSON object instead of the summary");
   AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunCalibrate(*opts); });
 }

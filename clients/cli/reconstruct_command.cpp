@@ -37,6 +37,7 @@ struct ReconstructOptions {
   bool smooth = false;
   bool ascii = false;
   bool quiet = false;
+  bool json = false;      // the report on stdout instead of the summary
   ServiceAddress server;  // target empty: the work is done here
 };
 
@@ -115,7 +116,10 @@ void RunReconstructRemote(const ReconstructOptions& o) {
   if (!o.right_surface.empty()) write(o.right_surface, "right.ply");
   if (!o.report.empty()) io::WriteFileAtomically(o.report, report.dump(2) + "\n");
   write(o.output, "surface.ply");
-  PrintSessionSummary(report, o.output);
+  if (o.json)
+    std::cout << report.dump() << "\n";
+  else
+    PrintSessionSummary(report, o.output);
 }
 
 void RunReconstruct(const ReconstructOptions& o) {
@@ -162,7 +166,10 @@ void RunReconstruct(const ReconstructOptions& o) {
   if (!o.right_surface.empty()) io::WriteSurface(o.right_surface, *s.right.surface, encoding);
   if (!o.report.empty()) io::WriteFileAtomically(o.report, report.dump(2) + "\n");
   io::WriteSurface(o.output, s.joined.mesh, encoding);
-  PrintSessionSummary(report, o.output);
+  if (o.json)
+    std::cout << report.dump() << "\n";
+  else
+    PrintSessionSummary(report, o.output);
 }
 
 }  // namespace
@@ -193,6 +200,7 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_flag("--smooth", opts->smooth, "Smooth along each line (thesis eq. 5.32) first");
   cmd->add_flag("--ascii", opts->ascii, "Write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
+  cmd->add_flag("--json", opts->json, "Print the report as one JSON object instead of the summary");
   AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunReconstruct(*opts); });
 }

@@ -563,6 +563,9 @@ class SurfaceCliTest(unittest.TestCase):
         r = self.reconstruct(out, "--report", report, "--server", server)
         self.assertEqual(r.returncode, EXIT_OK, r.stderr)
         self.assertIn("shared world frame", r.stdout)
+        j = self.reconstruct(self.path("remote_face2.ply"), "--json", "-q", "--server", server)
+        self.assertEqual(j.returncode, EXIT_OK, j.stderr)
+        self.assertEqual(json.loads(j.stdout)["join"]["method"], "shared-frame")
         self.assertIn("%", r.stderr)  # progress
         with open(report) as f:
             rep = json.load(f)
@@ -579,6 +582,10 @@ class SurfaceCliTest(unittest.TestCase):
                 "--report", report, "--server", server, "-q")
         self.assertEqual(r.returncode, EXIT_OK, r.stderr)
         self.assertIn("id sha256:", r.stdout)
+        r = run("calibrate", os.path.join(self.dir.name, "left", "session.yaml"),
+                "-o", self.path("remote_left2.yaml"), "--server", server, "-q", "--json")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertTrue(json.loads(r.stdout)["calibration_id"].startswith("sha256:"))
         with open(out) as f:
             self.assertIn("format: bsls-calibration\n", f.read())
         with open(report) as f:
