@@ -23,7 +23,15 @@ nlohmann::json PolygonJson(const Polygon2d& polygon) {
   return points;
 }
 
-bool Finite(const Eigen::Vector2d& p) { return std::isfinite(p.x()) && std::isfinite(p.y()); }
+// A point of the world plane a face can be measured at: finite and within a
+// kilometre of the origin (anything further is a typing error, and would
+// overflow the surface's cell grid).
+constexpr const char* kNotOnThePlane = "not a finite point within 1 km of the origin";
+
+bool Finite(const Eigen::Vector2d& p) {
+  return std::isfinite(p.x()) && std::isfinite(p.y()) && std::abs(p.x()) <= 1e6 &&
+         std::abs(p.y()) <= 1e6;
+}
 
 }  // namespace
 
@@ -37,10 +45,11 @@ bool MeasurementPlan::IsValid(std::string* error) const {
     return false;
   };
   for (size_t i = 0; i < heights.size(); ++i)
-    if (!Finite(heights[i])) return fail("height " + std::to_string(i + 1) + ": not a finite point");
+    if (!Finite(heights[i]))
+      return fail("height " + std::to_string(i + 1) + ": " + kNotOnThePlane);
   for (size_t i = 0; i < distances.size(); ++i)
     if (!Finite(distances[i][0]) || !Finite(distances[i][1]))
-      return fail("distance " + std::to_string(i + 1) + ": not finite points");
+      return fail("distance " + std::to_string(i + 1) + ": " + kNotOnThePlane);
   for (const auto* regions : {&areas, &lesions}) {
     const char* kind = regions == &areas ? "area " : "lesion ";
     for (size_t i = 0; i < regions->size(); ++i) {
@@ -48,12 +57,13 @@ bool MeasurementPlan::IsValid(std::string* error) const {
       if (region.size() < 3)
         return fail(kind + std::to_string(i + 1) + ": a region needs at least 3 points");
       for (const Eigen::Vector2d& p : region)
-        if (!Finite(p)) return fail(kind + std::to_string(i + 1) + ": not finite points");
+        if (!Finite(p)) return fail(kind + std::to_string(i + 1) + ": " + kNotOnThePlane);
     }
   }
   if (baseline && lesions.empty()) return fail("a baseline is the reference of lesions: give one");
   std::string why;
   if (!lesion.IsValid(&why)) return fail("lesion parameters: " + why);
+  if (lesion.ring_width_mm > 1000.0) return fail("lesion parameters: a ring wider than 1 m");
   return true;
 }
 

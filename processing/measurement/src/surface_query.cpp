@@ -58,11 +58,12 @@ SurfaceQuery::SurfaceQuery(const geometry::SurfaceMesh& mesh, double cell_mm) : 
 std::vector<int> SurfaceQuery::FacesIn(const Eigen::AlignedBox2d& box) const {
   std::vector<int> faces;
   if (!box.intersects(bounds_)) return faces;
+  // Clamped as doubles first: a box far outside (or huge) must not overflow the cast.
   auto clampx = [&](double v) {
-    return std::clamp(static_cast<int>((v - bounds_.min().x()) / cell_mm_), 0, nx_ - 1);
+    return static_cast<int>(std::clamp((v - bounds_.min().x()) / cell_mm_, 0.0, nx_ - 1.0));
   };
   auto clampy = [&](double v) {
-    return std::clamp(static_cast<int>((v - bounds_.min().y()) / cell_mm_), 0, ny_ - 1);
+    return static_cast<int>(std::clamp((v - bounds_.min().y()) / cell_mm_, 0.0, ny_ - 1.0));
   };
   const int x0 = clampx(box.min().x()), x1 = clampx(box.max().x());
   const int y0 = clampy(box.min().y()), y1 = clampy(box.max().y());
