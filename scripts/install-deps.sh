@@ -22,7 +22,7 @@ packages=(
   libcap-dev                        # dropping capabilities
   libsystemd-dev                    # sd_notify, watchdog
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
-  python3-grpcio python3-protobuf python3-grpc-tools python3-numpy
+  python3-grpcio python3-protobuf python3-grpc-tools python3-numpy python3-yaml
   systemd                           # systemd-analyze security in the tests
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev
