@@ -53,7 +53,7 @@ inline fs::path WriteDaemonConfig(const fs::path& dir, const std::string& extra 
   return path;
 }
 
-class DaemonProcess {
+class DaemonProcess : public ChildProcess {
  public:
   // Starts bslsd with `config` and extra arguments; stdout and stderr go to
   // <dir>/bslsd.log. Returns once the socket answers GetStatus (or after
@@ -63,7 +63,7 @@ class DaemonProcess {
       : dir_(dir), socket_(dir / "bslsd.sock") {
     std::vector<std::string> argv = {BSLSD_PATH, "--config", config.string()};
     argv.insert(argv.end(), args.begin(), args.end());
-    pid_ = SpawnLogged(std::move(argv), (dir / "bslsd.log").string());
+    Spawn(std::move(argv), (dir / "bslsd.log").string());
     const auto until = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < until && !exited()) {
       if (fs::exists(socket_)) {
@@ -80,11 +80,10 @@ class DaemonProcess {
     }
   }
   ~DaemonProcess() {
-    if (pid_ > 0 && !exited()) Kill();
+    if (pid() > 0 && !exited()) Kill();
   }
 
   bool ready() const { return ready_; }
-  pid_t pid() const { return pid_; }
   const fs::path& socket() const { return socket_; }
   // The daemon's log so far (for failure messages).
   std::string Log() const {
@@ -100,38 +99,14 @@ class DaemonProcess {
 
   // SIGTERM, then waits up to `timeout`: the exit status (-1 if it did not exit).
   int Terminate(std::chrono::seconds timeout = std::chrono::seconds(60)) {
-    ::kill(pid_, SIGTERM);
+    ::kill(pid(), SIGTERM);
     return Wait(timeout);
-  }
-  // SIGKILL and reap.
-  void Kill() {
-    ::kill(pid_, SIGKILL);
-    Wait(std::chrono::seconds(30));
-  }
-  // The exit code once the process ended (-1 while it runs or if killed).
-  int Wait(std::chrono::seconds timeout) {
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    while (!exited() && std::chrono::steady_clock::now() < until)
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    return exit_code_;
-  }
-  bool exited() {
-    if (reaped_) return true;
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      reaped_ = true;
-      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    }
-    return reaped_;
   }
 
  private:
   fs::path dir_;
   fs::path socket_;
-  pid_t pid_ = -1;
   bool ready_ = false;
-  bool reaped_ = false;
-  int exit_code_ = -1;
 };
 
 // A client context with a deadline (our clients always set one).

@@ -87,7 +87,7 @@ inline double CpuSeconds(pid_t pid) {
 // loopback TCP, `--workers`, `--replica`, plus `extra` arguments. Its stdout
 // and stderr go to <folder>/<replica>.log (a file, never a pipe that could
 // fill up and stall the replica).
-class ProcessdProcess {
+class ProcessdProcess : public bsls::testing::ChildProcess {
  public:
   // Starts the replica and returns once it printed its port (ready() true) or
   // after `timeout` / its early exit (ready() false; Log() says why).
@@ -109,7 +109,7 @@ class ProcessdProcess {
                                      "--set",
                                      "listen.plaintext_loopback=true"};
     argv.insert(argv.end(), extra.begin(), extra.end());
-    pid_ = bsls::testing::SpawnLogged(std::move(argv), log_.string(), /*truncate=*/true);
+    Spawn(std::move(argv), log_.string(), /*truncate=*/true);
     const auto until = std::chrono::steady_clock::now() + timeout;
     while (std::chrono::steady_clock::now() < until && !exited()) {
       const std::string text = Log();
@@ -123,7 +123,7 @@ class ProcessdProcess {
   }
   // Kills the replica if it still runs.
   ~ProcessdProcess() {
-    if (pid_ > 0 && !exited()) Kill();
+    if (pid() > 0 && !exited()) Kill();
   }
   ProcessdProcess(const ProcessdProcess&) = delete;
   ProcessdProcess& operator=(const ProcessdProcess&) = delete;
@@ -132,8 +132,6 @@ class ProcessdProcess {
   bool ready() const { return port_ > 0; }
   // The TCP port it serves (0 until ready).
   int port() const { return port_; }
-  // The process id (for signals and /proc).
-  pid_t pid() const { return pid_; }
   // The replica name it puts in its Results.
   const std::string& name() const { return name_; }
   // "127.0.0.1:PORT", for a target list.
@@ -141,49 +139,19 @@ class ProcessdProcess {
   // What the replica wrote so far.
   std::string Log() const { return ReadWholeFile(log_); }
 
-  // SIGKILL, then reaps the process.
-  void Kill() {
-    ::kill(pid_, SIGKILL);
-    Wait(std::chrono::seconds(30));
-  }
   // SIGTERM (drain), then waits: the exit code, or -1 if it did not exit in
   // time or died of a signal (then it is killed).
   int Terminate(std::chrono::seconds timeout = std::chrono::seconds(60)) {
-    if (!exited()) ::kill(pid_, SIGTERM);
+    if (!exited()) ::kill(pid(), SIGTERM);
     const int code = Wait(timeout);
     if (!exited()) Kill();
     return code;
   }
-  // Waits up to `timeout` for the exit: its code (-1 while it runs or when
-  // a signal ended it).
-  int Wait(std::chrono::seconds timeout) {
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    while (!exited() && std::chrono::steady_clock::now() < until)
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    return exit_code_;
-  }
-  // True once the process ended (it is reaped here).
-  bool exited() {
-    if (reaped_) return true;
-    int status = 0;
-    if (::waitpid(pid_, &status, WNOHANG) == pid_) {
-      reaped_ = true;
-      exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-      signal_ = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
-    }
-    return reaped_;
-  }
-  // The signal that ended the process (0: none or still running).
-  int signal() const { return signal_; }
 
  private:
   std::string name_;
   fs::path log_;
-  pid_t pid_ = -1;
   int port_ = 0;
-  bool reaped_ = false;
-  int exit_code_ = -1;
-  int signal_ = 0;
 };
 
 // "ipv4:127.0.0.1:p1,127.0.0.1:p2,..." for round_robin over `replicas`.
