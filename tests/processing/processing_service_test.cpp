@@ -316,8 +316,13 @@ TEST(ProcessingService, AFullPoolRefusesAtOnce) {
     held.Close();
   }
   // The place is free again.
-  for (int i = 0; i < 50 && s.service().Stats().waiting != 0; ++i)
+  // The server sees the cancellation on its own thread: wait until the
+  // held place (queued or holding the worker) has been given back.
+  for (int i = 0; i < 250; ++i) {
+    const auto stats = s.service().Stats();
+    if (stats.waiting == 0 && stats.busy == 0) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
   EXPECT_TRUE(s.Client().ProcessFrame(FaceRequest(pattern::Side::kLeft, false)).status.ok());
 }
 
