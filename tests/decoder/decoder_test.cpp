@@ -75,8 +75,8 @@ class TestObjects : public ::testing::TestWithParam<SceneCase> {};
 
 // Planes, ramp and ball: every junction, no wrong label. The truth counts a
 // junction at the image edge only when none of its strokes is cut lengthwise
-// by the edge (docs/decoding.md); plane and ball are then found whole, the
-// ramp misses two corners on the top and bottom rows (99.7 %).
+// by the edge (docs/decoding.md). The ramp's junctions on the top and bottom
+// rows are Ts that the edge cut into corners (5.2.3.3 at the frame's edge).
 TEST_P(TestObjects, EveryJunctionRightlyLabelled) {
   const SceneCase c = GetParam();
   const simulator::Frame frame = RenderFrame(c.kind, c.side, 7);
@@ -85,8 +85,7 @@ TEST_P(TestObjects, EveryJunctionRightlyLabelled) {
   const Evaluation e = Evaluate(frame, r);
   EXPECT_EQ(e.inner.found, e.inner.truth) << Name(c) << ": " << e.inner.Summary();
   EXPECT_EQ(e.all.Wrong(), 0) << Name(c) << ": " << e.all.Summary();
-  EXPECT_GE(e.all.Recall(), 0.995) << Name(c) << ": " << e.all.Summary();
-  if (c.kind != SurfaceKind::kRamp) EXPECT_EQ(e.all.found, e.all.truth) << e.all.Summary();
+  EXPECT_EQ(e.all.found, e.all.truth) << Name(c) << ": " << e.all.Summary();
   EXPECT_EQ(e.all.v_offset % 2, 0);
   EXPECT_LE(e.line_rms, 0.1) << Name(c);
   EXPECT_GT(e.line_points, 5000) << Name(c);

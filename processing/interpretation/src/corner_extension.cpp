@@ -47,10 +47,11 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
 
 bool CornerParams::IsValid(std::string* error) const {
   if (leg < 2 || stub < 1 || leg_tolerance_deg <= 0 || leg_tolerance_deg >= 45 ||
-      min_free_segment < 1) {
+      min_free_segment < 1 || min_free_segment_at_edge < 1) {
     if (error)
       *error =
-          "corner params: leg >= 2, stub >= 1, min_free_segment >= 1, tolerance in (0, 45) degrees";
+          "corner params: leg >= 2, stub >= 1, min_free_segment(_at_edge) >= 1, tolerance in (0, "
+          "45) degrees";
     return false;
   }
   return true;
@@ -58,7 +59,8 @@ bool CornerParams::IsValid(std::string* error) const {
 
 // Thesis 5.2.3.3: extending a degree-2 point to degree 3.
 std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerParams& params,
-                                     cv::Mat& skeleton, const cv::Mat& stripe_mask) {
+                                     cv::Mat& skeleton, const cv::Mat& stripe_mask,
+                                     cv::Rect imaged) {
   if (!stripe_mask.empty() &&
       (stripe_mask.type() != CV_8UC1 || stripe_mask.size() != skeleton.size()))
     throw std::invalid_argument(
@@ -68,9 +70,17 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
   // outline; a free end (the partner line too faint to see) counts for a
   // segment long enough not to be a hook, when the mask will vouch for the
   // line going on.
-  auto segment_counts = [&](NodeKind end, int length) {
+  if (imaged.empty()) imaged = cv::Rect(0, 0, skeleton.cols, skeleton.rows);
+  // True when the stub from `corner` along `dir` (from the line into the
+  // corner) leaves the imaged area: the line runs out of the frame there.
+  auto line_leaves_frame = [&](cv::Point corner, cv::Point2d dir) {
+    dir *= params.stub / std::hypot(dir.x, dir.y);
+    return !imaged.contains(cv::Point(cvRound(corner.x + dir.x), cvRound(corner.y + dir.y)));
+  };
+  auto segment_counts = [&](NodeKind end, int length, bool at_edge) {
     return end == NodeKind::kJunction ||
-           (!stripe_mask.empty() && length >= params.min_free_segment);
+           (!stripe_mask.empty() &&
+            length >= (at_edge ? params.min_free_segment_at_edge : params.min_free_segment));
   };
   // A corner may also be a small cluster of pixels (a node with two branches).
   for (const SkeletonNode& node : graph.nodes()) {
@@ -87,8 +97,10 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     else
       continue;
     const int segment = line_dir == d0 ? node.rotation[1] : node.rotation[0];
-    if (!segment_counts(graph.nodes()[graph.Target(segment)].kind, graph.Length(segment))) continue;
     const cv::Point corner(cvRound(node.centre.x), cvRound(node.centre.y));
+    if (!segment_counts(graph.nodes()[graph.Target(segment)].kind, graph.Length(segment),
+                        line_leaves_frame(corner, -line_dir)))
+      continue;
     if (AddStub(corner, -line_dir, node.pixels, params, skeleton, stripe_mask))
       corners.push_back(corner);
   }
@@ -126,16 +138,18 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     }
     // True when the chain, walked from index i in direction step, leaves the
     // horizontal (turns into a line) before it ends, or its end counts.
-    auto segment_ends_on_line = [&](int i, int step) {
+    auto segment_ends_on_line = [&](int i, int step, bool at_edge) {
       for (int k = i + step * params.leg; k >= 0 && k < n; k += step) {
         const cv::Point2d d(px[k] - px[k - step * params.leg]);
         if (LeanFromVerticalDeg(d) < 90 - params.leg_tolerance_deg) return true;
       }
       const int end = step > 0 ? edge.to : edge.from;
-      return segment_counts(graph.nodes()[end].kind, step > 0 ? n - 1 - i : i);
+      return segment_counts(graph.nodes()[end].kind, step > 0 ? n - 1 - i : i, at_edge);
     };
     for (const Corner& c : found) {
-      if (!segment_ends_on_line(c.index, c.segment_after ? 1 : -1)) continue;
+      if (!segment_ends_on_line(c.index, c.segment_after ? 1 : -1,
+                                line_leaves_frame(px[c.index], c.vertical)))
+        continue;
       // A rounded corner passes the leg test a few pixels before its apex:
       // the corner is the pixel farthest from the chord across the bend.
       const int lo = std::max(0, c.index - params.leg), hi = std::min(n - 1, c.index + params.leg);

@@ -124,7 +124,8 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   }
 
   // Thesis 5.2.3.3: corners become junctions with a one-stroke stub.
-  result.corners = ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, mask);
+  result.corners =
+      ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, mask, image);
 
   // Thesis 5.2.3 and 5.1.4: trace boundary and loops, correct, retrace. The
   // graph of the last round is the final one: a round without repairs leaves

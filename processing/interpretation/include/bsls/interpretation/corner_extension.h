@@ -28,6 +28,11 @@ struct CornerParams {
   // a corner when at least this long and the stripe mask shows the line going
   // on; shorter ones are hooks at line ends.
   int min_free_segment = 15;
+  // px: the same for a corner whose line runs out of the imaged area (its
+  // stub would leave the frame): there the corner is a T that the frame's
+  // edge cut, not a hook at a line's end, and the segment along the edge is
+  // often broken (half its profile is outside the frame).
+  int min_free_segment_at_edge = 6;
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;
@@ -38,9 +43,12 @@ struct CornerParams {
 // non-zero = stripe, e.g. the one the skeleton was thinned from), a stub is
 // drawn only where the mask shows the line going on beyond the corner, i.e.
 // where thinning or pruning lost a short stroke; a corner where a line really
-// turns (along the face's outline) is left alone.
+// turns (along the face's outline) is left alone. `imaged` is the part of
+// `skeleton` the camera saw (empty: all of it); beyond it lies a margin that
+// takes the stubs of corners at the frame's edge.
 std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerParams& params,
-                                     cv::Mat& skeleton, const cv::Mat& stripe_mask = cv::Mat());
+                                     cv::Mat& skeleton, const cv::Mat& stripe_mask = cv::Mat(),
+                                     cv::Rect imaged = cv::Rect());
 
 }  // namespace bsls::interpretation
 
