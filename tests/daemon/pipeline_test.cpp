@@ -115,7 +115,9 @@ class Pipeline : public ::testing::Test {
     return files;
   }
   void TearDown() override {
-    if (daemon_ && !daemon_->exited()) EXPECT_EQ(daemon_->Terminate(), 0) << daemon_->Log();
+    if (daemon_ && !daemon_->exited()) {
+      EXPECT_EQ(daemon_->Terminate(), 0) << daemon_->Log();
+    }
   }
 
   fs::path dir_;

@@ -3,8 +3,10 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "bsls/joining/join_error.h"
+#include "bsls/session/both_sides.h"
 #include "bsls/measurement/measurement_error.h"
 
 namespace bsls::session {
@@ -37,6 +39,7 @@ reconstruction::SideOutcome ReconstructOneSide(const cv::Mat& grey, Side side,
                        FrameName(side) + ": no surface was reconstructed");
   return outcome;
 }
+
 
 nlohmann::json SideJson(const reconstruction::SideOutcome& s, const std::string& name) {
   const reconstruction::ReconstructionReport& r = s.report;
@@ -93,12 +96,12 @@ SessionOutcome ReconstructSession(const cv::Mat& left, const calibration::SideCa
   reconstruction::SidePipelineParams side_params = params.side;
   side_params.reconstruct = true;
   const double measure_share = params.measurements.empty() ? 0.0 : 0.15;
-  observer.CheckCancelled("the left side");
-  observer.Report("left side", 0.0);
-  out.left = ReconstructOneSide(left, Side::kLeft, left_cal, side_params);
-  observer.CheckCancelled("the right side");
-  observer.Report("right side", 0.4 - measure_share / 2);
-  out.right = ReconstructOneSide(right, Side::kRight, right_cal, side_params);
+  observer.CheckCancelled("the sides");
+  observer.Report("both sides", 0.0);
+  // The sides are independent until the join: one core each.
+  std::tie(out.left, out.right) = RunBothSides(
+      [&] { return ReconstructOneSide(left, Side::kLeft, left_cal, side_params); },
+      [&] { return ReconstructOneSide(right, Side::kRight, right_cal, side_params); });
   observer.CheckCancelled("the join");
   observer.Report("join", 0.8 - measure_share);
   try {

@@ -8,7 +8,8 @@
 //
 // Frames and units: image pixels in, world millimetres out (contracts 3);
 // the joined mesh is in the left side's frame.
-// Thread-safety: ReconstructSession is a pure function of its arguments; the
+// Thread-safety: ReconstructSession is a pure function of its arguments (it
+// runs the two sides on two threads, the left on one of its own); the
 // observer's callbacks run on the calling thread.
 #ifndef BSLS_SESSION_SESSION_H_
 #define BSLS_SESSION_SESSION_H_

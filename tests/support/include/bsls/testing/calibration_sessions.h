@@ -1,7 +1,7 @@
 // Simulated calibration sessions shared by the side-calibration and
 // calibration-file tests. CTest runs every test case in its own process, so a
-// rendered session is cached on disk (one folder per session kind and test
-// binary build, created whole by a rename) and rendered only by the first
+// rendered session is cached on disk (one folder per session kind, test
+// binary and its build, created whole by a rename) and rendered only by the first
 // process that needs it; each process calibrates it once.
 #ifndef BSLS_TESTING_CALIBRATION_SESSIONS_H_
 #define BSLS_TESTING_CALIBRATION_SESSIONS_H_
@@ -55,16 +55,19 @@ inline std::filesystem::path SessionFolder(SessionKind kind) {
   namespace fs = std::filesystem;
   static std::map<SessionKind, fs::path> folders;
   if (auto it = folders.find(kind); it != folders.end()) return it->second;
-  // Keyed by this binary's build: a rebuilt simulator renders afresh.
+  // Keyed by this binary and its build: a rebuilt simulator renders afresh.
+  // Only this binary's earlier builds are cleared below: test binaries of
+  // other builds may run beside it and use their own folders.
   struct stat exe {};
   const std::string build = ::stat("/proc/self/exe", &exe) == 0
                                 ? std::to_string(exe.st_mtime) + "_" + std::to_string(exe.st_size)
                                 : std::to_string(::getpid());
-  const std::string name = std::string("bsls_calibration_session_") +
+  std::error_code ec;
+  const std::string binary = fs::read_symlink("/proc/self/exe", ec).filename().string();
+  const std::string name = std::string("bsls_calibration_session_") + binary + "_" +
                            (kind == SessionKind::kLeftNoisy ? "left_noisy_" : "right_clean_") +
                            build;
   const fs::path folder = fs::path(::testing::TempDir()) / name;
-  std::error_code ec;
   if (!fs::is_regular_file(folder / simulator::kSessionManifestName, ec)) {
     const fs::path temp = folder.string() + ".tmp" + std::to_string(::getpid());
     fs::remove_all(temp, ec);
