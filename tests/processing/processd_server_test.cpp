@@ -42,7 +42,7 @@ TEST_F(ProcessdServer, ServesTheUnixSocketAndPlainLoopback) {
   config.replica = "r1";
   auto server = Server::Start(config, "test");
   ASSERT_GT(server->tcp_port(), 0);
-  for (const std::string target :
+  for (const std::string& target :
        {"unix:" + config.listen.unix_socket, "127.0.0.1:" + std::to_string(server->tcp_port())}) {
     processing::ClientOptions options;
     options.target = target;
