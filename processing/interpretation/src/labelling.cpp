@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <queue>
@@ -91,8 +92,12 @@ bool WalkDown(const JunctionNetwork& net, const std::vector<char>& trusted_edge,
 // Pixels of a line walked from a node up or down until it stops. A line runs
 // one way in y: where the chain turns back or runs sideways (into a segment,
 // e.g. round the corner of a brick cut off at the image border) the walk ends.
+// It also ends before a junction labelled with another line (`other_line`
+// says which are): where lines crowd together (a cavity's wall) the chain
+// can cross onto a neighbour's strand, whose junctions know better.
 std::vector<cv::Point> WalkPixels(const JunctionNetwork& net, int from, bool downwards,
-                                  std::set<int>* visited_nodes) {
+                                  std::set<int>* visited_nodes,
+                                  const std::function<bool(int)>& other_line) {
   constexpr int kMaxSideways = 2;  // consecutive steps without progress in y
   const SkeletonGraph& g = net.graph();
   const int sign = downwards ? 1 : -1;
@@ -114,7 +119,7 @@ std::vector<cv::Point> WalkPixels(const JunctionNetwork& net, int from, bool dow
   int cur = from;
   for (int guard = 0; guard < 10000; ++guard) {
     const auto step = net.AlongLine(cur, downwards);
-    if (!step) break;
+    if (!step || other_line(step->target)) break;
     for (const cv::Point& p : g.Pixels(step->half_edge))
       if (!accept(p)) return out;
     const int t = step->target;
@@ -404,9 +409,17 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
 
   // Lines: walk each labelled line up and down from its junctions.
   std::map<int, std::vector<int>> nodes_of_line;
+  std::map<int, int> line_of_node;
   for (const LabelledJunction& j : out->junctions)
-    if (j.node >= 0) nodes_of_line[j.p].push_back(j.node);
+    if (j.node >= 0) {
+      nodes_of_line[j.p].push_back(j.node);
+      line_of_node[j.node] = j.p;
+    }
   for (auto& [p, nodes] : nodes_of_line) {
+    const auto other_line = [&, p = p](int node) {
+      const auto labelled = line_of_node.find(node);
+      return labelled != line_of_node.end() && labelled->second != p;
+    };
     std::sort(nodes.begin(), nodes.end(),
               [&](int a, int b) { return net.role(a).centre.y < net.role(b).centre.y; });
     std::set<int> visited;
@@ -414,11 +427,11 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     for (int n : nodes) {
       if (visited.count(n)) continue;
       visited.insert(n);
-      std::vector<cv::Point> up = WalkPixels(net, n, false, &visited);
+      std::vector<cv::Point> up = WalkPixels(net, n, false, &visited, other_line);
       std::vector<cv::Point> run(up.rbegin(), up.rend());
       const cv::Point2d c = net.role(n).centre;
       run.push_back({cvRound(c.x), cvRound(c.y)});
-      std::vector<cv::Point> down = WalkPixels(net, n, true, &visited);
+      std::vector<cv::Point> down = WalkPixels(net, n, true, &visited, other_line);
       run.insert(run.end(), down.begin(), down.end());
       runs.push_back(std::move(run));
     }
