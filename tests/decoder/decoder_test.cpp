@@ -153,7 +153,9 @@ TEST(Decoder, CrowdedLinesOnALesionKeepTheirOwnStrands) {
   EXPECT_GE(e.all.Recall(), 0.95) << e.all.Summary();
   EXPECT_LE(e.line_rms, 0.15) << "points " << e.line_points;
   for (const DecodedLine& line : r.lines) {
-    if (line.p >= 3 && line.p <= 5) EXPECT_GT(line.points.size(), 250u) << "line " << line.p;
+    if (line.p >= 3 && line.p <= 5) {
+      EXPECT_GT(line.points.size(), 250u) << "line " << line.p;
+    }
   }
 }
 
