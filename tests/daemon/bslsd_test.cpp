@@ -2,10 +2,7 @@
 // socket and store, driven over gRPC (issue 4, "Done means").
 #include <gtest/gtest.h>
 #include <openssl/sha.h>
-#include <arpa/inet.h>
 #include <grp.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -407,21 +404,6 @@ TEST_F(Bslsd, EmulatedUsbFramestoreBackendGrabsBothSides) {
   ASSERT_TRUE(grab.ok()) << grab.error_message();
   ASSERT_EQ(reply.capture().frames_size(), 2);
   EXPECT_EQ(PixelHash(reply.capture().frames(1)), reply.capture().frames(1).sha256());
-}
-
-// A TCP port on loopback that nothing listens on right now.
-int FreeLoopbackPort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t length = sizeof address;
-  int port = 0;
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0)
-    port = ntohs(address.sin_port);
-  ::close(fd);
-  return port;
 }
 
 // A stub over TCP with `client` as the client certificate (none when its

@@ -4,9 +4,12 @@
 #ifndef BSLS_TESTS_DAEMON_DAEMON_PROCESS_H_
 #define BSLS_TESTS_DAEMON_DAEMON_PROCESS_H_
 
+#include <arpa/inet.h>
 #include <grpcpp/grpcpp.h>
 #include <fcntl.h>
+#include <netinet/in.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -114,6 +117,22 @@ inline std::unique_ptr<grpc::ClientContext> Deadline(std::chrono::milliseconds m
   auto context = std::make_unique<grpc::ClientContext>();
   context->set_deadline(std::chrono::system_clock::now() + ms);
   return context;
+}
+
+// A TCP port on loopback that nothing listens on right now (0 if none
+// could be had).
+inline int FreeLoopbackPort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t length = sizeof address;
+  int port = 0;
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0 &&
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) == 0)
+    port = ntohs(address.sin_port);
+  ::close(fd);
+  return port;
 }
 
 }  // namespace bsls::testing

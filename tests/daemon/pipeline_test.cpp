@@ -2,10 +2,7 @@
 // framestore hands every acknowledged grab to a real bsls-processd and keeps
 // what comes back beside the capture as a sealed record; the queue survives
 // an absent service and a restart of the daemon.
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
 
 #include <atomic>
 #include <nlohmann/json.hpp>
@@ -34,19 +31,6 @@ std::unique_ptr<ProcessdProcess> StartReplica(const fs::path& dir, const std::st
       BSLS_PROCESSD_PATH, dir, name, 1,
       std::vector<std::string>{"--set", "scratch_dir=" + dir.string()},
       std::chrono::seconds(120), tcp);
-}
-
-// A loopback TCP port nothing listens on right now.
-int FreePort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  socklen_t size = sizeof address;
-  ::bind(fd, reinterpret_cast<sockaddr*>(&address), size);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
-  ::close(fd);
-  return ntohs(address.sin_port);
 }
 
 class Pipeline : public ::testing::Test {
@@ -193,7 +177,7 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
 }
 
 TEST_F(Pipeline, CapturesWaitThroughAnOutageAndARestartOfTheDaemon) {
-  const std::string target = "127.0.0.1:" + std::to_string(FreePort());
+  const std::string target = "127.0.0.1:" + std::to_string(FreeLoopbackPort());
   StartDaemon(target);  // nobody listens there yet
   const std::string first = Grab(v1::GRAB_SIDE_BOTH);
   const std::string second = Grab(v1::GRAB_SIDE_BOTH);

@@ -353,6 +353,23 @@ Footprint SettleTo(pid_t pid, const Footprint& baseline) {
   return now;
 }
 
+// Waits for the process `name` (`pid`) to settle after the load, prints its
+// footprints (fresh, after the warm-up, after the load) and the phases'
+// times, and expects it back within the tolerances of `baseline`.
+void ExpectBackToBaseline(const char* name, pid_t pid, const Footprint& fresh,
+                          const Footprint& baseline, double warm_s, double load_s) {
+  const Footprint after = SettleTo(pid, baseline);
+  const long rss_tolerance = kRssToleranceKib + SanitizerSlackKib();
+  std::printf(
+      "%s: fds fresh %d, baseline %d, after %d; RSS fresh %ld KiB, baseline %ld KiB, after %ld "
+      "KiB (tolerance %ld KiB); warm-up %.1f s, load %.1f s\n",
+      name, fresh.fds, baseline.fds, after.fds, fresh.rss_kib, baseline.rss_kib, after.rss_kib,
+      rss_tolerance, warm_s, load_s);
+  EXPECT_LE(after.fds, baseline.fds + kFdTolerance) << name;
+  EXPECT_LE(after.rss_kib, baseline.rss_kib + rss_tolerance)
+      << name << " kept more resident memory than its baseline after the load";
+}
+
 // A channel of its own (a new connection, not a shared subchannel).
 std::shared_ptr<grpc::Channel> FreshChannel(const std::string& target, int n) {
   grpc::ChannelArguments args;
@@ -1065,15 +1082,7 @@ TEST(MalformedRequests, ProcessdSurvivesTenThousand) {
   EXPECT_EQ(info.waiting(), 0u);
   EXPECT_EQ(tally.hung, 0);
   // Back to the baseline.
-  const Footprint after = SettleTo(replica.pid(), baseline);
-  std::printf(
-      "bsls-processd: fds fresh %d, baseline %d, after %d; RSS fresh %ld KiB, baseline %ld KiB, "
-      "after %ld KiB (tolerance %ld KiB); warm-up %.1f s, load %.1f s\n",
-      fresh.fds, baseline.fds, after.fds, fresh.rss_kib, baseline.rss_kib, after.rss_kib,
-      kRssToleranceKib + SanitizerSlackKib(), warm_s, load_s);
-  EXPECT_LE(after.fds, baseline.fds + kFdTolerance);
-  EXPECT_LE(after.rss_kib, baseline.rss_kib + kRssToleranceKib + SanitizerSlackKib())
-      << "bsls-processd kept more resident memory than its baseline after the load";
+  ExpectBackToBaseline("bsls-processd", replica.pid(), fresh, baseline, warm_s, load_s);
   // Every upload's scratch folder is gone.
   EXPECT_TRUE(fs::is_empty(scratch)) << fs::begin(fs::directory_iterator(scratch))->path();
   // The service's own failures (a status that says it broke, not the caller).
@@ -1339,15 +1348,7 @@ TEST(MalformedRequests, BslsdSurvivesTenThousand) {
   EXPECT_TRUE(answers()) << daemon.Log();
   EXPECT_EQ(tally.hung, 0);
   stub.reset();
-  const Footprint after = SettleTo(daemon.pid(), baseline);
-  std::printf(
-      "bslsd: fds fresh %d, baseline %d, after %d; RSS fresh %ld KiB, baseline %ld KiB, after %ld "
-      "KiB (tolerance %ld KiB); warm-up %.1f s, load %.1f s\n",
-      fresh.fds, baseline.fds, after.fds, fresh.rss_kib, baseline.rss_kib, after.rss_kib,
-      kRssToleranceKib + SanitizerSlackKib(), warm_s, load_s);
-  EXPECT_LE(after.fds, baseline.fds + kFdTolerance);
-  EXPECT_LE(after.rss_kib, baseline.rss_kib + kRssToleranceKib + SanitizerSlackKib())
-      << "bslsd kept more resident memory than its baseline after the load";
+  ExpectBackToBaseline("bslsd", daemon.pid(), fresh, baseline, warm_s, load_s);
   EXPECT_TRUE(tally.suspicious.empty()) << "see SUSPICIOUS above";
   EXPECT_EQ(daemon.Terminate(), 0) << daemon.Log().substr(0, 20000);
   std::error_code ec;

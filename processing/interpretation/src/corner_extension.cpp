@@ -66,10 +66,6 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     throw std::invalid_argument(
         "ExtendCorners: stripe mask must be CV_8UC1 of the skeleton's size");
   std::vector<cv::Point> corners;
-  // A corner's segment must end on a line (a junction), not run off along an
-  // outline; a free end (the partner line too faint to see) counts for a
-  // segment long enough not to be a hook, when the mask will vouch for the
-  // line going on.
   if (imaged.empty()) imaged = cv::Rect(0, 0, skeleton.cols, skeleton.rows);
   // True when the stub from `corner` along `dir` (from the line into the
   // corner) leaves the imaged area: the line runs out of the frame there.
@@ -77,6 +73,10 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     dir *= params.stub / std::hypot(dir.x, dir.y);
     return !imaged.contains(cv::Point(cvRound(corner.x + dir.x), cvRound(corner.y + dir.y)));
   };
+  // A corner's segment must end on a line (a junction), not run off along an
+  // outline; a free end (the partner line too faint to see) counts for a
+  // segment long enough not to be a hook (shorter where the line leaves the
+  // frame), when the mask will vouch for the line going on.
   auto segment_counts = [&](NodeKind end, int length, bool at_edge) {
     return end == NodeKind::kJunction ||
            (!stripe_mask.empty() &&

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <map>
 #include <queue>
@@ -92,12 +91,13 @@ bool WalkDown(const JunctionNetwork& net, const std::vector<char>& trusted_edge,
 // Pixels of a line walked from a node up or down until it stops. A line runs
 // one way in y: where the chain turns back or runs sideways (into a segment,
 // e.g. round the corner of a brick cut off at the image border) the walk ends.
-// It also ends before a junction labelled with another line (`other_line`
-// says which are): where lines crowd together (a cavity's wall) the chain
-// can cross onto a neighbour's strand, whose junctions know better.
+// It also ends before a junction labelled with a line other than `line`
+// (`line_of_node`: node -> p of the labelled junctions): where lines crowd
+// together (a cavity's wall) the chain can cross onto a neighbour's strand,
+// whose junctions know better.
 std::vector<cv::Point> WalkPixels(const JunctionNetwork& net, int from, bool downwards,
                                   std::set<int>* visited_nodes,
-                                  const std::function<bool(int)>& other_line) {
+                                  const std::map<int, int>& line_of_node, int line) {
   constexpr int kMaxSideways = 2;  // consecutive steps without progress in y
   const SkeletonGraph& g = net.graph();
   const int sign = downwards ? 1 : -1;
@@ -119,7 +119,10 @@ std::vector<cv::Point> WalkPixels(const JunctionNetwork& net, int from, bool dow
   int cur = from;
   for (int guard = 0; guard < 10000; ++guard) {
     const auto step = net.AlongLine(cur, downwards);
-    if (!step || other_line(step->target)) break;
+    if (!step) break;
+    if (const auto labelled = line_of_node.find(step->target);
+        labelled != line_of_node.end() && labelled->second != line)
+      break;
     for (const cv::Point& p : g.Pixels(step->half_edge))
       if (!accept(p)) return out;
     const int t = step->target;
@@ -416,10 +419,6 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
       line_of_node[j.node] = j.p;
     }
   for (auto& [p, nodes] : nodes_of_line) {
-    const auto other_line = [&, p = p](int node) {
-      const auto labelled = line_of_node.find(node);
-      return labelled != line_of_node.end() && labelled->second != p;
-    };
     std::sort(nodes.begin(), nodes.end(),
               [&](int a, int b) { return net.role(a).centre.y < net.role(b).centre.y; });
     std::set<int> visited;
@@ -427,11 +426,11 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     for (int n : nodes) {
       if (visited.count(n)) continue;
       visited.insert(n);
-      std::vector<cv::Point> up = WalkPixels(net, n, false, &visited, other_line);
+      std::vector<cv::Point> up = WalkPixels(net, n, false, &visited, line_of_node, p);
       std::vector<cv::Point> run(up.rbegin(), up.rend());
       const cv::Point2d c = net.role(n).centre;
       run.push_back({cvRound(c.x), cvRound(c.y)});
-      std::vector<cv::Point> down = WalkPixels(net, n, true, &visited, other_line);
+      std::vector<cv::Point> down = WalkPixels(net, n, true, &visited, line_of_node, p);
       run.insert(run.end(), down.begin(), down.end());
       runs.push_back(std::move(run));
     }

@@ -6,8 +6,8 @@
 #include <tuple>
 
 #include "bsls/joining/join_error.h"
-#include "bsls/session/both_sides.h"
 #include "bsls/measurement/measurement_error.h"
+#include "bsls/session/both_sides.h"
 
 namespace bsls::session {
 namespace {
@@ -39,7 +39,6 @@ reconstruction::SideOutcome ReconstructOneSide(const cv::Mat& grey, Side side,
                        FrameName(side) + ": no surface was reconstructed");
   return outcome;
 }
-
 
 nlohmann::json SideJson(const reconstruction::SideOutcome& s, const std::string& name) {
   const reconstruction::ReconstructionReport& r = s.report;
