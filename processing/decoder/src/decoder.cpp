@@ -304,6 +304,10 @@ struct JunctionPlan {
   bool ok = false;  // false: the line has too few centres near the junction
   double a = 0.0, b = 0.0;
   std::vector<std::pair<double, double>> vertical;
+  // The line's measured centres twice as far each side (empty where the fit
+  // fell back to the skeleton): a fold's branch curving into it is fitted
+  // over these.
+  std::vector<std::pair<double, double>> wide;
   std::vector<cv::Point> columns;  // (column, approximate row) of each centre to measure
 };
 
@@ -316,7 +320,9 @@ JunctionPlan PlanJunction(const LineCentres& line, const interpretation::Labelle
   // The line as x(y): sub-pixel centres, or where a steep or crowded line has
   // too few of them, its skeleton (within a pixel of the centre).
   plan.vertical = RowsNear(line.measured, y0, params.junction_fit_rows, 0.0);
-  if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) {
+  if (plan.vertical.size() >= 3 && FitLine(plan.vertical, &plan.a, &plan.b)) {
+    plan.wide = RowsNear(line.measured, y0, 2 * params.junction_fit_rows, 0.0);
+  } else {
     // The skeleton bends into the segment within junction_clearance of the
     // junction (most where a steep line meets it at a sharp angle): those
     // rows are left out while enough others remain.
@@ -387,31 +393,52 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
         *out = (c + e * (a2 - a) - e * b2 * y0) / den;
         return std::abs(*out - y0) <= reach;
       };
+      // Where the parabola x = k0 + k1 t + k2 t^2 (t = y - y0) meets the
+      // segment: e k2 t^2 + (e k1 - 1) t + c + e (k0 - a) - y0 = 0; the root
+      // nearer t = 0, in the form that stays exact as e k2 -> 0.
+      auto meet_curve = [&](const cv::Vec3d& k, cv::Point2d* out) {
+        const double qa = e * k[2], qb = e * k[1] - 1.0, qc = c + e * (k[0] - a) - y0;
+        const double disc = qb * qb - 4 * qa * qc;
+        if (disc < 0) return false;
+        const double t = 2 * qc / (-qb + std::copysign(std::sqrt(disc), -qb));
+        if (std::abs(t) > reach) return false;
+        *out = cv::Point2d(k[0] + k[1] * t + k[2] * t * t, y0 + t);
+        return true;
+      };
       std::vector<std::pair<double, double>> upper, lower;
       for (const auto& v : vertical) (v.first < 0 ? upper : lower).push_back(v);
       double au, bu, al, bl, yu, yl, ya;
       const bool branches = upper.size() >= 2 && lower.size() >= 2 && FitLine(upper, &au, &bu) &&
                             FitLine(lower, &al, &bl);
-      // A line folding at its junction (nose, lips): the branches above and
-      // below meet the segment each on its own, and the junction lies between
-      // the two meeting points.
+      // A line folding near its junction (nose, lips): the branches above and
+      // below meet the segment each on its own. A segment coming from the
+      // fold's open side runs into the branch at its row first: the meeting
+      // point nearer its side (the other one lies on the far branch's
+      // extension beyond the tip), where that branch, curving into the fold,
+      // is fitted as a parabola over twice the rows when it has them. A
+      // segment coming at the tip from outside, or branches meeting it within
+      // fold_tip_spread of each other, meet the fold at its tip: the junction
+      // lies between the meeting points.
       if (branches && std::abs(bu - bl) > params.fold_slope_change) {
         if (meet(au, bu, &yu) && meet(al, bl, &yl)) {
           const double xu = au + bu * (yu - y0), xl = al + bl * (yl - y0);
-          return cv::Point2d(0.5 * (xu + xl), 0.5 * (yu + yl));
+          double side = 0.0;  // > 0: the segment comes from the right
+          for (const cv::Point& s : plan.columns) side += s.x - a;
+          const bool tip_right = bu > bl;
+          if ((side > 0) == tip_right || std::abs(xu - xl) <= params.fold_tip_spread)
+            return cv::Point2d(0.5 * (xu + xl), 0.5 * (yu + yl));
+          const bool entered_upper = (side > 0) == (xu > xl);
+          std::vector<std::pair<double, double>> branch;
+          for (const auto& v : plan.wide)
+            if ((v.first < 0) == entered_upper) branch.push_back(v);
+          cv::Point2d curved;
+          if (cv::Vec3d k; FitParabola(branch, &k) && meet_curve(k, &curved)) return curved;
+          return entered_upper ? cv::Point2d(xu, yu) : cv::Point2d(xl, yl);
         }
       } else if (cv::Vec3d k; branches && FitParabola(vertical, &k)) {
         // A line curving smoothly through it: its centres on both sides as a
-        // parabola x = k0 + k1 t + k2 t^2 (t = y - y0), which meets the segment
-        // where e k2 t^2 + (e k1 - 1) t + c + e (k0 - a) - y0 = 0; the root
-        // nearer t = 0, in the form that stays exact as e k2 -> 0.
-        const double qa = e * k[2], qb = e * k[1] - 1.0, qc = c + e * (k[0] - a) - y0;
-        const double disc = qb * qb - 4 * qa * qc;
-        if (disc >= 0) {
-          const double t = 2 * qc / (-qb + std::copysign(std::sqrt(disc), -qb));
-          if (std::abs(t) <= reach)
-            return cv::Point2d(k[0] + k[1] * t + k[2] * t * t, y0 + t);
-        }
+        // parabola.
+        if (cv::Point2d curved; meet_curve(k, &curved)) return curved;
       }
       if (meet(a, b, &ya)) y = ya;
     }
@@ -431,6 +458,7 @@ DecodeParams ScaledForBinning(const DecodeParams& params, int n) {
   out.segment_fit_columns *= n;
   out.junction_clearance *= n;
   out.max_centre_residual *= n;
+  out.fold_tip_spread *= n;
   out.centre.search_radius *= n;
   out.centre.max_width *= n;
   out.centre.min_sigma *= n;
@@ -461,6 +489,7 @@ bool DecodeParams::IsValid(std::string* error) const {
   if (segment_fit_columns < 2) return fail("segment_fit_columns must be at least 2");
   if (!(max_fill_slope >= 0)) return fail("max_fill_slope must not be negative");
   if (!(fold_slope_change > 0)) return fail("fold_slope_change must be positive");
+  if (!(fold_tip_spread >= 0)) return fail("fold_tip_spread must not be negative");
   if (junction_clearance < 0 || junction_clearance >= junction_fit_rows)
     return fail("junction_clearance must lie in 0..junction_fit_rows-1");
   if (min_dynamic_range < 0 || max_saturated_fraction <= 0 || max_saturated_fraction > 1)

@@ -56,6 +56,9 @@ struct DecodeParams {
   // A line whose slope (dx/dy) above and below a junction differs by more
   // folds there; otherwise it is fitted as one smooth curve through it.
   double fold_slope_change = 0.5;
+  // px: a fold's branches meeting the segment closer together than this meet
+  // it at the fold's tip; farther apart, the junction is on one branch.
+  double fold_tip_spread = 2.0;
   // Working resolution. The pixel-sized parameters (extraction,
   // interpretation, centre and the lengths above) hold for a stripe pitch
   // near tuned_pitch px: measured 10.4-20.8 px on the thesis scenes at
