@@ -154,37 +154,56 @@ std::vector<std::pair<double, double>> RowsNear(const RowValues& rows, double ce
 
 struct LineCentres {
   RowValues measured;         // row -> sub-pixel x, outliers removed
+  // The measured rows that no segment passes within its widened clearance:
+  // the junction fits use only these.
+  RowValues clear;
   RowValues skeleton;         // row -> mean x of the line's skeleton pixels
   RowValues slope;            // row -> |dx/dy| of the skeleton there (rows the skeleton crosses)
   std::vector<char> skipped;  // by row from measured.First(): crossed but not measured
   std::vector<cv::Point2d> points;  // the decoded centres: measured, skipped rows refilled
 };
 
-// True when the skeleton has a segment leaving the line near (x, y): a set
-// pixel 2-4 columns to either side within `clearance` rows that is not part of
-// the line itself.
-bool SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<int, int>>& own, int x,
-                   int y, int clearance) {
-  for (int dy = -clearance; dy <= clearance; ++dy) {
+// How near a segment leaving the line passes a row of it.
+enum class SegmentNear {
+  kNone,    // none within the widened clearance
+  kObtuse,  // only beyond the base clearance, where the line leans away from it
+  kNear,    // within the base clearance, or where the line runs along it
+};
+
+// Whether the skeleton has a segment leaving the line near (x, y): set pixels
+// 2-4 columns to either side that are not part of the line itself, within
+// `clearance` rows, or within `wide_clearance` rows on the side of the
+// segment where a line leaning at `slope` (dx/dy) runs along it (the acute
+// angle between them; there a steep line's wide row profile takes in the
+// segment's light over many rows) or away from it.
+SegmentNear SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<int, int>>& own,
+                          int x, int y, int clearance, int wide_clearance, double slope) {
+  const int reach = std::max(clearance, wide_clearance);
+  SegmentNear out = SegmentNear::kNone;
+  for (int dy = -reach; dy <= reach; ++dy) {
     const int yy = y + dy;
     if (yy < 0 || yy >= skeleton.rows) continue;
     const uchar* row = skeleton.ptr<uchar>(yy);
     for (int k = 2; k <= 4; ++k)
-      for (int xx : {x - k, x + k})
-        if (xx >= 0 && xx < skeleton.cols && row[xx] &&
-            !std::binary_search(own.begin(), own.end(), std::make_pair(xx, yy)))
-          return true;
+      for (int side : {-1, 1}) {
+        const int xx = x + side * k;
+        if (xx < 0 || xx >= skeleton.cols || !row[xx] ||
+            std::binary_search(own.begin(), own.end(), std::make_pair(xx, yy)))
+          continue;
+        if (std::abs(dy) <= clearance || dy * slope * side < 0) return SegmentNear::kNear;
+        out = SegmentNear::kObtuse;
+      }
   }
-  return false;
+  return out;
 }
 
-// |dx/dy| of a line's skeleton over `reach` rows each side of row y (0 when unknown).
+// dx/dy of a line's skeleton over `reach` rows each side of row y (0 when unknown).
 double LocalSlope(const RowValues& skeleton, int y, int reach) {
   int a = y - reach, last = y + reach;
   while (a <= y + reach && !skeleton.Has(a)) ++a;
   while (last >= a && !skeleton.Has(last)) --last;
   if (a > y + reach || last <= a) return 0.0;
-  return std::abs((skeleton.At(last) - skeleton.At(a)) / (last - a));
+  return (skeleton.At(last) - skeleton.At(a)) / (last - a);
 }
 
 // Sub-pixel centres of one labelled line, one per row its skeleton crosses.
@@ -220,6 +239,7 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
   const int first = span.empty() ? 0 : span.front().first;
   const int count = span.empty() ? 0 : span.back().first - first + 1;
   out.measured.Reset(first, count);
+  out.clear.Reset(first, count);
   out.skeleton.Reset(first, count);
   out.slope.Reset(first, count);
   out.skipped.assign(static_cast<size_t>(count), 0);
@@ -229,8 +249,10 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
       out.skeleton.Set(y, 0.5 * (range.first + range.second));
   for (const auto& [y, range] : span) {
     const auto [lo, hi] = range;
-    // A steep line's row profile is wide, so a segment biases more rows of it.
-    const double slope = LocalSlope(out.skeleton, y, 3 * n);
+    // A steep line's row profile is wide, so a segment biases more rows of it
+    // on the side where the line runs along it.
+    const double signed_slope = LocalSlope(out.skeleton, y, 3 * n);
+    const double slope = std::abs(signed_slope);
     out.slope.Set(y, slope);
     const int clearance =
         params.junction_clearance +
@@ -238,14 +260,21 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
                                      std::max(0.0, slope - params.max_fill_slope)));
     const int x = (lo + hi) / 2;
     // A row where the skeleton runs sideways is a segment, not the line.
-    if (hi - lo > 2 * n || SegmentNearby(skeleton, own, x, y, clearance)) {
+    const SegmentNear near =
+        hi - lo > 2 * n
+            ? SegmentNear::kNear
+            : SegmentNearby(skeleton, own, x, y, params.junction_clearance, clearance,
+                            signed_slope);
+    if (near == SegmentNear::kNear) {
       skip(y);
       continue;
     }
-    if (auto cx = extraction::StripeCentreInRow(grey, y, 0.5 * (lo + hi), params.centre))
+    if (auto cx = extraction::StripeCentreInRow(grey, y, 0.5 * (lo + hi), params.centre)) {
       out.measured.Set(y, *cx);
-    else
+      if (near == SegmentNear::kNone) out.clear.Set(y, *cx);
+    } else {
       skip(y);
+    }
   }
   // Outliers: more than max_centre_residual from the line through the
   // neighbours within junction_fit_rows on the same stretch of the line: not
@@ -276,6 +305,7 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
   }
   for (int y : outliers) {
     out.measured.Erase(y);
+    out.clear.Erase(y);
     skip(y);
   }
   // The decoded points: measured centres, and the skipped rows filled from
@@ -319,9 +349,9 @@ JunctionPlan PlanJunction(const LineCentres& line, const interpretation::Labelle
   JunctionPlan plan;
   // The line as x(y): sub-pixel centres, or where a steep or crowded line has
   // too few of them, its skeleton (within a pixel of the centre).
-  plan.vertical = RowsNear(line.measured, y0, params.junction_fit_rows, 0.0);
+  plan.vertical = RowsNear(line.clear, y0, params.junction_fit_rows, 0.0);
   if (plan.vertical.size() >= 3 && FitLine(plan.vertical, &plan.a, &plan.b)) {
-    plan.wide = RowsNear(line.measured, y0, 2 * params.junction_fit_rows, 0.0);
+    plan.wide = RowsNear(line.clear, y0, 2 * params.junction_fit_rows, 0.0);
   } else {
     // The skeleton bends into the segment within junction_clearance of the
     // junction (most where a steep line meets it at a sharp angle): those
