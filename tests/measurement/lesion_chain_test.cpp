@@ -44,6 +44,10 @@ struct Lesion {
   // Share of the region the measured surface covers today (a floor that
   // keeps what the decoder reaches; the whole region is lit and seen).
   double min_coverage;
+  // Whether the chain meets the acceptance for the area (3 %) and the
+  // volume (5 %) both ways today; otherwise they are held one way (never
+  // more than the truth: the uncovered part is missing).
+  bool area_met, volume_met;
 };
 
 // Thesis 7.2, Figures 7.12-7.13: a lump on the cheek near the mouth (Table
@@ -52,13 +56,13 @@ struct Lesion {
 const Lesion kLesions[] = {
     {"cheek lump",
      {.centre_xy_mm = {-42.0, -32.0}, .height_mm = 15.0, .radius_mm = 30.0, .top_radius_mm = 12.0},
-     0.5},
+     0.65, false, false},
     {"forehead cavity",
      {.centre_xy_mm = {-28.0, 50.0}, .height_mm = -15.0, .radius_mm = 28.0, .top_radius_mm = 11.0},
-     0.9},
+     0.99, true, true},
     {"cheek cavity",
      {.centre_xy_mm = {42.0, -30.0}, .height_mm = -10.0, .radius_mm = 16.0, .top_radius_mm = 7.0},
-     0.75},
+     0.99, false, true},
 };
 
 simulator::ThesisSceneOptions SceneOptions(bool with_lesions) {
@@ -175,13 +179,19 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
         m.baseline->rms_mm, m.baseline->transform.translation().norm());
     const Errors e = Compare("baseline", lesion, truth, m);
     EXPECT_LT(std::abs(e.peak_mm), kPeakToleranceMm);
-    // Area and volume: NOT yet within the acceptance through the chain where
-    // the decoder still loses line points on steep skirts (the cheek lump
-    // and cavity: the surface covers 56 % and 79 % of their regions), so
-    // what is measured there is the covered part (issue 3 notes). Held
-    // here: never more than the truth, and the coverage reached.
+    // Area and volume within the acceptance where the chain meets it; where
+    // it does not yet (issue 3 notes: the cheek lump's surface covers 68 %
+    // of its region, where lines 4-5 cross at the nasolabial fold and are
+    // lost over 30-47 rows; the cheek cavity is covered whole but its area
+    // is 3.9 % short), held one way: never more than the truth.
     EXPECT_LT(e.area_relative, kAreaRelativeTolerance);
     EXPECT_LT(e.volume_relative, kVolumeRelativeTolerance);
+    if (lesion.area_met) {
+      EXPECT_GT(e.area_relative, -kAreaRelativeTolerance);
+    }
+    if (lesion.volume_met) {
+      EXPECT_GT(e.volume_relative, -kVolumeRelativeTolerance);
+    }
     EXPECT_GE(m.surface_coverage, lesion.min_coverage);
     EXPECT_LT(m.baseline->transform.translation().norm(), 0.2);  // one rig, one pose
 

@@ -69,12 +69,77 @@ int SmoothCentres(std::vector<Centre>* centres) {
   return moved;
 }
 
+// The cubic Hermite curve from (y0, x0) with slope m0 to (y1, x1) with slope
+// m1 (dx/drow), at row y.
+double Hermite(double y0, double x0, double m0, double y1, double x1, double m1, double y) {
+  const double h = y1 - y0, t = (y - y0) / h, t2 = t * t, t3 = t2 * t;
+  return (2 * t3 - 3 * t2 + 1) * x0 + (t3 - 2 * t2 + t) * h * m0 + (-2 * t3 + 3 * t2) * x1 +
+         (t3 - t2) * h * m1;
+}
+
+// The slope dx/drow of a line's centres at `row`, from the measured rows
+// within 3 on the side `step` (-1 above, +1 below) by least squares; the
+// chord slope `fallback` when fewer than two.
+double EndSlope(const std::map<int, double>& x_of_row, int row, int step, double fallback) {
+  double n = 0, sy = 0, sx = 0, syy = 0, syx = 0;
+  for (int k = 0; k <= 3; ++k) {
+    const auto it = x_of_row.find(row + step * k);
+    if (it == x_of_row.end()) continue;
+    const double y = step * k;
+    n += 1;
+    sy += y;
+    sx += it->second;
+    syy += y * y;
+    syx += y * it->second;
+  }
+  const double den = n * syy - sy * sy;
+  if (n < 2 || std::abs(den) < 1e-9) return fallback;
+  return (n * syx - sy * sx) / den;
+}
+
+// Thesis Appendix B extended: the centres x(row) across a gap (row0, row1)
+// that holds junctions of the line, pinned at them: anchors are the gap's
+// ends and the junctions (sorted by row), each stretch between two a cubic
+// Hermite curve, slopes at the ends from the measured rows beyond them,
+// Catmull-Rom slopes at the junctions. Empty when a junction lies more than
+// `max_offset` px from the curve across the gap without it.
+std::vector<double> AnchoredBridge(const std::map<int, double>& x_of_row, int row0, int row1,
+                                   const std::vector<cv::Point2d>& junctions, double max_offset) {
+  const double x0 = x_of_row.at(row0), x1 = x_of_row.at(row1);
+  const double chord = (x1 - x0) / (row1 - row0);
+  const double m0 = EndSlope(x_of_row, row0, -1, chord), m1 = EndSlope(x_of_row, row1, +1, chord);
+  std::vector<cv::Point2d> anchors{{x0, double(row0)}};
+  for (const cv::Point2d& j : junctions) {
+    const double across = Hermite(row0, x0, m0, row1, x1, m1, j.y);
+    if (std::abs(across - j.x) > max_offset) return {};
+    anchors.push_back(j);
+  }
+  anchors.push_back({x1, double(row1)});
+  std::vector<double> slopes(anchors.size());
+  slopes.front() = m0;
+  slopes.back() = m1;
+  for (std::size_t k = 1; k + 1 < anchors.size(); ++k)
+    slopes[k] = (anchors[k + 1].x - anchors[k - 1].x) / (anchors[k + 1].y - anchors[k - 1].y);
+  std::vector<double> xs;
+  std::size_t k = 0;
+  for (int row = row0 + 1; row < row1; ++row) {
+    while (k + 2 < anchors.size() && anchors[k + 1].y <= row) ++k;
+    xs.push_back(Hermite(anchors[k].y, anchors[k].x, slopes[k], anchors[k + 1].y,
+                         anchors[k + 1].x, slopes[k + 1], row));
+  }
+  return xs;
+}
+
 }  // namespace
 
 bool ReconstructionParams::IsValid(std::string* error) const {
   if (!mesh.IsValid(error)) return false;
   if (max_bridge_rows < 0 || max_bridge_rows > 64)
     return Fail(error, "reconstruction: max_bridge_rows must be in [0, 64]");
+  if (max_anchored_bridge_rows < 0 || max_anchored_bridge_rows > 64)
+    return Fail(error, "reconstruction: max_anchored_bridge_rows must be in [0, 64]");
+  if (!std::isfinite(max_anchor_offset_px) || max_anchor_offset_px <= 0.0)
+    return Fail(error, "reconstruction: max_anchor_offset_px must be finite and > 0");
   if (!std::isfinite(bridge_sigma_px) || bridge_sigma_px < 0.0)
     return Fail(error, "reconstruction: bridge_sigma_px must be finite and >= 0");
   return true;
@@ -109,6 +174,10 @@ geometry::SurfaceMesh Reconstruct(const decoder::DecodeResult& decode,
   const UncertaintyParams& u = triangulator.model().uncertainty;
   const MeshParams& mesh_params = params.mesh;
   std::map<int, TriangulatedLine> by_p;  // ordered by p
+  std::multimap<int, cv::Point2d> junctions_of;  // p -> image position
+  for (const decoder::DecodedJunction& j : decode.junctions)
+    if (std::isfinite(j.position.x) && std::isfinite(j.position.y))
+      junctions_of.emplace(j.p, j.position);
   for (const decoder::DecodedLine& line : decode.lines) {
     std::vector<Centre> centres = CentresOf(line, u.stripe_centre_sigma_px);
     if (centres.empty()) continue;
@@ -145,27 +214,46 @@ geometry::SurfaceMesh Reconstruct(const decoder::DecodeResult& decode,
       if (i + 1 == measured.size()) break;
       const int row0 = measured[i].row, row1 = measured[i + 1].row;
       const int missing = row1 - row0 - 1;
-      if (missing < 1 || missing > params.max_bridge_rows) continue;
+      if (missing < 1) continue;
+      // The line's junctions inside the gap, clear of its ends.
+      std::vector<cv::Point2d> inside;
+      if (missing > params.max_bridge_rows) {
+        if (missing > params.max_anchored_bridge_rows) continue;
+        const auto [from, to] = junctions_of.equal_range(line.p);
+        for (auto it = from; it != to; ++it)
+          if (it->second.y > row0 + 0.5 && it->second.y < row1 - 0.5) inside.push_back(it->second);
+        if (inside.empty()) continue;
+        std::sort(inside.begin(), inside.end(),
+                  [](const cv::Point2d& a, const cv::Point2d& b) { return a.y < b.y; });
+      }
       const int h = missing + 1;  // knot spacing, rows
       // A jump in depth across the gap is an occlusion, not a break: no bridge.
       const double jump = (measured[i + 1].position - measured[i].position).norm();
       if (jump > std::max(mesh_params.min_along_jump_mm, mesh_params.max_along_ratio * step * h))
         continue;
-      std::vector<double> knots;
-      int first_knot_row = row0;
-      if (const auto it = x_of_row.find(row0 - h); it != x_of_row.end()) {
-        knots.push_back(it->second);
-        first_knot_row = row0 - h;
+      std::vector<double> xs;
+      if (!inside.empty()) {
+        xs = AnchoredBridge(x_of_row, row0, row1, inside, params.max_anchor_offset_px);
+        if (xs.empty()) continue;
+      } else {
+        std::vector<double> knots;
+        int first_knot_row = row0;
+        if (const auto it = x_of_row.find(row0 - h); it != x_of_row.end()) {
+          knots.push_back(it->second);
+          first_knot_row = row0 - h;
+        }
+        knots.push_back(measured_x[i]);
+        knots.push_back(measured_x[i + 1]);
+        if (const auto it = x_of_row.find(row1 + h); it != x_of_row.end())
+          knots.push_back(it->second);
+        const std::optional<CubicBSpline> spline = CubicBSpline::Interpolate(knots);
+        if (!spline) continue;
+        for (int row = row0 + 1; row < row1; ++row)
+          xs.push_back((*spline)(double(row - first_knot_row) / h));
       }
-      knots.push_back(measured_x[i]);
-      knots.push_back(measured_x[i + 1]);
-      if (const auto it = x_of_row.find(row1 + h); it != x_of_row.end())
-        knots.push_back(it->second);
-      const std::optional<CubicBSpline> spline = CubicBSpline::Interpolate(knots);
-      if (!spline) continue;
       const double sigma = std::hypot(u.stripe_centre_sigma_px, params.bridge_sigma_px);
       for (int row = row0 + 1; row < row1; ++row) {
-        const double x = (*spline)(double(row - first_knot_row) / h);
+        const double x = xs[static_cast<size_t>(row - row0 - 1)];
         const auto point = triangulator.LineSample(line.p, {x, double(row)}, sigma);
         if (!point) continue;
         vertices.push_back(

@@ -47,6 +47,15 @@ struct ReconstructionParams {
   // B-spline through the stripe centres around them (thesis Appendix B);
   // 0 disables bridging. Longer gaps stay holes in the mesh.
   int max_bridge_rows = 6;
+  // A longer gap that holds a junction of the line is bridged up to this
+  // many missing rows (0: never): the junction lies on the line, and the
+  // decoder leaves out the rows beside a steep line's segment, so the gap
+  // is pinned in its middle. Each stretch between the gap's ends and its
+  // junctions is a cubic Hermite curve x(row) with Catmull-Rom tangents.
+  int max_anchored_bridge_rows = 24;
+  // px: a junction farther than this from the Hermite curve across its gap
+  // without it does not pin the gap (a fold or a misplaced junction): no bridge.
+  double max_anchor_offset_px = 3.0;
   // px: image error of a bridged centre, added in quadrature to the stripe
   // centre's along the row (bridged vertices are interpolated, not measured).
   double bridge_sigma_px = 0.5;
