@@ -190,6 +190,20 @@ TEST_F(LesionFace, SteepLinesKeepTheRowsLeaningAwayFromASegment) {
   EXPECT_LE(e.line_rms, 0.13) << "points " << e.line_points;
 }
 
+// The decoded junction (p, v) on a face frame against its truth, px.
+double JunctionError(Side side, std::uint32_t seed, int p, int v) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, seed);
+  const DecodeResult r = Decode(frame.image, side);
+  EXPECT_TRUE(r.ok) << r.error;
+  std::optional<cv::Point2d> truth, decoded;
+  for (const simulator::PointLabel& l : simulator::VisibleJunctions(frame.truth))
+    if (l.p == p && l.v == v) truth = l.position;
+  for (const auto& j : r.junctions)
+    if (j.p == p && j.q == v) decoded = j.position;
+  EXPECT_TRUE(truth && decoded);
+  return truth && decoded ? cv::norm(*truth - *decoded) : 1e9;
+}
+
 // Junction placement at a fold: on the face, line 4 folds beside the nose
 // wing three rows below its junction with segment (4, 7), which comes from
 // the fold's open side and meets the upper branch. Placed between the two
@@ -200,16 +214,19 @@ TEST(Decoder, ASegmentEnteringAFoldFromItsOpenSideMeetsTheNearerBranch) {
   for (const auto& [side, seed] :
        {std::pair{Side::kLeft, 3u}, std::pair{Side::kLeft, 4u}, std::pair{Side::kRight, 4u}}) {
     SCOPED_TRACE(std::string(pattern::ToString(side)) + " seed " + std::to_string(seed));
-    const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, seed);
-    const DecodeResult r = Decode(frame.image, side);
-    ASSERT_TRUE(r.ok) << r.error;
-    std::optional<cv::Point2d> truth, decoded;
-    for (const simulator::PointLabel& l : simulator::VisibleJunctions(frame.truth))
-      if (l.p == 4 && l.v == 7) truth = l.position;
-    for (const auto& j : r.junctions)
-      if (j.p == 4 && j.q == 7) decoded = j.position;
-    ASSERT_TRUE(truth && decoded);
-    EXPECT_LT(cv::norm(*truth - *decoded), 2.0) << *truth << " decoded at " << *decoded;
+    EXPECT_LT(JunctionError(side, seed, 4, 7), 2.0);
+  }
+}
+
+// Line 3 beside the nose wing: the wing hides four rows of it just above its
+// junction (3, 7), so that one measured row is left there within reach. A
+// straight fit through that row and the rows below placed the junction 4.8
+// and 5.5 px off on these frames; the rows below alone, as a parabola over
+// twice the reach, place it within 2.5 px.
+TEST(Decoder, ALineWithOneRowBesideItsJunctionIsFittedFromItsOtherSide) {
+  for (const auto& [side, seed] : {std::pair{Side::kLeft, 4u}, std::pair{Side::kRight, 2u}}) {
+    SCOPED_TRACE(std::string(pattern::ToString(side)) + " seed " + std::to_string(seed));
+    EXPECT_LT(JunctionError(side, seed, 3, 7), 2.5);
   }
 }
 

@@ -469,6 +469,17 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
         // A line curving smoothly through it: its centres on both sides as a
         // parabola.
         if (cv::Point2d curved; meet_curve(k, &curved)) return curved;
+      } else if (!branches && std::min(upper.size(), lower.size()) == 1) {
+        // A line with a single measured row on one side within reach (where
+        // the nose wing hides a few rows of it next to the junction): its
+        // centres on the other side, over twice the rows, as a parabola: a
+        // line bending into the junction runs past a straight fit's meeting
+        // point, and the lone row is no guide to a fold.
+        std::vector<std::pair<double, double>> one_side;
+        for (const auto& v : plan.wide)
+          if ((v.first < 0) == (upper.size() >= 2)) one_side.push_back(v);
+        cv::Point2d curved;
+        if (cv::Vec3d q; FitParabola(one_side, &q) && meet_curve(q, &curved)) return curved;
       }
       if (meet(a, b, &ya)) y = ya;
     }
