@@ -62,7 +62,7 @@ const Lesion kLesions[] = {
      0.99, true, true},
     {"cheek cavity",
      {.centre_xy_mm = {42.0, -30.0}, .height_mm = -10.0, .radius_mm = 16.0, .top_radius_mm = 7.0},
-     0.99, false, true},
+     0.99, true, true},
 };
 
 simulator::ThesisSceneOptions SceneOptions(bool with_lesions) {
@@ -179,11 +179,11 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
         m.baseline->rms_mm, m.baseline->transform.translation().norm());
     const Errors e = Compare("baseline", lesion, truth, m);
     EXPECT_LT(std::abs(e.peak_mm), kPeakToleranceMm);
-    // Area and volume within the acceptance where the chain meets it; where
-    // it does not yet (issue 3 notes: the cheek lump's surface covers 68 %
-    // of its region, where lines 4-5 cross at the nasolabial fold and are
-    // lost over 30-47 rows; the cheek cavity is covered whole but its area
-    // is 3.9 % short), held one way: never more than the truth.
+    // Area and volume within the acceptance where the chain meets it (the
+    // cavities; the cheek cavity's area only just: -2.9 %); where it does
+    // not yet (issue 3 notes: the cheek lump's surface covers 68 % of its
+    // region, where lines 4-5 cross at the nasolabial fold and are lost over
+    // 30-47 rows), held one way: never more than the truth.
     EXPECT_LT(e.area_relative, kAreaRelativeTolerance);
     EXPECT_LT(e.volume_relative, kVolumeRelativeTolerance);
     if (lesion.area_met) {

@@ -22,8 +22,10 @@
 //     than the stripe spacing is underestimated (thesis Tables 7.3-7.4).
 //  4. Area: of the part of the region where |d| >= level_fraction * |peak|
 //     (default 0.5: the area at half height), cut from the faces at the
-//     linearly interpolated level, measured on the reference surface (the
-//     footprint the lesion covers on the face; noise does not inflate it).
+//     interpolated level (on an edge across stripes, where the mesh labels
+//     its stripes, from the cubic through four stripes; linearly along a
+//     stripe), measured on the reference surface (the footprint the lesion
+//     covers on the face; noise does not inflate it).
 //     Half height is where a smooth profile is steepest and inflects, so the
 //     level line moves least with reference and noise errors and linear
 //     interpolation between stripes is exact to second order there.
