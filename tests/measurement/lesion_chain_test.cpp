@@ -179,8 +179,12 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
         m.baseline->rms_mm, m.baseline->transform.translation().norm());
     const Errors e = Compare("baseline", lesion, truth, m);
     EXPECT_LT(std::abs(e.peak_mm), kPeakToleranceMm);
+    // The peak window centred on the lesion's top: within 0.07 mm here
+    // (+0.11 to +0.25 mm centred on the extreme vertex, whose stripe has
+    // the largest error of its own).
+    EXPECT_LT(std::abs(e.peak_mm), 0.15);
     // Area and volume within the acceptance where the chain meets it (the
-    // cavities; the cheek cavity's area only just: -2.9 %); where it does
+    // cavities: areas -1.0 and -1.5 %, volumes -0.3 and -1.2 %); where it does
     // not yet (issue 3 notes: the cheek lump's surface covers 68 % of its
     // region, where lines 4-5 cross at the nasolabial fold and are lost over
     // 30-47 rows), held one way: never more than the truth.

@@ -26,6 +26,8 @@ constexpr int kCubicTerms = 10;
 // The vertex continuing an edge onto the next stripe turns from it by at
 // most acos of this.
 constexpr double kContinuationCos = 0.8;
+// The lesion's top: vertices within this fraction of the extreme deviation.
+constexpr double kTopFraction = 0.9;
 // A peak window whose minor/major scatter is below this holds one stripe.
 constexpr double kCollinearRatio = 0.05;
 
@@ -261,13 +263,24 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
     return deviations[v];
   };
 
-  // Peak: sign from the extreme vertex, value from a quadratic around it.
+  // Peak: sign from the extreme vertex, value from a quadratic around the top.
   int extreme = inside.front();
   for (int v : inside)
     if (std::abs(deviation(v)) > std::abs(deviation(extreme))) extreme = v;
   const double sign = deviation(extreme) >= 0.0 ? 1.0 : -1.0;
   result.cavity = sign < 0.0;
-  const Eigen::Vector2d centre = mesh.positions[extreme].head<2>();
+  // The window is centred on the lesion's top (the centroid of the vertices
+  // within kTopFraction of the extreme one), not on the extreme vertex:
+  // that vertex lies on the stripe whose own error is largest, and a window
+  // around it carries that error into the peak.
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  int top = 0;
+  for (int v : inside)
+    if (sign * deviation(v) >= kTopFraction * std::abs(deviation(extreme))) {
+      centre += mesh.positions[v].head<2>();
+      ++top;
+    }
+  centre /= static_cast<double>(top);
   std::vector<int> window;
   for (int v : inside)
     if ((mesh.positions[v].head<2>() - centre).norm() <= params.peak_fit_radius_mm)
