@@ -94,5 +94,46 @@ TEST(CornerExtension, TheSameShortSegmentInsideTheFrameIsAHook) {
   EXPECT_TRUE(corners.empty());
 }
 
+// A line with T-junctions every 13 rows whose segments alternate sides, as
+// the brick pattern has them, up to a corner with an 8 px segment (the
+// face's outline cut the rest: the forehead's top, the chin). `first_side`:
+// the side (+1 right, -1 left) of the segment of the junction nearest the
+// corner; `first_row`: that junction's row (the corner is on row 14).
+struct PatternCorner {
+  cv::Mat skeleton = cv::Mat::zeros(80, 80, CV_8UC1);
+  cv::Mat mask = cv::Mat::zeros(80, 80, CV_8UC1);
+  PatternCorner(int first_side, int first_row) {
+    cv::line(skeleton, {30, 76}, {30, 14}, 255);  // the line, up to the corner
+    cv::line(skeleton, {30, 14}, {22, 14}, 255);  // the corner's segment, to the left
+    for (int row = first_row, side = first_side; row <= 70; row += 13, side = -side)
+      cv::line(skeleton, {30, row}, {30 + 12 * side, row}, 255);
+    cv::rectangle(mask, cv::Rect(29, 0, 3, 78), 255, cv::FILLED);  // the line's stroke goes on
+    cv::rectangle(mask, cv::Rect(10, 13, 21, 3), 255, cv::FILLED);
+    mask |= skeleton;
+  }
+  std::vector<cv::Point> Extend() {
+    return ExtendCorners(SkeletonGraph::Build(skeleton), {}, skeleton, mask);
+  }
+};
+
+TEST(CornerExtension, ACornerWhereThePatternPutsTheNextJunctionTakesAShortSegment) {
+  PatternCorner in_pattern(+1, 27);  // one row pitch below, its segment on the other side
+  const std::vector<cv::Point> corners = in_pattern.Extend();
+  ASSERT_EQ(corners.size(), 1u);
+  EXPECT_NEAR(corners[0].x, 30, 1);
+  EXPECT_NEAR(corners[0].y, 14, 1);
+  EXPECT_GT(cv::countNonZero(in_pattern.skeleton(cv::Rect(29, 9, 3, 4))), 0);  // the stub
+}
+
+TEST(CornerExtension, AShortSegmentOnTheSideOfTheLastJunctionsSegmentIsAHook) {
+  PatternCorner same_side(-1, 27);  // the pattern alternates: this one is not a T
+  EXPECT_TRUE(same_side.Extend().empty());
+}
+
+TEST(CornerExtension, AShortSegmentTwoRowPitchesFromTheLastJunctionIsAHook) {
+  PatternCorner far(-1, 40);  // the junction nearest the corner two pitches away
+  EXPECT_TRUE(far.Extend().empty());
+}
+
 }  // namespace
 }  // namespace bsls::interpretation

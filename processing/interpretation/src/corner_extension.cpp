@@ -47,11 +47,12 @@ bool AddStub(cv::Point corner, cv::Point2d dir, const std::vector<cv::Point>& ow
 
 bool CornerParams::IsValid(std::string* error) const {
   if (leg < 2 || stub < 1 || leg_tolerance_deg <= 0 || leg_tolerance_deg >= 45 ||
-      min_free_segment < 1 || min_free_segment_at_edge < 1) {
+      min_free_segment < 1 || min_free_segment_at_edge < 1 || min_free_segment_in_pattern < 1 ||
+      !(pitch_tolerance > 0 && pitch_tolerance < 1)) {
     if (error)
       *error =
-          "corner params: leg >= 2, stub >= 1, min_free_segment(_at_edge) >= 1, tolerance in (0, "
-          "45) degrees";
+          "corner params: leg >= 2, stub >= 1, min_free_segment(_at_edge, _in_pattern) >= 1, "
+          "tolerance in (0, 45) degrees, pitch_tolerance in (0, 1)";
     return false;
   }
   return true;
@@ -77,10 +78,44 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
   // outline; a free end (the partner line too faint to see) counts for a
   // segment long enough not to be a hook (shorter where the line leaves the
   // frame), when the mask will vouch for the line going on.
-  auto segment_counts = [&](NodeKind end, int length, bool at_edge) {
-    return end == NodeKind::kJunction ||
-           (!stripe_mask.empty() &&
-            length >= (at_edge ? params.min_free_segment_at_edge : params.min_free_segment));
+  auto segment_counts = [&](NodeKind end, int length, bool at_edge, bool in_pattern) {
+    const int needed = at_edge      ? params.min_free_segment_at_edge
+                       : in_pattern ? params.min_free_segment_in_pattern
+                                    : params.min_free_segment;
+    return end == NodeKind::kJunction || (!stripe_mask.empty() && length >= needed);
+  };
+  // The row pitch along lines: the median distance between neighbouring
+  // T-junctions joined by a vertical chain.
+  std::vector<double> spacings;
+  for (const SkeletonEdge& edge : graph.edges()) {
+    if (edge.from < 0 || edge.to < 0 || edge.from == edge.to) continue;
+    const SkeletonNode& a = graph.nodes()[edge.from];
+    const SkeletonNode& b = graph.nodes()[edge.to];
+    if (a.kind != NodeKind::kJunction || b.kind != NodeKind::kJunction ||
+        a.rotation.size() != 3 || b.rotation.size() != 3)
+      continue;
+    const cv::Point2d chord = b.centre - a.centre;
+    if (LeanFromVerticalDeg(chord) <= params.leg_tolerance_deg)
+      spacings.push_back(std::hypot(chord.x, chord.y));
+  }
+  double row_pitch = 0.0;
+  if (!spacings.empty()) {
+    std::nth_element(spacings.begin(), spacings.begin() + spacings.size() / 2, spacings.end());
+    row_pitch = spacings[spacings.size() / 2];
+  }
+  // True when a corner at `corner`, whose segment leaves towards x sign
+  // `segment_dx`, sits where the pattern puts the next junction after
+  // `node` (reached from the corner along the line).
+  auto in_pattern = [&](cv::Point corner, double segment_dx, int node) {
+    if (row_pitch <= 0.0 || node < 0) return false;
+    const SkeletonNode& t = graph.nodes()[node];
+    if (t.kind != NodeKind::kJunction || t.rotation.size() != 3) return false;
+    const double distance = std::hypot(t.centre.x - corner.x, t.centre.y - corner.y);
+    if (std::abs(distance - row_pitch) > params.pitch_tolerance * row_pitch) return false;
+    int segment = t.rotation[0];
+    for (int h : t.rotation)
+      if (std::abs(graph.Departure(h).y) < std::abs(graph.Departure(segment).y)) segment = h;
+    return graph.Departure(segment).x * segment_dx < 0.0;
   };
   // A corner may also be a small cluster of pixels (a node with two branches).
   for (const SkeletonNode& node : graph.nodes()) {
@@ -97,9 +132,11 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     else
       continue;
     const int segment = line_dir == d0 ? node.rotation[1] : node.rotation[0];
+    const int line = line_dir == d0 ? node.rotation[0] : node.rotation[1];
     const cv::Point corner(cvRound(node.centre.x), cvRound(node.centre.y));
     if (!segment_counts(graph.nodes()[graph.Target(segment)].kind, graph.Length(segment),
-                        line_leaves_frame(corner, -line_dir)))
+                        line_leaves_frame(corner, -line_dir),
+                        in_pattern(corner, graph.Departure(segment).x, graph.Target(line))))
       continue;
     if (AddStub(corner, -line_dir, node.pixels, params, skeleton, stripe_mask))
       corners.push_back(corner);
@@ -138,17 +175,21 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     }
     // True when the chain, walked from index i in direction step, leaves the
     // horizontal (turns into a line) before it ends, or its end counts.
-    auto segment_ends_on_line = [&](int i, int step, bool at_edge) {
+    auto segment_ends_on_line = [&](int i, int step, bool at_edge, bool pattern) {
       for (int k = i + step * params.leg; k >= 0 && k < n; k += step) {
         const cv::Point2d d(px[k] - px[k - step * params.leg]);
         if (LeanFromVerticalDeg(d) < 90 - params.leg_tolerance_deg) return true;
       }
       const int end = step > 0 ? edge.to : edge.from;
-      return segment_counts(graph.nodes()[end].kind, step > 0 ? n - 1 - i : i, at_edge);
+      return segment_counts(graph.nodes()[end].kind, step > 0 ? n - 1 - i : i, at_edge, pattern);
     };
     for (const Corner& c : found) {
-      if (!segment_ends_on_line(c.index, c.segment_after ? 1 : -1,
-                                line_leaves_frame(px[c.index], c.vertical)))
+      const int step = c.segment_after ? 1 : -1;
+      const double segment_dx = px[std::clamp(c.index + step * params.leg, 0, n - 1)].x -
+                                px[c.index].x;
+      const int line_end = c.segment_after ? edge.from : edge.to;
+      if (!segment_ends_on_line(c.index, step, line_leaves_frame(px[c.index], c.vertical),
+                                in_pattern(px[c.index], segment_dx, line_end)))
         continue;
       // A rounded corner passes the leg test a few pixels before its apex:
       // the corner is the pixel farthest from the chord across the bend.

@@ -33,6 +33,14 @@ struct CornerParams {
   // edge cut, not a hook at a line's end, and the segment along the edge is
   // often broken (half its profile is outside the frame).
   int min_free_segment_at_edge = 6;
+  // px: the same for a corner that sits where the pattern puts the line's
+  // next junction: one row pitch (within pitch_tolerance of the median
+  // distance between neighbouring junctions along lines) from a T-junction
+  // of its line whose segment leaves on the other side (the brick pattern's
+  // segments alternate sides along a line). There the short segment is one
+  // that the face's outline cut (the chin, the forehead's top), not a hook.
+  int min_free_segment_in_pattern = 6;
+  double pitch_tolerance = 0.3;  // fraction of the row pitch, in (0, 1)
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;
