@@ -199,6 +199,14 @@ TEST(Reconstruct, GapsAroundJunctionsAreBridgedThroughThem) {
   EXPECT_LT(std::sqrt(sum / bridged), 0.15) << bridged << " bridged";
   EXPECT_LT(worst, 0.5);
 
+  // A junction listed twice (a line decoded twice) pins the gap once.
+  decoder::DecodeResult doubled = gapped;
+  for (std::size_t k : pinned) doubled.junctions.push_back(gapped.junctions[k]);
+  ReconstructionReport doubled_report;
+  const geometry::SurfaceMesh doubled_mesh = Reconstruct(doubled, model, params, &doubled_report);
+  EXPECT_EQ(doubled_report.bridged_samples, report.bridged_samples);
+  for (const Eigen::Vector3d& position : doubled_mesh.positions) ASSERT_TRUE(position.allFinite());
+
   // A junction moved off its line pins nothing.
   decoder::DecodeResult moved = gapped;
   for (std::size_t k : pinned) moved.junctions[k].position.x += 4.0;

@@ -109,10 +109,10 @@ std::vector<double> AnchoredBridge(const std::map<int, double>& x_of_row, int ro
   const double chord = (x1 - x0) / (row1 - row0);
   const double m0 = EndSlope(x_of_row, row0, -1, chord), m1 = EndSlope(x_of_row, row1, +1, chord);
   std::vector<cv::Point2d> anchors{{x0, double(row0)}};
-  for (const cv::Point2d& j : junctions) {
+  for (const cv::Point2d& j : junctions) {  // sorted by row, inside (row0 + 0.5, row1 - 0.5)
     const double across = Hermite(row0, x0, m0, row1, x1, m1, j.y);
     if (std::abs(across - j.x) > max_offset) return {};
-    anchors.push_back(j);
+    if (j.y - anchors.back().y >= 0.5) anchors.push_back(j);  // one anchor per row: no h = 0
   }
   anchors.push_back({x1, double(row1)});
   std::vector<double> slopes(anchors.size());
