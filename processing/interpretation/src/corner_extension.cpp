@@ -77,7 +77,8 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
   // A corner's segment must end on a line (a junction), not run off along an
   // outline; a free end (the partner line too faint to see) counts for a
   // segment long enough not to be a hook (shorter where the line leaves the
-  // frame), when the mask will vouch for the line going on.
+  // frame or where the pattern puts the line's next junction), when the
+  // mask will vouch for the line going on.
   auto segment_counts = [&](NodeKind end, int length, bool at_edge, bool in_pattern) {
     const int needed = at_edge      ? params.min_free_segment_at_edge
                        : in_pattern ? params.min_free_segment_in_pattern
