@@ -107,9 +107,9 @@ INSTANTIATE_TEST_SUITE_P(
 class Faces : public ::testing::TestWithParam<Side> {};
 
 // Simulated faces with eyebrow patches and noise: no junction with a wrong p,
-// line centres within 0.15 px RMS. The issue asks for >= 98 % recall; 97.4 %
-// is what the decoder reaches today on every seed tried (docs/decoding.md)
-// and must not regress.
+// line centres within 0.15 px RMS, >= 98 % of the lit and visible junctions
+// found (the issue's figure; seeds 1-2 reach 98.4-99.0 %, seeds 1-5 together
+// 98.6 %, the worst of them 97.9 %: bench/decoder/recall_report, docs/decoding.md).
 TEST_P(Faces, LabelsAreRightAndCentresSubPixel) {
   const Side side = GetParam();
   for (std::uint32_t seed : {1u, 2u}) {
@@ -119,7 +119,7 @@ TEST_P(Faces, LabelsAreRightAndCentresSubPixel) {
     const Evaluation e = Evaluate(frame, r);
     EXPECT_EQ(e.all.wrong_p, 0) << e.all.Summary();
     EXPECT_EQ(e.all.wrong_v, 0) << e.all.Summary();
-    EXPECT_GE(e.all.Recall(), 0.97) << e.all.Summary();
+    EXPECT_GE(e.all.Recall(), 0.98) << e.all.Summary();
     EXPECT_LE(e.line_rms, 0.15) << "points " << e.line_points;
     EXPECT_GT(e.line_points, 4000);
   }

@@ -40,6 +40,38 @@ TEST(SkeletonGraph, TJunctionHasThreeBranchesInAnticlockwiseOrder) {
   }
 }
 
+// The skirt of a lump facing away from the projector: the line comes down at
+// ~38 degrees from vertical and leaves at ~72 degrees, nearly as flat as its
+// segment (~8 degrees from horizontal). The flatter branch is the segment and
+// the line is followed through the junction both ways (it was lost there
+// with a 70 degree limit on a line's lean, and with it the rows below).
+TEST(JunctionNetwork, ASteepLineIsFollowedPastASegmentNearlyAsFlat) {
+  cv::Mat sk = cv::Mat::zeros(100, 100, CV_8UC1);
+  const cv::Point junction{50, 50};
+  cv::line(sk, junction, {68, 26}, 255);  // up, 37 degrees from vertical
+  cv::line(sk, junction, {22, 59}, 255);  // down, 72 degrees from vertical
+  cv::line(sk, junction, {80, 54}, 255);  // the segment, 8 degrees from horizontal
+  const SkeletonGraph g = SkeletonGraph::Build(sk);
+  const JunctionNetwork net(g, pattern::Side::kLeft);
+  int junctions = 0;
+  for (int n = 0; n < static_cast<int>(g.nodes().size()); ++n) {
+    if (g.nodes()[n].kind != NodeKind::kJunction) continue;
+    ++junctions;
+    const auto down = net.AlongLine(n, true), up = net.AlongLine(n, false);
+    ASSERT_TRUE(down.has_value());
+    ASSERT_TRUE(up.has_value());
+    EXPECT_LT(g.nodes()[down->target].centre.x, 30.0);
+    EXPECT_GT(g.nodes()[up->target].centre.y, 20.0);
+    EXPECT_LT(g.nodes()[up->target].centre.y, 32.0);
+    const auto across = net.AcrossSegment(n);
+    ASSERT_TRUE(across.has_value());
+    EXPECT_GT(g.nodes()[across->target].centre.x, 75.0);
+    // Segment to the right on the left side: corresponding.
+    EXPECT_EQ(net.role(n).attribute, JunctionAttribute::kCorresponding);
+  }
+  EXPECT_EQ(junctions, 1);
+}
+
 TEST(SkeletonGraph, ClosedRingWithoutNodesGetsAnAnchor) {
   cv::Mat sk = cv::Mat::zeros(40, 40, CV_8UC1);
   cv::rectangle(sk, {10, 10}, {30, 25}, 255);

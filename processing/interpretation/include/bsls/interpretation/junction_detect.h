@@ -25,7 +25,10 @@ struct JunctionParams {
   int min_radius = 2;  // the 5x5 fall-back window
   // How far (degrees) a path may lean from vertical and still be a line, or
   // from horizontal and still be a segment (thesis: compared with 0 and 45).
-  double vertical_tolerance_deg = 70.0;
+  // A line may lean far: on a skirt turned away from the projector (a lump's,
+  // the outer cheek) it runs at 60-75 degrees; of three branches the segment
+  // is still the most horizontal one.
+  double vertical_tolerance_deg = 80.0;
   double horizontal_tolerance_deg = 55.0;
   // How far (degrees) the two line paths may be from opposite (a line can
   // fold sharply at a junction, e.g. at the lips).
