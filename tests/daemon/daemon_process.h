@@ -99,6 +99,13 @@ class DaemonProcess : public ChildProcess {
     return grpc::CreateChannel("unix:" + socket_.string(), grpc::InsecureChannelCredentials());
   }
   std::unique_ptr<v1::CaptureDaemon::Stub> Stub() const { return v1::CaptureDaemon::NewStub(Channel()); }
+  // A stub on a connection of its own with `args` (transport settings of a
+  // particular client).
+  std::unique_ptr<v1::CaptureDaemon::Stub> Stub(grpc::ChannelArguments args) const {
+    args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+    return v1::CaptureDaemon::NewStub(grpc::CreateCustomChannel(
+        "unix:" + socket_.string(), grpc::InsecureChannelCredentials(), args));
+  }
 
   // SIGTERM, then waits up to `timeout`: the exit status (-1 if it did not exit).
   int Terminate(std::chrono::seconds timeout = std::chrono::seconds(60)) {
