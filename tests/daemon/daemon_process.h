@@ -95,16 +95,18 @@ class DaemonProcess : public ChildProcess {
   }
 
   // A new channel to the daemon's socket.
-  std::shared_ptr<grpc::Channel> Channel() const {
-    return grpc::CreateChannel("unix:" + socket_.string(), grpc::InsecureChannelCredentials());
+  std::shared_ptr<grpc::Channel> Channel() const { return Channel(grpc::ChannelArguments()); }
+  // A new channel to the daemon's socket with `args` (transport settings of
+  // a particular client).
+  std::shared_ptr<grpc::Channel> Channel(const grpc::ChannelArguments& args) const {
+    return grpc::CreateCustomChannel("unix:" + socket_.string(),
+                                     grpc::InsecureChannelCredentials(), args);
   }
   std::unique_ptr<v1::CaptureDaemon::Stub> Stub() const { return v1::CaptureDaemon::NewStub(Channel()); }
-  // A stub on a connection of its own with `args` (transport settings of a
-  // particular client).
+  // A stub on a connection of its own with `args`.
   std::unique_ptr<v1::CaptureDaemon::Stub> Stub(grpc::ChannelArguments args) const {
     args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
-    return v1::CaptureDaemon::NewStub(grpc::CreateCustomChannel(
-        "unix:" + socket_.string(), grpc::InsecureChannelCredentials(), args));
+    return v1::CaptureDaemon::NewStub(Channel(args));
   }
 
   // SIGTERM, then waits up to `timeout`: the exit status (-1 if it did not exit).

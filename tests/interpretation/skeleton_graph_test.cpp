@@ -41,7 +41,7 @@ TEST(SkeletonGraph, TJunctionHasThreeBranchesInAnticlockwiseOrder) {
 }
 
 // The skirt of a lump facing away from the projector: the line comes down at
-// ~38 degrees from vertical and leaves at ~72 degrees, nearly as flat as its
+// ~37 degrees from vertical and leaves at ~72 degrees, nearly as flat as its
 // segment (~8 degrees from horizontal). The flatter branch is the segment and
 // the line is followed through the junction both ways (it was lost there
 // with a 70 degree limit on a line's lean, and with it the rows below).
