@@ -2,10 +2,12 @@
 # Runs the whole BSLS test suite from a clean clone: installs the Debian
 # dependencies, builds and tests the product (RelWithDebInfo), then builds it
 # again with clang, AddressSanitizer and UndefinedBehaviorSanitizer, runs the
-# same tests there (except those labelled `accuracy`: the whole chain at full
-# size, figures against the acceptance bounds, whose code the other tests
-# already run under the sanitizers at a fraction of the time), and runs the
-# decoder's libFuzzer target for a bounded time.
+# same tests there (except those labelled `accuracy`: figures on full frames
+# or the whole chain against the acceptance bounds, whose code the other tests
+# already run under the sanitizers at a fraction of the time; and `timing`),
+# and runs the libFuzzer targets for a bounded time. The malformed-request
+# load is 2,000 calls per service there instead of 10,000: the sanitizer stage
+# looks for memory errors and leaks, the first stage for the figure.
 #
 #   scripts/test.sh            everything
 #   BSLS_TEST_QUICK=1 ...      the first build and its tests only
