@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -188,6 +189,78 @@ TEST(SimulatedLesionTest, ACubicReferenceFitsTheCheekBetterThanAQuadricOrAPlane)
   const std::string table = FormatTable(Rows(with_cubic));
   EXPECT_NE(table.find("lump height"), std::string::npos);
   EXPECT_EQ(ToJson(with_cubic)["kind"], "lump");
+}
+
+// `mesh` without the faces whose x-y centroid `drop` selects (a hole where
+// stripes were lost).
+geometry::SurfaceMesh WithoutFaces(geometry::SurfaceMesh mesh,
+                                   const std::function<bool(const Eigen::Vector2d&)>& drop) {
+  std::vector<Eigen::Vector3i> kept;
+  for (const Eigen::Vector3i& f : mesh.faces) {
+    const Eigen::Vector2d centroid =
+        (mesh.positions[f[0]] + mesh.positions[f[1]] + mesh.positions[f[2]]).head<2>() / 3.0;
+    if (!drop(centroid)) kept.push_back(f);
+  }
+  mesh.faces = kept;
+  return mesh;
+}
+
+// Stripes lost over a stretch across the thesis lump's half-height contour
+// (a hole of 16 x 20 mm the surface encloses): the measured area and volume
+// miss what lies in it, the filled ones carry the lump's flank across it
+// (thin plate) and say how much was interpolated. A hole open to the
+// outside of the surface (the face's edge) is not guessed.
+TEST(SimulatedLesionTest, HolesTheSurfaceEnclosesAreFilledAndFlagged) {
+  const auto cheek = std::make_shared<simulator::BallSurface>(simulator::BallParams{
+      .centre_mm = {0.0, 0.0, -60.0}, .radius_mm = 160.0, .cut_below_z_mm = 0.0});
+  const Case& c = kThesisCases[0];
+  const auto decorated = std::make_shared<simulator::LesionSurface>(cheek, std::vector{c.lesion});
+  testing::StripeSampling stripes;
+  stripes.side = c.side;
+  stripes.noise_mm = kNoiseMm;
+  const geometry::SurfaceMesh whole = testing::SampleStripes(*decorated, stripes);
+  const LesionMeasureParams params;
+  const simulator::LesionTruth truth = decorated->Truth(0, params.level_fraction);
+  const Eigen::Vector2d centre = c.lesion.centre_xy_mm;
+  const Polygon2d region = testing::Circle(centre, c.lesion.radius_mm + 2.0);
+  const double region_xy = std::numbers::pi * std::pow(c.lesion.radius_mm + 2.0, 2);
+
+  const LesionMeasurement intact = MeasureLesion(SurfaceQuery(whole), region, params);
+  EXPECT_EQ(intact.filled_share, 0.0);
+  EXPECT_EQ(intact.filled_area_mm2.value, intact.area_mm2.value);
+  EXPECT_EQ(intact.filled_volume_mm3.value, intact.volume_mm3.value);
+
+  const Eigen::Vector2d hole_centre = centre + Eigen::Vector2d(0.0, -22.0);
+  const geometry::SurfaceMesh holed_mesh = WithoutFaces(whole, [&](const Eigen::Vector2d& xy) {
+    return std::abs(xy.x() - hole_centre.x()) < 8.0 && std::abs(xy.y() - hole_centre.y()) < 10.0;
+  });
+  const SurfaceQuery holed(holed_mesh);
+  const LesionMeasurement m = MeasureLesion(holed, region, params);
+  const double measured = m.area_mm2.value / truth.area_on_base_mm2 - 1.0;
+  const double filled = m.filled_area_mm2.value / truth.area_on_base_mm2 - 1.0;
+  const double filled_volume = m.filled_volume_mm3.value / std::abs(truth.volume_mm3) - 1.0;
+  std::printf(
+      "hole of %.0f mm^2: area measured %+.1f %%, filled %+.1f +- %.1f %% (%.1f %% of the region "
+      "interpolated); volume measured %+.1f %%, filled %+.1f %%\n",
+      m.filled_share * region_xy, 100.0 * measured, 100.0 * filled,
+      100.0 * m.filled_area_mm2.uncertainty / truth.area_on_base_mm2, 100.0 * m.filled_share,
+      100.0 * (m.volume_mm3.value / std::abs(truth.volume_mm3) - 1.0), 100.0 * filled_volume);
+  EXPECT_LT(measured, -0.05);  // the hole matters
+  EXPECT_LT(std::abs(filled), kAreaRelativeTolerance);
+  EXPECT_LT(std::abs(filled_volume), kVolumeRelativeTolerance);
+  EXPECT_NEAR(m.filled_share * region_xy, 16.0 * 20.0, 60.0);  // the hole, but a few cells
+  EXPECT_GT(m.filled_area_mm2.uncertainty, m.area_mm2.uncertainty);
+  EXPECT_EQ(ToJson(m)["holes_filled"]["share_of_region"], m.filled_share);
+  EXPECT_NE(FormatTable(Rows(m)).find("lump area, holes filled"), std::string::npos);
+
+  // Everything beyond x = centre - 20 mm gone: open to the outside, not filled.
+  const geometry::SurfaceMesh cut_mesh = WithoutFaces(
+      whole, [&](const Eigen::Vector2d& xy) { return xy.x() < centre.x() - 20.0; });
+  const SurfaceQuery cut(cut_mesh);
+  const LesionMeasurement edge = MeasureLesion(cut, region, params);
+  EXPECT_LT(edge.surface_coverage, 0.9);
+  EXPECT_EQ(edge.filled_share, 0.0);
+  EXPECT_EQ(edge.filled_area_mm2.value, edge.area_mm2.value);
 }
 
 TEST(SimulatedLesionTest, RejectsARegionWithoutSurface) {

@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "hole_fill.h"
 #include "polygon.h"
 
 namespace bsls::measurement {
@@ -30,6 +31,11 @@ constexpr double kContinuationCos = 0.8;
 constexpr double kTopFraction = 0.9;
 // A peak window whose minor/major scatter is below this holds one stripe.
 constexpr double kCollinearRatio = 0.05;
+// The grid the region's holes are filled on: cell side, and how far it
+// reaches past the region so that surface around a hole on the region's
+// boundary encloses it.
+constexpr double kFillCellMm = 0.5;
+constexpr double kFillMarginMm = 4.0;
 
 int TermsOf(ReferenceKind kind) {
   switch (kind) {
@@ -524,6 +530,63 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   result.volume_mm3.value = volume;
   result.volume_mm3.uncertainty = std::sqrt(volume_variance);
   result.region_area_mm2 = SurfaceArea(surface, region);
+
+  // The holes the measured surface encloses, filled: sign * d sampled on a
+  // grid where a face covers a cell's centre, interpolated over each hole
+  // (thin plate; the membrane's answer gives the spread), and the hole cells
+  // inside the region added to the area and the volume.
+  internal::GridField field;
+  field.cell_mm = kFillCellMm;
+  field.origin = box.min() - Eigen::Vector2d::Constant(kFillMarginMm);
+  const Eigen::Vector2d extent = box.sizes() + Eigen::Vector2d::Constant(2.0 * kFillMarginMm);
+  field.cols = static_cast<int>(std::ceil(extent.x() / kFillCellMm));
+  field.rows = static_cast<int>(std::ceil(extent.y() / kFillCellMm));
+  field.value.assign(static_cast<std::size_t>(field.cols) * field.rows,
+                     std::numeric_limits<double>::quiet_NaN());
+  const Eigen::AlignedBox2d grid_box(field.origin, field.origin + extent);
+  for (int f : surface.FacesIn(grid_box)) {
+    const Eigen::Vector3i& face = mesh.faces[f];
+    const std::array<double, 3> values = {sign * deviation(face[0]), sign * deviation(face[1]),
+                                          sign * deviation(face[2])};
+    if (!std::isfinite(values[0] + values[1] + values[2])) continue;
+    const Eigen::Vector2d a = mesh.positions[face[0]].head<2>(),
+                          b = mesh.positions[face[1]].head<2>(),
+                          c = mesh.positions[face[2]].head<2>();
+    if (std::abs(internal::SignedArea({a, b, c})) < 1e-12) continue;
+    const Eigen::Vector2d lo = (a.cwiseMin(b).cwiseMin(c) - field.origin) / kFillCellMm;
+    const Eigen::Vector2d hi = (a.cwiseMax(b).cwiseMax(c) - field.origin) / kFillCellMm;
+    for (int r = std::max(0, static_cast<int>(std::floor(lo.y())));
+         r <= std::min(field.rows - 1, static_cast<int>(std::ceil(hi.y()))); ++r)
+      for (int col = std::max(0, static_cast<int>(std::floor(lo.x())));
+           col <= std::min(field.cols - 1, static_cast<int>(std::ceil(hi.x()))); ++col) {
+        const int index = r * field.cols + col;
+        const Eigen::Vector3d w = internal::Barycentric(a, b, c, field.Centre(index));
+        if (w.minCoeff() < -1e-9) continue;
+        field.value[index] = w[0] * values[0] + w[1] * values[1] + w[2] * values[2];
+      }
+  }
+  const std::vector<double> plate = internal::FillHoles(field, internal::FillKind::kThinPlate);
+  const std::vector<double> membrane = internal::FillHoles(field, internal::FillKind::kMembrane);
+  double plate_area = 0.0, plate_volume = 0.0, membrane_area = 0.0, membrane_volume = 0.0,
+         filled_xy = 0.0;
+  const double cell_xy = kFillCellMm * kFillCellMm;
+  for (std::size_t i = 0; i < field.value.size(); ++i) {
+    if (!std::isnan(field.value[i]) || std::isnan(plate[i])) continue;  // measured, or open
+    const Eigen::Vector2d xy = field.Centre(static_cast<int>(i));
+    if (!internal::Contains(region, xy)) continue;
+    const double slant = std::sqrt(1.0 + reference.gradient(xy).squaredNorm());
+    filled_xy += cell_xy;
+    plate_volume += cell_xy * plate[i];
+    membrane_volume += cell_xy * membrane[i];
+    if (plate[i] >= result.level_mm) plate_area += cell_xy * slant;
+    if (membrane[i] >= result.level_mm) membrane_area += cell_xy * slant;
+  }
+  result.filled_share = filled_xy / region_xy;
+  result.filled_area_mm2 = {area + plate_area,
+                            std::hypot(result.area_mm2.uncertainty, plate_area - membrane_area)};
+  result.filled_volume_mm3 = {
+      volume + plate_volume,
+      std::hypot(result.volume_mm3.uncertainty, plate_volume - membrane_volume)};
 }
 
 // `region` checked and counter-clockwise.

@@ -56,6 +56,10 @@ nlohmann::json ToJson(const LesionMeasurement& result) {
           {"region_area_mm2", ToJson(result.region_area_mm2)},
           {"region_vertices", result.region_vertices},
           {"surface_coverage", result.surface_coverage},
+          {"holes_filled",
+           {{"area_mm2", ToJson(result.filled_area_mm2)},
+            {"volume_mm3", ToJson(result.filled_volume_mm3)},
+            {"share_of_region", result.filled_share}}},
           {"reference", ToJson(result.reference)}};
   if (result.baseline) out["baseline"] = ToJson(*result.baseline);
   return out;
@@ -83,6 +87,11 @@ std::vector<ReportRow> Rows(const LesionMeasurement& result) {
       {result.cavity ? "cavity volume" : "lump volume", result.volume_mm3, "mm^3"},
       {"region area", result.region_area_mm2, "mm^2"},
       {"region covered by the surface", {100.0 * result.surface_coverage, 0.0}, "%"},
+      {result.cavity ? "cavity area, holes filled" : "lump area, holes filled",
+       result.filled_area_mm2, "mm^2"},
+      {result.cavity ? "cavity volume, holes filled" : "lump volume, holes filled",
+       result.filled_volume_mm3, "mm^3"},
+      {"region interpolated (holes filled)", {100.0 * result.filled_share, 0.0}, "%"},
       {"reference residual RMS", {result.reference.residual_rms_mm, 0.0}, "mm"}};
   if (result.baseline)
     rows.push_back({"baseline registration RMS", {result.baseline->rms_mm, 0.0}, "mm"});

@@ -30,6 +30,9 @@
 //     level line moves least with reference and noise errors and linear
 //     interpolation between stripes is exact to second order there.
 //  5. Volume: integral of d over the region (signed: > 0 for a lump).
+//  6. Holes filled: the area and volume again with every hole the surface
+//     encloses in the region filled by a thin plate through the deviation
+//     around it (hole_fill.h); flagged with the share interpolated.
 //
 // Against a baseline (MeasureLesionAgainstBaseline): the reference is an
 // earlier scan of the same face without the lesion (before it grew, before
@@ -104,6 +107,16 @@ struct LesionMeasurement {
   // 1 where stripes were lost or hidden (shadow, occlusion), and the area and
   // volume miss what lies in those holes.
   double surface_coverage = 1.0;
+  // The area and volume with the holes the measured surface encloses in the
+  // region filled by interpolation: the deviation carried into each hole
+  // from the surface around it (thin plate, least squared Laplacian). An
+  // estimate, not a measurement: `filled_share` is the share of the
+  // region's x-y area that was interpolated, and the uncertainties add the
+  // spread between the thin plate and a membrane fill. Equal to area_mm2 and
+  // volume_mm3 when the surface covers the region.
+  Measured filled_area_mm2;
+  Measured filled_volume_mm3;
+  double filled_share = 0.0;
   ReferenceSurface reference;
   int region_vertices = 0;
   // Against a baseline: how it was registered onto this surface.
