@@ -48,10 +48,6 @@ struct Lesion {
   // volume (5 %) both ways today; otherwise they are held one way (never
   // more than the truth: the uncovered part is missing).
   bool area_met, volume_met;
-  // Floors of the relative area and volume errors with the enclosed holes
-  // filled (LesionMeasurement::filled_*): the acceptance where it is met,
-  // otherwise what the chain reaches today.
-  double filled_area_floor, filled_volume_floor;
 };
 
 // Thesis 7.2, Figures 7.12-7.13: a lump on the cheek near the mouth (Table
@@ -60,13 +56,13 @@ struct Lesion {
 const Lesion kLesions[] = {
     {"cheek lump",
      {.centre_xy_mm = {-42.0, -32.0}, .height_mm = 15.0, .radius_mm = 30.0, .top_radius_mm = 12.0},
-     0.70, false, false, -0.035, -0.07},
+     0.70, false, false},
     {"forehead cavity",
      {.centre_xy_mm = {-28.0, 50.0}, .height_mm = -15.0, .radius_mm = 28.0, .top_radius_mm = 11.0},
-     0.99, true, true, -kAreaRelativeTolerance, -kVolumeRelativeTolerance},
+     0.99, true, true},
     {"cheek cavity",
      {.centre_xy_mm = {42.0, -30.0}, .height_mm = -10.0, .radius_mm = 16.0, .top_radius_mm = 7.0},
-     0.99, true, true, -kAreaRelativeTolerance, -kVolumeRelativeTolerance},
+     0.99, true, true},
 };
 
 simulator::ThesisSceneOptions SceneOptions(bool with_lesions) {
@@ -208,18 +204,17 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
       EXPECT_GT(e.volume_relative, -kVolumeRelativeTolerance);
     }
     EXPECT_GE(m.surface_coverage, lesion.min_coverage);
-    // The holes the surface encloses filled (the lump's, where lines 3-5
-    // pinch at the nasolabial fold: 11.6 % of its region; the cavities have
-    // none): filling only adds, stays below the truth's acceptance, and
-    // keeps what it reaches today (lump: area -3.0 %, volume -5.8 %; the
-    // rest of the lump's gap is open to the face's outline, not guessed).
+    // With the region's holes filled (LesionMeasurement::filled_*; the
+    // lump: 30 % of its region, where lines 3-5 pinch at the nasolabial fold
+    // and its lower outer skirt, where lines 10-13 bend and fade; flagged as
+    // interpolated; the cheek cavity: 5 % of its region, where the baseline
+    // has no surface under the measured one): the acceptance both ways for
+    // every lesion (lump area +2.0 %, volume +1.5 %). Filling only adds area.
     const double filled_area = m.filled_area_mm2.value / truth.area_on_base_mm2 - 1.0;
     const double filled_volume = m.filled_volume_mm3.value / std::abs(truth.volume_mm3) - 1.0;
     EXPECT_GE(filled_area, e.area_relative);
-    EXPECT_LT(filled_area, kAreaRelativeTolerance);
-    EXPECT_GT(filled_area, lesion.filled_area_floor);
-    EXPECT_LT(filled_volume, kVolumeRelativeTolerance);
-    EXPECT_GT(filled_volume, lesion.filled_volume_floor);
+    EXPECT_LT(std::abs(filled_area), kAreaRelativeTolerance);
+    EXPECT_LT(std::abs(filled_volume), kVolumeRelativeTolerance);
     EXPECT_LT(m.baseline->transform.translation().norm(), 0.2);  // one rig, one pose
 
     const LesionMeasurement r = MeasureLesionAgainstBaseline(surface, moved, Region(lesion));

@@ -565,6 +565,12 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
         field.value[index] = w[0] * values[0] + w[1] * values[1] + w[2] * values[2];
       }
   }
+  // Outside the region the face is undisturbed (the premise of the region
+  // and of its reference): d = 0 where no face covers a cell there, so that
+  // a hole reaching the region's boundary is enclosed too.
+  for (std::size_t i = 0; i < field.value.size(); ++i)
+    if (std::isnan(field.value[i]) && !internal::Contains(region, field.Centre(static_cast<int>(i))))
+      field.value[i] = 0.0;
   const std::vector<double> plate = internal::FillHoles(field, internal::FillKind::kThinPlate);
   const std::vector<double> membrane = internal::FillHoles(field, internal::FillKind::kMembrane);
   double plate_area = 0.0, plate_volume = 0.0, membrane_area = 0.0, membrane_volume = 0.0,

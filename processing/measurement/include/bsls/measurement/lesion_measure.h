@@ -30,9 +30,11 @@
 //     level line moves least with reference and noise errors and linear
 //     interpolation between stripes is exact to second order there.
 //  5. Volume: integral of d over the region (signed: > 0 for a lump).
-//  6. Holes filled: the area and volume again with every hole the surface
-//     encloses in the region filled by a thin plate through the deviation
-//     around it (hole_fill.h); flagged with the share interpolated.
+//  6. Holes filled: the area and volume again with every hole in the region
+//     (no surface, or no reference under it) filled by a thin plate through
+//     the deviation around it, taken as 0 outside the region where nothing
+//     was measured (the face undisturbed there: the premise of the region
+//     and its reference) (hole_fill.h); flagged with the share interpolated.
 //
 // Against a baseline (MeasureLesionAgainstBaseline): the reference is an
 // earlier scan of the same face without the lesion (before it grew, before
@@ -107,13 +109,14 @@ struct LesionMeasurement {
   // 1 where stripes were lost or hidden (shadow, occlusion), and the area and
   // volume miss what lies in those holes.
   double surface_coverage = 1.0;
-  // The area and volume with the holes the measured surface encloses in the
-  // region filled by interpolation: the deviation carried into each hole
-  // from the surface around it (thin plate, least squared Laplacian). An
-  // estimate, not a measurement: `filled_share` is the share of the
-  // region's x-y area that was interpolated, and the uncertainties add the
-  // spread between the thin plate and a membrane fill. Equal to area_mm2 and
-  // volume_mm3 when the surface covers the region.
+  // The area and volume with the region's holes (no surface, or no
+  // reference under it) filled by interpolation: the deviation carried into
+  // each hole from the surface around it and from d = 0 outside the region
+  // (thin plate, least squared Laplacian). An estimate, not a measurement:
+  // `filled_share` is the share of the region's x-y area that was
+  // interpolated, and the uncertainties add the spread between the thin
+  // plate and a membrane fill. Equal to area_mm2 and volume_mm3 when the
+  // surface covers the region.
   Measured filled_area_mm2;
   Measured filled_volume_mm3;
   double filled_share = 0.0;
