@@ -36,6 +36,10 @@ constexpr double kCollinearRatio = 0.05;
 // boundary encloses it.
 constexpr double kFillCellMm = 0.5;
 constexpr double kFillMarginMm = 4.0;
+// A larger region gets larger cells: at most this many, which bounds the
+// fill's memory and time (a 200 mm square, a whole face, at 0.5 mm; a
+// region of 80 mm radius with a quarter of it to fill takes 0.6 s here).
+constexpr double kMaxFillCells = 160000.0;
 
 int TermsOf(ReferenceKind kind) {
   switch (kind) {
@@ -536,11 +540,12 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   // (thin plate; the membrane's answer gives the spread), and the hole cells
   // inside the region added to the area and the volume.
   internal::GridField field;
-  field.cell_mm = kFillCellMm;
   field.origin = box.min() - Eigen::Vector2d::Constant(kFillMarginMm);
   const Eigen::Vector2d extent = box.sizes() + Eigen::Vector2d::Constant(2.0 * kFillMarginMm);
-  field.cols = static_cast<int>(std::ceil(extent.x() / kFillCellMm));
-  field.rows = static_cast<int>(std::ceil(extent.y() / kFillCellMm));
+  const double cell = std::max(kFillCellMm, std::sqrt(extent.prod() / kMaxFillCells));
+  field.cell_mm = cell;
+  field.cols = static_cast<int>(std::ceil(extent.x() / cell));
+  field.rows = static_cast<int>(std::ceil(extent.y() / cell));
   field.value.assign(static_cast<std::size_t>(field.cols) * field.rows,
                      std::numeric_limits<double>::quiet_NaN());
   const Eigen::AlignedBox2d grid_box(field.origin, field.origin + extent);
@@ -553,8 +558,8 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
                           b = mesh.positions[face[1]].head<2>(),
                           c = mesh.positions[face[2]].head<2>();
     if (std::abs(internal::SignedArea({a, b, c})) < 1e-12) continue;
-    const Eigen::Vector2d lo = (a.cwiseMin(b).cwiseMin(c) - field.origin) / kFillCellMm;
-    const Eigen::Vector2d hi = (a.cwiseMax(b).cwiseMax(c) - field.origin) / kFillCellMm;
+    const Eigen::Vector2d lo = (a.cwiseMin(b).cwiseMin(c) - field.origin) / cell;
+    const Eigen::Vector2d hi = (a.cwiseMax(b).cwiseMax(c) - field.origin) / cell;
     for (int r = std::max(0, static_cast<int>(std::floor(lo.y())));
          r <= std::min(field.rows - 1, static_cast<int>(std::ceil(hi.y()))); ++r)
       for (int col = std::max(0, static_cast<int>(std::floor(lo.x())));
@@ -575,7 +580,7 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   const std::vector<double> membrane = internal::FillHoles(field, internal::FillKind::kMembrane);
   double plate_area = 0.0, plate_volume = 0.0, membrane_area = 0.0, membrane_volume = 0.0,
          filled_xy = 0.0;
-  const double cell_xy = kFillCellMm * kFillCellMm;
+  const double cell_xy = cell * cell;
   for (std::size_t i = 0; i < field.value.size(); ++i) {
     if (!std::isnan(field.value[i]) || std::isnan(plate[i])) continue;  // measured, or open
     const Eigen::Vector2d xy = field.Centre(static_cast<int>(i));
