@@ -2,6 +2,7 @@
 
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
+#include <algorithm>
 #include <array>
 #include <cassert>
 #include <cmath>
@@ -35,6 +36,32 @@ bool OnBorder(const GridField& field, int index) {
 
 Eigen::Vector2d GridField::Centre(int index) const {
   return origin + cell_mm * Eigen::Vector2d(index % cols + 0.5, index / cols + 0.5);
+}
+
+std::vector<char> InsideMask(const GridField& field, const Polygon2d& polygon) {
+  std::vector<char> inside(static_cast<std::size_t>(field.cols) * field.rows, 0);
+  const int corners = static_cast<int>(polygon.size());
+  std::vector<double> crossings;
+  for (int r = 0; r < field.rows; ++r) {
+    const double y = field.origin.y() + field.cell_mm * (r + 0.5);
+    crossings.clear();
+    for (int i = 0; i < corners; ++i) {
+      const Eigen::Vector2d& a = polygon[i];
+      const Eigen::Vector2d& b = polygon[(i + 1) % corners];
+      if ((a.y() > y) != (b.y() > y))
+        crossings.push_back(a.x() + (y - a.y()) * (b.x() - a.x()) / (b.y() - a.y()));
+    }
+    std::sort(crossings.begin(), crossings.end());
+    for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
+      // Cells whose centre x lies in [crossings[k], crossings[k + 1]).
+      const double first = (crossings[k] - field.origin.x()) / field.cell_mm - 0.5;
+      const double last = (crossings[k + 1] - field.origin.x()) / field.cell_mm - 0.5;
+      const int c0 = std::max(0, static_cast<int>(std::ceil(first)));
+      const int c1 = std::min(field.cols - 1, static_cast<int>(std::ceil(last)) - 1);
+      for (int c = c0; c <= c1; ++c) inside[static_cast<std::size_t>(r) * field.cols + c] = 1;
+    }
+  }
+  return inside;
 }
 
 std::vector<int> EnclosedHoles(const GridField& field) {

@@ -15,6 +15,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "bsls/measurement/surface_query.h"
+
 namespace bsls::measurement::internal {
 
 // A scalar field on cols x rows square cells; cell (c, r) is centred at
@@ -30,6 +32,10 @@ struct GridField {
 };
 
 enum class FillKind { kMembrane, kThinPlate };
+
+// 1 for every cell of `field`'s grid whose centre lies inside `polygon`
+// (even-odd rule, as internal::Contains), by scanlines: O(rows x corners).
+std::vector<char> InsideMask(const GridField& field, const Polygon2d& polygon);
 
 // The unknown cells of `field` that form holes: 4-connected sets of unknown
 // cells that touch no border of the grid (the known cells enclose them),
