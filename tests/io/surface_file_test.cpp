@@ -192,6 +192,15 @@ TEST(ReadPly, TruncatedAndCorruptFilesFailClearly) {
       "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n",
       "face 0 refers to vertex 7");
   expect_error("ply\nformat binary_middle_endian 1.0\nend_header\n", "unknown format");
+  // 8 MiB of blank header lines: refused at 1 MiB (parsing them all took
+  // seconds, minutes under the sanitizers).
+  std::string padded = good;
+  padded.insert(4, std::string(8 << 20, '\n'));
+  expect_error(padded, "header runs past 1024 KiB");
+  // Words are split on any white space; a header with tabs and padding reads.
+  std::string spaced = good;
+  spaced.replace(spaced.find("format "), 7, "format\t  ");
+  EXPECT_EQ(DecodePly(spaced, "spaced.ply").positions.size(), 20u);
 }
 
 TEST(ReadPly, MissingFileNamesIt) {

@@ -166,6 +166,9 @@ class BodyReader {
   std::size_t pos_ = 0;
 };
 
+// Longest PLY header read (bytes); comments included.
+constexpr std::size_t kMaxPlyHeaderBytes = 1 << 20;
+
 // The next header line (without the line end), advancing `pos`.
 std::optional<std::string_view> NextLine(std::string_view bytes, std::size_t* pos) {
   if (*pos >= bytes.size()) return std::nullopt;
@@ -177,10 +180,15 @@ std::optional<std::string_view> NextLine(std::string_view bytes, std::size_t* po
   return line;
 }
 
+// The whitespace-separated words of `line`.
 std::vector<std::string> Words(std::string_view line) {
-  std::istringstream in{std::string(line)};
+  constexpr std::string_view kSpace = " \t\r\f\v";
   std::vector<std::string> words;
-  for (std::string w; in >> w;) words.push_back(w);
+  for (std::size_t at = line.find_first_not_of(kSpace); at != std::string_view::npos;) {
+    const std::size_t end = std::min(line.find_first_of(kSpace, at), line.size());
+    words.emplace_back(line.substr(at, end - at));
+    at = line.find_first_not_of(kSpace, end);
+  }
   return words;
 }
 
@@ -321,6 +329,10 @@ geometry::SurfaceMesh DecodePly(std::string_view bytes, const std::string& name)
   std::vector<Element> elements;
   bool ended = false;
   while (!ended) {
+    // A header is a few hundred bytes; one of megabytes is not a surface's.
+    if (pos > kMaxPlyHeaderBytes)
+      throw header_error("the header runs past " + std::to_string(kMaxPlyHeaderBytes >> 10) +
+                         " KiB without an end_header line");
     line = NextLine(bytes, &pos);
     if (!line) throw header_error("the header has no end_header line");
     const std::vector<std::string> w = Words(*line);
@@ -440,12 +452,12 @@ geometry::SurfaceMesh DecodePly(std::string_view bytes, const std::string& name)
           mesh.uncertainty_mm[v] = static_cast<float>(sigma);
         }
         if (iline >= 0) {
-          const double line = values[iline];
-          if (!(line >= std::numeric_limits<std::int32_t>::min() &&
-                line <= std::numeric_limits<std::int32_t>::max()) ||
-              line != std::floor(line))
+          const double p = values[iline];
+          if (!(p >= std::numeric_limits<std::int32_t>::min() &&
+                p <= std::numeric_limits<std::int32_t>::max()) ||
+              p != std::floor(p))
             body.Fail("line is not a 32-bit integer in " + what);
-          mesh.line[v] = static_cast<std::int32_t>(line);
+          mesh.line[v] = static_cast<std::int32_t>(p);
         }
         if (iflags >= 0) {
           const double flags = values[iflags];
