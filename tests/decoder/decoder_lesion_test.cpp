@@ -8,14 +8,8 @@
 #include "bsls/decoder/decoder.h"
 #include "decoder_evaluation.h"
 
-namespace bsls::decoder {
+namespace bsls::decoder::test {
 namespace {
-
-using pattern::Side;
-using simulator::SurfaceKind;
-using test::Evaluate;
-using test::Evaluation;
-using test::kNoiseSigma;
 
 // The thesis's lesions (Tables 7.3-7.4: a lump on the cheek, cavities above
 // the eyebrow and on the other cheek) on the face, left side, rendered once.
@@ -78,4 +72,4 @@ TEST_F(LesionFace, SteepLinesKeepTheRowsLeaningAwayFromASegment) {
 }
 
 }  // namespace
-}  // namespace bsls::decoder
+}  // namespace bsls::decoder::test

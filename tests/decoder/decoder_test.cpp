@@ -12,16 +12,8 @@
 #include "bsls/decoder/decode_output.h"
 #include "decoder_evaluation.h"
 
-namespace bsls::decoder {
+namespace bsls::decoder::test {
 namespace {
-
-using pattern::Side;
-using simulator::SurfaceKind;
-using test::Evaluate;
-using test::Evaluation;
-using test::kMatchReach;
-using test::kNoiseSigma;
-using test::RenderFrame;
 
 struct SceneCase {
   SurfaceKind kind;
@@ -259,4 +251,4 @@ TEST(Decoder, InvalidInputIsRejectedWithReason) {
 }
 
 }  // namespace
-}  // namespace bsls::decoder
+}  // namespace bsls::decoder::test

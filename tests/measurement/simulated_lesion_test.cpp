@@ -205,6 +205,26 @@ geometry::SurfaceMesh WithoutFaces(geometry::SurfaceMesh mesh,
   return mesh;
 }
 
+// Relative errors of a measurement's area and volume, measured and filled.
+struct Relative {
+  double area_measured, area_filled, volume_measured, volume_filled;
+};
+
+// The errors of `m` against `truth`, printed under `what`.
+Relative RelativeErrors(const char* what, const LesionMeasurement& m,
+                        const simulator::LesionTruth& truth) {
+  const double area = truth.area_on_base_mm2, volume = std::abs(truth.volume_mm3);
+  const Relative e{m.area_mm2.value / area - 1.0, m.filled_area_mm2.value / area - 1.0,
+                   m.volume_mm3.value / volume - 1.0, m.filled_volume_mm3.value / volume - 1.0};
+  std::printf(
+      "%s: area measured %+.1f %%, filled %+.1f +- %.1f %% (%.1f %% of the region "
+      "interpolated); volume measured %+.1f %%, filled %+.1f %%\n",
+      what, 100.0 * e.area_measured, 100.0 * e.area_filled,
+      100.0 * m.filled_area_mm2.uncertainty / area, 100.0 * m.filled_share,
+      100.0 * e.volume_measured, 100.0 * e.volume_filled);
+  return e;
+}
+
 // Stripes lost over a stretch across the thesis lump's half-height contour
 // (a hole of 16 x 20 mm the surface encloses): the measured area and volume
 // miss what lies in it, the filled ones carry the lump's flank across it
@@ -235,18 +255,10 @@ TEST(SimulatedLesionTest, HolesInTheRegionAreFilledAndFlagged) {
   });
   const SurfaceQuery holed(holed_mesh);
   const LesionMeasurement m = MeasureLesion(holed, region, params);
-  const double measured = m.area_mm2.value / truth.area_on_base_mm2 - 1.0;
-  const double filled = m.filled_area_mm2.value / truth.area_on_base_mm2 - 1.0;
-  const double filled_volume = m.filled_volume_mm3.value / std::abs(truth.volume_mm3) - 1.0;
-  std::printf(
-      "hole of %.0f mm^2: area measured %+.1f %%, filled %+.1f +- %.1f %% (%.1f %% of the region "
-      "interpolated); volume measured %+.1f %%, filled %+.1f %%\n",
-      m.filled_share * region_xy, 100.0 * measured, 100.0 * filled,
-      100.0 * m.filled_area_mm2.uncertainty / truth.area_on_base_mm2, 100.0 * m.filled_share,
-      100.0 * (m.volume_mm3.value / std::abs(truth.volume_mm3) - 1.0), 100.0 * filled_volume);
-  EXPECT_LT(measured, -0.05);  // the hole matters
-  EXPECT_LT(std::abs(filled), kAreaRelativeTolerance);
-  EXPECT_LT(std::abs(filled_volume), kVolumeRelativeTolerance);
+  const Relative hole = RelativeErrors("hole", m, truth);
+  EXPECT_LT(hole.area_measured, -0.05);  // the hole matters
+  EXPECT_LT(std::abs(hole.area_filled), kAreaRelativeTolerance);
+  EXPECT_LT(std::abs(hole.volume_filled), kVolumeRelativeTolerance);
   EXPECT_NEAR(m.filled_share * region_xy, 16.0 * 20.0, 60.0);  // the hole, but a few cells
   EXPECT_GT(m.filled_area_mm2.uncertainty, m.area_mm2.uncertainty);
   EXPECT_EQ(ToJson(m)["holes_filled"]["share_of_region"], m.filled_share);
@@ -261,19 +273,11 @@ TEST(SimulatedLesionTest, HolesInTheRegionAreFilledAndFlagged) {
       whole, [&](const Eigen::Vector2d& xy) { return xy.x() < centre.x() - 10.0; });
   const SurfaceQuery cut(cut_mesh);
   const LesionMeasurement edge = MeasureLesion(cut, region, params);
-  const double edge_measured = edge.area_mm2.value / truth.area_on_base_mm2 - 1.0;
-  const double edge_filled = edge.filled_area_mm2.value / truth.area_on_base_mm2 - 1.0;
-  const double edge_volume = edge.filled_volume_mm3.value / std::abs(truth.volume_mm3) - 1.0;
-  std::printf(
-      "open to the region's boundary: area measured %+.1f %%, filled %+.1f +- %.1f %% (%.1f %% "
-      "of the region interpolated); volume filled %+.1f %%\n",
-      100.0 * edge_measured, 100.0 * edge_filled,
-      100.0 * edge.filled_area_mm2.uncertainty / truth.area_on_base_mm2,
-      100.0 * edge.filled_share, 100.0 * edge_volume);
+  const Relative open = RelativeErrors("open to the region's boundary", edge, truth);
   EXPECT_LT(edge.surface_coverage, 0.75);
-  EXPECT_LT(edge_measured, -0.2);
-  EXPECT_LT(std::abs(edge_filled), kAreaRelativeTolerance);
-  EXPECT_LT(std::abs(edge_volume), kVolumeRelativeTolerance);
+  EXPECT_LT(open.area_measured, -0.2);
+  EXPECT_LT(std::abs(open.area_filled), kAreaRelativeTolerance);
+  EXPECT_LT(std::abs(open.volume_filled), kVolumeRelativeTolerance);
   EXPECT_NEAR(edge.filled_share, 1.0 - edge.surface_coverage, 0.02);
   EXPECT_GT(edge.filled_area_mm2.uncertainty, m.filled_area_mm2.uncertainty);
 }
