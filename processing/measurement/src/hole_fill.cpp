@@ -94,14 +94,14 @@ std::vector<int> EnclosedHoles(const GridField& field) {
   return label;
 }
 
-std::vector<double> FillHoles(const GridField& field, FillKind kind) {
+FilledField FillHoles(const GridField& field) {
   const int n = field.cols * field.rows;
   const std::vector<int> hole = EnclosedHoles(field);
   std::vector<int> unknown_index(n, -1);
   int unknowns = 0;
   for (int i = 0; i < n; ++i)
     if (hole[i] != kOpen) unknown_index[i] = unknowns++;
-  std::vector<double> out = field.value;
+  FilledField out{field.value, field.value};
   if (unknowns == 0) return out;
 
   // One row per 5-point Laplacian: u(N) + u(S) + u(E) + u(W) - 4 u(centre),
@@ -125,37 +125,40 @@ std::vector<double> FillHoles(const GridField& field, FillKind kind) {
       if (unknown_index[cells[k]] >= 0) entries.emplace_back(row, unknown_index[cells[k]], weights[k]);
     rhs.push_back(b);
   };
+  // The membrane's equations first, one per hole cell in the unknowns'
+  // order (a square system); then, for the thin plate, the known cells on a
+  // hole's rim: their Laplacian, too, is kept small, which carries the slope
+  // across the rim.
+  for (int i = 0; i < n; ++i)
+    if (unknown_index[i] >= 0) add_row(i);
+  const int membrane_rows = static_cast<int>(rhs.size());
   for (int i = 0; i < n; ++i) {
-    if (unknown_index[i] >= 0) {
-      add_row(i);  // every hole cell: the membrane's equations
-    } else if (kind == FillKind::kThinPlate && Known(field, i)) {
-      // Known cells on a hole's rim: their Laplacian, too, is kept small,
-      // which carries the slope across the rim.
-      for (int next : Neighbours(field, i))
-        if (unknown_index[next] >= 0) {
-          add_row(i);
-          break;
-        }
-    }
+    if (unknown_index[i] >= 0 || !Known(field, i)) continue;
+    for (int next : Neighbours(field, i))
+      if (unknown_index[next] >= 0) {
+        add_row(i);
+        break;
+      }
   }
   Eigen::SparseMatrix<double> a(static_cast<int>(rhs.size()), unknowns);
   a.setFromTriplets(entries.begin(), entries.end());
   const Eigen::VectorXd b = Eigen::Map<const Eigen::VectorXd>(rhs.data(), rhs.size());
-  Eigen::VectorXd u;
-  if (kind == FillKind::kMembrane) {
-    // Square: one equation per hole cell, every neighbour in the hole or known.
-    Eigen::SparseMatrix<double> negated = -a;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(negated);
-    assert(solver.info() == Eigen::Success);  // -Laplacian with Dirichlet rim: positive definite
-    u = solver.solve(-b);
-  } else {
-    const Eigen::SparseMatrix<double> normal = a.transpose() * a;
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(normal);
-    assert(solver.info() == Eigen::Success);  // holds the membrane's full-rank rows
-    u = solver.solve(a.transpose() * b);
-  }
+
+  // Membrane: -Laplacian with a Dirichlet rim, positive definite.
+  const Eigen::SparseMatrix<double> negated = -a.topRows(membrane_rows);
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> membrane(negated);
+  assert(membrane.info() == Eigen::Success);
+  const Eigen::VectorXd um = membrane.solve(-b.head(membrane_rows));
+  // Thin plate: least squares over all rows (holds the membrane's full-rank ones).
+  const Eigen::SparseMatrix<double> normal = a.transpose() * a;
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> plate(normal);
+  assert(plate.info() == Eigen::Success);
+  const Eigen::VectorXd up = plate.solve(a.transpose() * b);
   for (int i = 0; i < n; ++i)
-    if (unknown_index[i] >= 0) out[i] = u[unknown_index[i]];
+    if (unknown_index[i] >= 0) {
+      out.thin_plate[i] = up[unknown_index[i]];
+      out.membrane[i] = um[unknown_index[i]];
+    }
   return out;
 }
 

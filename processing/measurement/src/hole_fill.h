@@ -31,8 +31,6 @@ struct GridField {
   Eigen::Vector2d Centre(int index) const;
 };
 
-enum class FillKind { kMembrane, kThinPlate };
-
 // 1 for every cell of `field`'s grid whose centre lies inside `polygon`
 // (even-odd rule, as internal::Contains), by scanlines: O(rows x corners).
 std::vector<char> InsideMask(const GridField& field, const Polygon2d& polygon);
@@ -42,9 +40,14 @@ std::vector<char> InsideMask(const GridField& field, const Polygon2d& polygon);
 // each with a label >= 0 (-1: known, or unknown but open to the border).
 std::vector<int> EnclosedHoles(const GridField& field);
 
-// `field` with the cells of every enclosed hole (EnclosedHoles) interpolated
-// by `kind` from the known cells around it; open unknown cells stay NaN.
-std::vector<double> FillHoles(const GridField& field, FillKind kind);
+// `field`'s values with the cells of every enclosed hole (EnclosedHoles)
+// interpolated from the known cells around it, both ways; open unknown cells
+// stay NaN.
+struct FilledField {
+  std::vector<double> thin_plate;
+  std::vector<double> membrane;
+};
+FilledField FillHoles(const GridField& field);
 
 }  // namespace bsls::measurement::internal
 

@@ -582,8 +582,9 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   // a hole reaching the region's boundary is enclosed too.
   for (std::size_t i = 0; i < field.value.size(); ++i)
     if (std::isnan(field.value[i]) && !in_region[i]) field.value[i] = 0.0;
-  const std::vector<double> plate = internal::FillHoles(field, internal::FillKind::kThinPlate);
-  const std::vector<double> membrane = internal::FillHoles(field, internal::FillKind::kMembrane);
+  const internal::FilledField filled = internal::FillHoles(field);
+  const std::vector<double>& plate = filled.thin_plate;
+  const std::vector<double>& membrane = filled.membrane;
   double plate_area = 0.0, plate_volume = 0.0, membrane_area = 0.0, membrane_volume = 0.0,
          filled_xy = 0.0;
   const double cell_xy = cell * cell;
