@@ -135,5 +135,43 @@ TEST(CornerExtension, AShortSegmentTwoRowPitchesFromTheLastJunctionIsAHook) {
   EXPECT_TRUE(far.Extend().empty());
 }
 
+// The chin's bottom row: a line leaning 27 degrees from vertical down to a
+// corner where the outline cut it, its 9 px segment leaving on the side the
+// pattern puts there (the junction one row pitch above has its segment on
+// the other side). Line and segment meet at ~60 degrees, so the stub's first
+// pixel beyond the corner touches the segment's first pixel.
+struct LeaningPatternCorner {
+  cv::Mat skeleton = cv::Mat::zeros(80, 80, CV_8UC1);
+  cv::Mat mask = cv::Mat::zeros(80, 80, CV_8UC1);
+  static int LineX(int row) { return 30 + (60 - row) / 2; }
+  LeaningPatternCorner() {
+    cv::line(skeleton, {LineX(4), 4}, {30, 60}, 255);  // the line, down to the corner
+    cv::line(skeleton, {30, 60}, {21, 60}, 255);       // the corner's segment, to the left
+    for (int row = 47, side = +1; row >= 8; row -= 13, side = -side)
+      cv::line(skeleton, {LineX(row), row}, {LineX(row) + 12 * side, row}, 255);
+    // The line's stroke goes on below the corner, as the segment's does.
+    cv::line(mask, {LineX(0), 0}, {LineX(76), 76}, 255, 3);
+    cv::rectangle(mask, cv::Rect(14, 59, 17, 3), 255, cv::FILLED);
+    mask |= skeleton;
+  }
+};
+
+TEST(CornerExtension, ALineMeetingItsSegmentAtASharpAngleWhereThePatternPutsATTakesAStub) {
+  LeaningPatternCorner chin;
+  const std::vector<cv::Point> corners =
+      ExtendCorners(SkeletonGraph::Build(chin.skeleton), {}, chin.skeleton, chin.mask);
+  ASSERT_EQ(corners.size(), 1u);
+  EXPECT_NEAR(corners[0].x, 30, 1);
+  EXPECT_NEAR(corners[0].y, 60, 1);
+  // The stub goes on down along the line, below the segment.
+  EXPECT_GT(cv::countNonZero(chin.skeleton(cv::Rect(26, 61, 5, 4))), 0);
+  const SkeletonGraph g = SkeletonGraph::Build(chin.skeleton);
+  const JunctionNetwork net(g, pattern::Side::kLeft);
+  int t_junctions = 0;
+  for (int n = 0; n < static_cast<int>(g.nodes().size()); ++n)
+    if (net.IsPatternJunction(n) && std::abs(g.nodes()[n].centre.y - 60) < 2) ++t_junctions;
+  EXPECT_EQ(t_junctions, 1);
+}
+
 }  // namespace
 }  // namespace bsls::interpretation

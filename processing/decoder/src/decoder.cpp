@@ -369,6 +369,13 @@ JunctionPlan PlanJunction(const LineCentres& line, const interpretation::Labelle
        i < n - 2 * n_binning && static_cast<int>(plan.columns.size()) < params.segment_fit_columns;
        ++i) {
     const cv::Point& s = j.segment[i];
+    // Where the segment's skeleton turns into a line (its far end unlit,
+    // the chain goes on along the neighbour line's lit stretch) its columns
+    // end: beyond, they measure that line.
+    if (i >= 3 * n_binning) {
+      const cv::Point back = j.segment[i - 3 * n_binning];
+      if (std::abs(s.y - back.y) > std::abs(s.x - back.x)) break;
+    }
     if (std::abs(s.x - plan.a) <= params.junction_clearance) continue;
     plan.columns.push_back(s);
   }
@@ -386,6 +393,22 @@ struct ColumnCentres {
     return centres[static_cast<size_t>(it - keys.begin())];
   }
 };
+
+// Drops from `columns` ((x, y) pairs) the one furthest from the line fitted
+// through the others when it lies more than `max_residual` from it.
+void DropWorstColumn(std::vector<std::pair<double, double>>& columns, double max_residual) {
+  double c, e;
+  if (!FitLine(columns, &c, &e)) return;
+  const auto residual = [&](const std::pair<double, double>& p) {
+    return std::abs(p.second - c - e * p.first);
+  };
+  const auto worst = std::max_element(
+      columns.begin(), columns.end(),
+      [&](const auto& l, const auto& r) { return residual(l) < residual(r); });
+  std::vector<std::pair<double, double>> others(columns.begin(), worst);
+  others.insert(others.end(), worst + 1, columns.end());
+  if (FitLine(others, &c, &e) && residual(*worst) > max_residual) columns = std::move(others);
+}
 
 // The junction where the line's centre curve meets the segment's: the line's
 // measured centres near the junction fitted as x(y), the segment's centres
@@ -412,6 +435,11 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
       if (const std::optional<double>& cy = columns.At(s)) measured.push_back({s.x - a, *cy});
     }
     double c, e;
+    // A column far off the line through the others is dropped: where a line
+    // leans towards the segment's side below or above the junction, its
+    // light reaches into the column profiles nearest to it (one in a short
+    // segment of 5 columns moved the chin's corner junctions 4 px).
+    if (measured.size() >= 4) DropWorstColumn(measured, 2.0 * params.max_centre_residual);
     const bool fitted = (measured.size() >= 2 && FitLine(measured, &c, &e)) ||
                         (skeleton.size() >= 2 && FitLine(skeleton, &c, &e));
     if (fitted) {

@@ -189,8 +189,9 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
       const double segment_dx = px[std::clamp(c.index + step * params.leg, 0, n - 1)].x -
                                 px[c.index].x;
       const int line_end = c.segment_after ? edge.from : edge.to;
+      const bool pattern = in_pattern(px[c.index], segment_dx, line_end);
       if (!segment_ends_on_line(c.index, step, line_leaves_frame(px[c.index], c.vertical),
-                                in_pattern(px[c.index], segment_dx, line_end)))
+                                pattern))
         continue;
       // A rounded corner passes the leg test a few pixels before its apex:
       // the corner is the pixel farthest from the chord across the bend.
@@ -204,7 +205,16 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
         if (d > farthest) farthest = d, apex = k;
       }
       const cv::Point corner = px[apex];
-      if (AddStub(corner, c.vertical, {corner}, params, skeleton, stripe_mask))
+      // Where the pattern puts a junction, the chain's pixels next to the
+      // apex count as the corner's own: a line meeting its segment at a
+      // sharp angle (the chin's bottom row) has the segment's first pixel
+      // beside the stub's first. Elsewhere a stub touching them would join
+      // strokes the pattern does not (whole stretches then take wrong rows).
+      std::vector<cv::Point> own{corner};
+      if (pattern)
+        for (int k = std::max(0, apex - 2); k <= std::min(n - 1, apex + 2); ++k)
+          if (k != apex) own.push_back(px[k]);
+      if (AddStub(corner, c.vertical, own, params, skeleton, stripe_mask))
         corners.push_back(corner);
     }
   }
