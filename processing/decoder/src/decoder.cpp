@@ -371,8 +371,9 @@ JunctionPlan PlanJunction(const LineCentres& line, const interpretation::Labelle
     const cv::Point& s = j.segment[i];
     // Where the segment's skeleton turns into a line (its far end unlit,
     // the chain goes on along the neighbour line's lit stretch) its columns
-    // end: beyond, they measure that line.
-    if (i >= 3 * n_binning) {
+    // end: beyond, they measure that line. (Not before the first column:
+    // next to the junction the skeleton may bend into the line.)
+    if (!plan.columns.empty() && i >= 3 * n_binning) {
       const cv::Point back = j.segment[i - 3 * n_binning];
       if (std::abs(s.y - back.y) > std::abs(s.x - back.x)) break;
     }
