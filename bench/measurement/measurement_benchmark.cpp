@@ -20,7 +20,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
+#include <numbers>
 #include <vector>
 
 #include "bsls/decoder/decoder.h"
@@ -79,7 +81,7 @@ const Side3d& Face(bool with_lump) {
 bsls::measurement::Polygon2d Region() {
   bsls::measurement::Polygon2d region;
   for (int i = 0; i < 64; ++i) {
-    const double a = 2.0 * 3.14159265358979 * i / 64;
+    const double a = 2.0 * std::numbers::pi * i / 64;
     region.push_back(kLump.centre_xy_mm +
                      (kLump.radius_mm + 2.0) * Eigen::Vector2d(std::cos(a), std::sin(a)));
   }
