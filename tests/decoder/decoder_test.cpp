@@ -211,6 +211,41 @@ TEST(Decoder, ThesisSizeFrameIsNotBinned) {
   EXPECT_EQ(r.binning, 1);
 }
 
+// The dark columns beside a face or a plane are left out of extraction and
+// interpretation (DecodeParams::region_rise): the same junctions, labels and
+// centres as from the whole frame.
+TEST(Decoder, ColumnsBesideThePatternAreLeftOutWithTheSameResult) {
+  struct Case {
+    SurfaceKind kind;
+    Side side;
+    std::uint32_t seed;
+  };
+  for (const Case& c : {Case{SurfaceKind::kFace, Side::kLeft, 1},
+                        Case{SurfaceKind::kFace, Side::kRight, 3},
+                        Case{SurfaceKind::kPlane, Side::kLeft, 3}}) {
+    SCOPED_TRACE(std::string(simulator::ToString(c.kind)) + " " +
+                 std::string(pattern::ToString(c.side)));
+    const simulator::Frame frame = RenderFrame(c.kind, c.side, c.seed);
+    const DecodeResult cut = Decode(frame.image, c.side);
+    DecodeParams whole_frame;
+    whole_frame.region_rise = 0.0;
+    const DecodeResult whole = Decode(frame.image, c.side, whole_frame);
+    ASSERT_TRUE(cut.ok && whole.ok);
+    EXPECT_EQ(whole.region, cv::Rect(0, 0, frame.image.cols, frame.image.rows));
+    EXPECT_EQ(cut.region.height, frame.image.rows);
+    EXPECT_LT(cut.region.width, 0.85 * frame.image.cols);
+    // Every junction the truth sees lies inside the columns kept.
+    for (const simulator::PointLabel& j : simulator::VisibleJunctions(frame.truth))
+      EXPECT_TRUE(cut.region.contains(cv::Point(cvRound(j.position.x), cvRound(j.position.y))));
+    const Evaluation a = Evaluate(frame, cut), b = Evaluate(frame, whole);
+    EXPECT_EQ(a.all.found, b.all.found);
+    EXPECT_EQ(a.all.Wrong(), 0);
+    EXPECT_EQ(a.line_points, b.line_points);
+    EXPECT_NEAR(a.line_rms, b.line_rms, 1e-3);
+    EXPECT_EQ(cut.skeleton.size(), frame.image.size());
+  }
+}
+
 TEST(Decoder, ThesisChainStillLabelsAPlaneRightly) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kPlane, Side::kLeft, 3);
   DecodeParams params;

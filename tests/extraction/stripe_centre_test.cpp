@@ -98,6 +98,83 @@ TEST(StripeCentre, NeighbouringStripesThirteenPixelsApartBarelyBias) {
   }
 }
 
+// Stripes 4-6 px apart, as lines crowd where a fold turns the face away
+// (thesis 5.1.4.8): measured one by one, each is pulled towards its
+// neighbours by their light; fitted jointly, each comes out where it is.
+// Three stripes 2 px wide (the simulated faces' lines), noise sigma 3,
+// 100 rows each.
+TEST(StripeCentre, CrowdedStripesFittedJointlyAreNotPulledByTheirNeighbours) {
+  for (double gap : {4.0, 5.0, 6.0}) {
+    const double truth[3] = {20.3, 20.3 + gap, 20.3 + 2.0 * gap - 0.4};
+    std::vector<double> clean(48, kBackground);
+    for (double c : truth) {
+      const auto one = testing::RenderStripeProfile(48, c, 2.0, kPsf, 0.0, kContrast);
+      for (size_t i = 0; i < clean.size(); ++i) clean[i] += one[i];
+    }
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, kNoise);
+    cv::Mat image(100, 48, CV_8UC1);
+    for (int y = 0; y < image.rows; ++y)
+      for (int x = 0; x < image.cols; ++x)
+        image.at<uchar>(y, x) = cv::saturate_cast<uchar>(clean[static_cast<size_t>(x)] + noise(rng));
+    double joint_sq = 0.0, single_sq = 0.0;
+    int joint_found = 0, single_found = 0;
+    for (int y = 0; y < image.rows; ++y) {
+      // Approximate positions as a skeleton gives them: whole pixels.
+      const std::vector<double> guess = {std::round(truth[0]), std::round(truth[1]),
+                                         std::round(truth[2])};
+      const auto joint = StripeCentresInRow(image, y, guess);
+      ASSERT_EQ(joint.size(), 3u);
+      for (int j = 0; j < 3; ++j) {
+        if (joint[static_cast<size_t>(j)]) {
+          ++joint_found;
+          joint_sq += std::pow(*joint[static_cast<size_t>(j)] - truth[j], 2);
+        }
+        if (const auto one = StripeCentreInRow(image, y, guess[static_cast<size_t>(j)])) {
+          ++single_found;
+          single_sq += std::pow(*one - truth[j], 2);
+        }
+      }
+    }
+    const double joint_rms = std::sqrt(joint_sq / std::max(joint_found, 1));
+    const double single_rms = std::sqrt(single_sq / std::max(single_found, 1));
+    std::printf("[ figures  ] gap %.0f px: joint fit %d of 300, RMS %.3f px; one by one %d, RMS %.3f px\n",
+                gap, joint_found, joint_rms, single_found, single_rms);
+    EXPECT_GE(joint_found, 297) << gap;
+    EXPECT_LT(joint_rms, 0.15) << gap;
+    // 6 px apart the stripes barely touch and one by one works as well.
+    if (gap < 6.0) {
+      EXPECT_LT(joint_rms, 0.5 * single_rms) << gap;
+    }
+  }
+  // A single stripe: the joint fit of one is as good as the profile method.
+  const cv::Mat one = testing::RenderSlantedStripe({48, 40}, 20.6, 0.0, 3.0, kPsf, kBackground,
+                                                   kContrast, kNoise, 3);
+  for (int y = 0; y < one.rows; ++y) {
+    const double guess[1] = {21.0};
+    const auto c = StripeCentresInRow(one, y, guess);
+    ASSERT_TRUE(c[0].has_value()) << y;
+    EXPECT_NEAR(*c[0], 20.6, 0.25) << y;
+  }
+}
+
+// No stripe where the fit is asked for one: nothing comes back, and
+// positions outside the image or out of order are refused.
+TEST(StripeCentre, CrowdedFitAnswersOnlyForRealStripes) {
+  cv::Mat flat(20, 40, CV_8UC1, cv::Scalar(30));
+  const double guess[2] = {15.0, 20.0};
+  for (const auto& c : StripeCentresInRow(flat, 5, guess)) EXPECT_FALSE(c.has_value());
+  const double outside[2] = {-2.0, 5.0};
+  for (const auto& c : StripeCentresInRow(flat, 5, outside)) EXPECT_FALSE(c.has_value());
+  const double reversed[2] = {20.0, 15.0};
+  ExpectInvalid([&] { StripeCentresInRow(flat, 5, reversed); }, "StripeCentresInRow");
+  ExpectInvalid([&] { StripeCentresInRow(flat, 20, guess); }, "StripeCentresInRow");
+  const double not_a_number[2] = {15.0, std::nan("")};
+  ExpectInvalid([&] { StripeCentresInRow(flat, 5, not_a_number); }, "StripeCentresInRow");
+  ExpectInvalid([&] { StripeCentresInRow(flat, 5, std::span<const double>()); },
+                "StripeCentresInRow");
+}
+
 TEST(StripeCentre, ProfileMeasurementReportsWidthAndContrast) {
   const auto p = testing::RenderStripeProfile(60, 25.25, 6.0, kPsf, kBackground, kContrast);
   const auto m = MeasureStripeProfile(p, 26.0, {});

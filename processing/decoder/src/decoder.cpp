@@ -152,6 +152,91 @@ std::vector<std::pair<double, double>> RowsNear(const RowValues& rows, double ce
   return out;
 }
 
+// Thesis 5.1.4.8, measured: the rows where labelled lines crowd (folds
+// that turn the face away squeeze neighbouring lines to a few pixels), each
+// row's crowd fitted once, jointly (extraction::StripeCentresInRow), so
+// that a line's centre there is not pulled by its neighbours' light.
+struct CrowdedRows {
+  struct Row {
+    std::vector<int> p;                   // the crowding lines, left to right
+    std::vector<std::optional<double>> x;  // their centres (nullopt: no proper ridge)
+    bool Has(int line) const { return std::find(p.begin(), p.end(), line) != p.end(); }
+    // The joint fit's centre of `line` (a member), nullopt where it failed.
+    std::optional<double> At(int line) const {
+      return x[static_cast<size_t>(std::find(p.begin(), p.end(), line) - p.begin())];
+    }
+  };
+  std::map<int, std::vector<Row>> rows;  // image row -> its crowds
+
+  // The crowd of line `p` in row y; nullptr where the line is alone.
+  const Row* Find(int y, int p) const {
+    const auto it = rows.find(y);
+    if (it == rows.end()) return nullptr;
+    for (const Row& row : it->second)
+      if (row.Has(p)) return &row;
+    return nullptr;
+  }
+};
+
+// Every row where the skeletons of two or more labelled lines pass within
+// crowd_distance of each other (each line's skeleton a narrow run there:
+// at most 2n px), grouped into chains of neighbours and fitted jointly.
+CrowdedRows MeasureCrowdedRows(const cv::Mat& grey,
+                               const std::vector<interpretation::LabelledLine>& lines,
+                               const DecodeParams& params, int n) {
+  // Row -> (x, p): the middle of each line's skeleton run there.
+  std::vector<std::vector<std::pair<double, int>>> at_row(static_cast<size_t>(grey.rows));
+  for (const interpretation::LabelledLine& line : lines) {
+    if (line.pixels.empty()) continue;
+    int top = grey.rows, bottom = -1;
+    for (const cv::Point& q : line.pixels) {
+      top = std::min(top, q.y);
+      bottom = std::max(bottom, q.y);
+    }
+    std::vector<std::pair<int, int>> span(static_cast<size_t>(bottom - top + 1),
+                                          {std::numeric_limits<int>::max(), -1});
+    for (const cv::Point& q : line.pixels) {
+      auto& [lo, hi] = span[static_cast<size_t>(q.y - top)];
+      lo = std::min(lo, q.x);
+      hi = std::max(hi, q.x);
+    }
+    for (int y = top; y <= bottom; ++y) {
+      const auto [lo, hi] = span[static_cast<size_t>(y - top)];
+      if (hi >= lo && hi - lo <= 2 * n)
+        at_row[static_cast<size_t>(y)].emplace_back(0.5 * (lo + hi), line.p);
+    }
+  }
+  std::vector<std::pair<int, CrowdedRows::Row>> crowds;  // (row, crowd) to fit
+  for (int y = 0; y < grey.rows; ++y) {
+    std::vector<std::pair<double, int>>& found = at_row[static_cast<size_t>(y)];
+    std::sort(found.begin(), found.end());
+    for (size_t i = 0; i < found.size();) {
+      size_t j = i + 1;
+      while (j < found.size() && found[j].first - found[j - 1].first <= params.crowd_distance) ++j;
+      if (j - i >= 2) {
+        CrowdedRows::Row row;
+        for (size_t k = i; k < j; ++k) row.p.push_back(found[k].second);
+        crowds.emplace_back(y, std::move(row));
+      }
+      i = j;
+    }
+  }
+  cv::parallel_for_(cv::Range(0, static_cast<int>(crowds.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      auto& [y, row] = crowds[static_cast<size_t>(i)];
+      const std::vector<std::pair<double, int>>& found = at_row[static_cast<size_t>(y)];
+      std::vector<double> guess;
+      for (int p : row.p)
+        for (const auto& [x, q] : found)
+          if (q == p) guess.push_back(x);
+      row.x = extraction::StripeCentresInRow(grey, y, guess, params.centre);
+    }
+  });
+  CrowdedRows out;
+  for (auto& [y, row] : crowds) out.rows[y].push_back(std::move(row));
+  return out;
+}
+
 struct LineCentres {
   RowValues measured;         // row -> sub-pixel x, outliers removed
   // The measured rows that no segment passes within its widened clearance:
@@ -171,24 +256,29 @@ enum class SegmentNear {
 };
 
 // Whether the skeleton has a segment leaving the line near (x, y): set pixels
-// 2-4 columns to either side that are not part of the line itself, within
+// 2-4 columns to either side that are not part of the line itself nor of a
+// line crowding it in row y (`crowd`, measured with it; `line_of` holds
+// p + 1 on every labelled line's pixels), within
 // `clearance` rows, or within `wide_clearance` rows on the side of the
 // segment where a line leaning at `slope` (dx/dy) runs along it (the acute
 // angle between them; there a steep line's wide row profile takes in the
 // segment's light over many rows) or away from it.
 SegmentNear SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<int, int>>& own,
-                          int x, int y, int clearance, int wide_clearance, double slope) {
+                          const CrowdedRows::Row* crowd, const cv::Mat& line_of, int x, int y,
+                          int clearance, int wide_clearance, double slope) {
   const int reach = std::max(clearance, wide_clearance);
   SegmentNear out = SegmentNear::kNone;
   for (int dy = -reach; dy <= reach; ++dy) {
     const int yy = y + dy;
     if (yy < 0 || yy >= skeleton.rows) continue;
     const uchar* row = skeleton.ptr<uchar>(yy);
+    const short* lines = line_of.ptr<short>(yy);
     for (int k = 2; k <= 4; ++k)
       for (int side : {-1, 1}) {
         const int xx = x + side * k;
         if (xx < 0 || xx >= skeleton.cols || !row[xx] ||
-            std::binary_search(own.begin(), own.end(), std::make_pair(xx, yy)))
+            std::binary_search(own.begin(), own.end(), std::make_pair(xx, yy)) ||
+            (crowd && lines[xx] && crowd->Has(lines[xx] - 1)))
           continue;
         if (std::abs(dy) <= clearance || dy * slope * side < 0) return SegmentNear::kNear;
         out = SegmentNear::kObtuse;
@@ -215,8 +305,8 @@ double LocalSlope(const RowValues& skeleton, int y, int reach) {
 // found at: the skeleton's own pixel sizes (a row's run, the slope's reach)
 // are n times larger.
 LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
-                        const interpretation::LabelledLine& line, const DecodeParams& params,
-                        int n) {
+                        const interpretation::LabelledLine& line, const CrowdedRows& crowded,
+                        const cv::Mat& line_of, const DecodeParams& params, int n) {
   // The line's pixels as sorted (x, y) for look-ups, and each row's span.
   std::vector<std::pair<int, int>> own;
   own.reserve(line.pixels.size());
@@ -259,17 +349,23 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
         static_cast<int>(std::lround(2.0 * params.junction_clearance *
                                      std::max(0.0, slope - params.max_fill_slope)));
     const int x = (lo + hi) / 2;
+    // Where the joint fit of its crowd failed, the line is measured on its
+    // own, as if it were alone.
+    const CrowdedRows::Row* crowd = crowded.Find(y, line.p);
+    const std::optional<double> joint = crowd ? crowd->At(line.p) : std::nullopt;
+    if (!joint) crowd = nullptr;
     // A row where the skeleton runs sideways is a segment, not the line.
     const SegmentNear near =
         hi - lo > 2 * n
             ? SegmentNear::kNear
-            : SegmentNearby(skeleton, own, x, y, params.junction_clearance, clearance,
-                            signed_slope);
+            : SegmentNearby(skeleton, own, crowd, line_of, x, y, params.junction_clearance,
+                            clearance, signed_slope);
     if (near == SegmentNear::kNear) {
       skip(y);
       continue;
     }
-    if (auto cx = extraction::StripeCentreInRow(grey, y, 0.5 * (lo + hi), params.centre)) {
+    if (auto cx = joint ? joint
+                        : extraction::StripeCentreInRow(grey, y, 0.5 * (lo + hi), params.centre)) {
       out.measured.Set(y, *cx);
       if (near == SegmentNear::kNone) out.clear.Set(y, *cx);
     } else {
@@ -529,6 +625,7 @@ DecodeParams ScaledForBinning(const DecodeParams& params, int n) {
   out.junction_clearance *= n;
   out.max_centre_residual *= n;
   out.fold_tip_spread *= n;
+  out.crowd_distance *= n;
   out.centre.search_radius *= n;
   out.centre.max_width *= n;
   out.centre.min_sigma *= n;
@@ -560,6 +657,7 @@ bool DecodeParams::IsValid(std::string* error) const {
   if (!(max_fill_slope >= 0)) return fail("max_fill_slope must not be negative");
   if (!(fold_slope_change > 0)) return fail("fold_slope_change must be positive");
   if (!(fold_tip_spread >= 0)) return fail("fold_tip_spread must not be negative");
+  if (!(crowd_distance >= 0)) return fail("crowd_distance must not be negative");
   if (junction_clearance < 0 || junction_clearance >= junction_fit_rows)
     return fail("junction_clearance must lie in 0..junction_fit_rows-1");
   if (min_dynamic_range < 0 || max_saturated_fraction <= 0 || max_saturated_fraction > 1)
@@ -567,6 +665,8 @@ bool DecodeParams::IsValid(std::string* error) const {
   if (q_offset && (*q_offset % 2) != 0) return fail("q_offset must be even");
   if (!(tuned_pitch > 0)) return fail("tuned_pitch must be positive");
   if (max_binning < 1 || max_binning > 16) return fail("max_binning must lie in 1..16");
+  if (!(region_rise >= 0)) return fail("region_rise must not be negative");
+  if (region_margin < 0) return fail("region_margin must not be negative");
   if (binning < 0 || binning > 16) return fail("binning must lie in 0..16");
   return true;
 }
@@ -596,7 +696,12 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     result.pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
   const int n = BinningFor(result.pitch, params);
   result.binning = n;
-  const cv::Mat working = internal::BinFrame(grey, n);
+  // The columns beside the lit pattern hold nothing to find.
+  const cv::Rect region =
+      internal::PatternColumns(grey, n, params.region_rise, params.region_margin * n);
+  result.region = region;
+  cv::Mat working = internal::BinFrame(grey(region), n);
+  if (!working.isContinuous()) working = working.clone();
   const extraction::ExtractionResult features =
       extraction::ExtractFeatures(working, params.extraction);
   result.times.extraction_ms = MsSince(t);
@@ -604,7 +709,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   t = Clock::now();
   interpretation::InterpretationResult interp = interpretation::Interpret(
       features.skeleton, side, params.spec, params.interpretation, features.mask);
-  internal::MapToFullFrame(n, grey.size(), &interp);
+  internal::MapToFullFrame(n, region.tl(), grey.size(), &interp);
   result.times.interpretation_ms = MsSince(t);
   result.skeleton = interp.skeleton;
   result.repairs = static_cast<int>(interp.repairs.size());
@@ -622,10 +727,14 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   // Lines, then junctions, are measured independently of each other: in
   // parallel (cv::parallel_for_, OpenCV's thread pool).
   const auto& lines = interp.labelling.lines;
+  cv::Mat line_of(grey.size(), CV_16SC1, cv::Scalar(0));  // p + 1 on each line's pixels
+  for (const interpretation::LabelledLine& line : lines)
+    for (const cv::Point& q : line.pixels) line_of.at<short>(q) = static_cast<short>(line.p + 1);
+  const CrowdedRows crowded = MeasureCrowdedRows(grey, lines, subpixel, n);
   std::vector<LineCentres> measured(lines.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
-      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], subpixel, n);
+      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], crowded, line_of, subpixel, n);
   });
   std::map<int, LineCentres> centres;
   for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);

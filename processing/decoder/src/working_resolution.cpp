@@ -56,35 +56,86 @@ cv::Mat BinFrame(const cv::Mat& grey, int n) {
   return out;
 }
 
+cv::Rect PatternColumns(const cv::Mat& grey, int n, double rise, int margin) {
+  const cv::Rect whole(0, 0, grey.cols, grey.rows);
+  constexpr int kBlock = 4;
+  if (!(rise > 0.0) || grey.cols < 2 * kBlock || grey.rows < kBlock) return whole;
+  cv::Mat means;
+  const cv::Size blocks(grey.cols / kBlock, grey.rows / kBlock);
+  // INTER_AREA at an integer factor is exactly the block mean.
+  cv::resize(grey(cv::Rect(0, 0, blocks.width * kBlock, blocks.height * kBlock)), means, blocks, 0,
+             0, cv::INTER_AREA);
+  // The dark ground: the 5th percentile of the block means.
+  int histogram[256] = {};
+  for (int y = 0; y < means.rows; ++y)
+    for (const uchar* m = means.ptr<uchar>(y); m != means.ptr<uchar>(y) + means.cols; ++m)
+      ++histogram[*m];
+  const int wanted = static_cast<int>(means.total() / 20);
+  int ground = 0;
+  for (int seen = histogram[0]; seen <= wanted && ground < 255;) seen += histogram[++ground];
+  const double above = ground + rise;
+  int first = means.cols, last = -1;
+  for (int y = 0; y < means.rows; ++y) {
+    const uchar* m = means.ptr<uchar>(y);
+    for (int x = 0; x < means.cols; ++x)
+      if (m[x] > above) {
+        first = std::min(first, x);
+        last = std::max(last, x);
+      }
+  }
+  if (last < 0) return whole;
+  int left = std::max(0, first * kBlock - margin);
+  left -= left % std::max(n, 1);
+  const int right = std::min(grey.cols, (last + 1) * kBlock + margin);
+  return {left, 0, right - left, grey.rows};
+}
+
 cv::Point2d ToFullFrame(const cv::Point2d& p, int n) {
   return {n * p.x + 0.5 * (n - 1), n * p.y + 0.5 * (n - 1)};
 }
 
-void MapToFullFrame(int n, cv::Size full, interpretation::InterpretationResult* r) {
-  if (n <= 1) return;
+void MapToFullFrame(int n, cv::Point offset, cv::Size full,
+                    interpretation::InterpretationResult* r) {
+  if (n <= 1 && offset == cv::Point() && r->skeleton.size() == full) return;
   const cv::Mat& binned = r->skeleton;
+  auto shifted = [offset](std::vector<cv::Point> pixels) {
+    for (cv::Point& p : pixels) p += offset;
+    return pixels;
+  };
   // The skeleton.
   std::vector<cv::Point> pixels;
   cv::findNonZero(binned, pixels);
   cv::Mat skeleton = cv::Mat::zeros(full, CV_8UC1);
-  for (const cv::Point& p : RedrawSet(pixels, binned, n)) skeleton.at<uchar>(p) = 255;
+  if (n <= 1) {
+    binned.copyTo(skeleton(cv::Rect(offset, binned.size())));
+  } else {
+    for (const cv::Point& p : RedrawSet(pixels, binned, n)) skeleton.at<uchar>(p + offset) = 255;
+  }
   // Labelled lines: their own pixels only, so that a line does not take in
   // the segments that leave it.
   cv::Mat own = cv::Mat::zeros(binned.size(), CV_8UC1);
   for (interpretation::LabelledLine& line : r->labelling.lines) {
+    if (n <= 1) {
+      line.pixels = shifted(std::move(line.pixels));
+      continue;
+    }
     for (const cv::Point& p : line.pixels) own.at<uchar>(p) = 1;
     std::vector<cv::Point> redrawn = RedrawSet(line.pixels, own, n);
     for (const cv::Point& p : line.pixels) own.at<uchar>(p) = 0;
-    line.pixels = std::move(redrawn);
+    line.pixels = shifted(std::move(redrawn));
   }
   // Junctions: positions, and segments in their order (from the junction on).
   for (interpretation::LabelledJunction& j : r->labelling.junctions) {
-    j.position = ToFullFrame(j.position, n);
+    j.position = ToFullFrame(j.position, n) + cv::Point2d(offset);
     if (j.segment.empty()) continue;
+    if (n <= 1) {
+      j.segment = shifted(std::move(j.segment));
+      continue;
+    }
     std::vector<cv::Point> segment{Centre(j.segment.front(), n)};
     for (size_t i = 1; i < j.segment.size(); ++i)
       AppendRun(Centre(j.segment[i - 1], n), Centre(j.segment[i], n), &segment);
-    j.segment = std::move(segment);
+    j.segment = shifted(std::move(segment));
   }
   r->skeleton = skeleton;
 }

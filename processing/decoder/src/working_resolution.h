@@ -23,17 +23,28 @@ namespace bsls::decoder::internal {
 // fill no whole block, are left out. n == 1 returns the frame itself.
 cv::Mat BinFrame(const cv::Mat& grey, int n);
 
+// The columns of `grey` (CV_8UC1) that can hold the pattern, as a rectangle
+// of full height: from `margin` px left of the first to `margin` px right of
+// the last column of 4 x 4 blocks whose mean rises more than `rise` grey
+// levels above the frame's dark ground (the 5th percentile of the block
+// means), the left edge on the binning grid of n. The whole frame when no
+// block is that bright or `rise` is 0. Only columns are cut: the
+// interpretation finds the reference line among the frame's central rows.
+cv::Rect PatternColumns(const cv::Mat& grey, int n, double rise, int margin);
+
 // A binned frame's point in full-frame pixel coordinates.
 cv::Point2d ToFullFrame(const cv::Point2d& p, int n);
 
-// Maps an interpretation of the n x n binned frame onto the full frame of
-// `full` size: the skeleton and every labelled line are redrawn through the
-// full-frame centres of their pixels (8-neighbours joined by straight runs,
-// so they stay connected), each junction's segment likewise in its order,
-// junction positions moved; the labels are kept. The reference line,
-// repairs, corners and boundary records stay in binned coordinates (nothing
-// after the interpretation reads them).
-void MapToFullFrame(int n, cv::Size full, interpretation::InterpretationResult* r);
+// Maps an interpretation of the n x n binned frame of the part of the full
+// frame from `offset` on onto the full frame of `full` size: the skeleton
+// and every labelled line are redrawn through the full-frame centres of
+// their pixels (8-neighbours joined by straight runs, so they stay
+// connected), each junction's segment likewise in its order, junction
+// positions moved; the labels are kept. The reference line, repairs,
+// corners and boundary records stay in working coordinates (nothing after
+// the interpretation reads them).
+void MapToFullFrame(int n, cv::Point offset, cv::Size full,
+                    interpretation::InterpretationResult* r);
 
 }  // namespace bsls::decoder::internal
 

@@ -59,6 +59,10 @@ struct DecodeParams {
   // px: a fold's branches meeting the segment closer together than this meet
   // it at the fold's tip; farther apart, the junction is on one branch.
   double fold_tip_spread = 2.0;
+  // px: lines whose skeletons pass closer than this in a row (a fold
+  // squeezing them) are measured there together, one joint fit of their
+  // stripes (extraction::StripeCentresInRow); 0: each on its own.
+  double crowd_distance = 8.0;
   // Working resolution. The pixel-sized parameters (extraction,
   // interpretation, centre and the lengths above) hold for a stripe pitch
   // near tuned_pitch px: measured 10.4-20.8 px on the thesis scenes at
@@ -69,6 +73,14 @@ struct DecodeParams {
   double tuned_pitch = 21.0;  // px, > 0
   int max_binning = 8;        // 1..16; 1 = never bin
   int binning = 0;            // 0 = from the measured pitch; 1..16 forces n (tests, benchmarks)
+  // The columns beside the lit pattern are left out of extraction and
+  // interpretation: those more than region_margin working px beyond every
+  // 4 x 4 block whose mean rises region_rise grey levels above the frame's
+  // dark ground (its 5th percentile). 0 keeps the whole frame. The margin
+  // spans the stripe detector's reach (max_scale 4 px smoothing, the 27 px
+  // contrast window).
+  double region_rise = 6.0;  // grey levels, >= 0
+  int region_margin = 32;    // working px, >= 0
   // A frame whose 1st-99th percentile range is narrower (grey levels) is blank.
   double min_dynamic_range = 16.0;
   // A frame with a larger fraction of pixels at 254-255 is saturated.
@@ -114,6 +126,7 @@ struct DecodeResult {
   // Diagnostics.
   double pitch = 0.0;  // measured stripe pitch, px of the frame (0: none found)
   int binning = 1;     // n: extraction and interpretation ran on the frame binned n x n
+  cv::Rect region;     // the part of the frame they ran on (DecodeParams::region_rise)
   int repairs = 0;
   int label_conflicts = 0;
   std::map<interpretation::LoopClass, int> loop_classes;

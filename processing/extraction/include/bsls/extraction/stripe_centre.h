@@ -46,6 +46,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace bsls::extraction {
 
@@ -83,6 +84,21 @@ std::optional<double> StripeCentreInRow(const cv::Mat& image, int y, double appr
 // Sub-pixel y of a (roughly horizontal) stripe crossing column x near y = approximate_y.
 std::optional<double> StripeCentreInColumn(const cv::Mat& image, int x, double approximate_y,
                                            const StripeCentreParams& params = {});
+
+// Sub-pixel x of (roughly vertical) stripes crossing row y close together,
+// near approximate_x (ascending): one pixel-integrated Gaussian per stripe
+// on a linear ground, fitted jointly (Levenberg-Marquardt) over the stripes
+// and search_radius + 1 px beyond, so that each one's light does not pull
+// the others' centres (thesis 5.1.4.8: lines that crowd in the image). An
+// entry is nullopt where its stripe is no proper ridge in the fit (height
+// below min_contrast, FWHM above max_width, beyond search_radius + 0.5 of
+// its approximate position or within 1 px of a neighbour), all of them
+// where the fit does not converge or a position lies outside the image.
+// No positions, a position that is not finite or positions out of order
+// throw std::invalid_argument.
+std::vector<std::optional<double>> StripeCentresInRow(const cv::Mat& image, int y,
+                                                     std::span<const double> approximate_x,
+                                                     const StripeCentreParams& params = {});
 
 }  // namespace bsls::extraction
 
