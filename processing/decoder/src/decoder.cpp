@@ -167,6 +167,17 @@ struct CrowdedRows {
     }
   };
   std::map<int, std::vector<Row>> rows;  // image row -> its crowds
+  // The skeleton pixels, as sorted (x, y), of every line in a crowd.
+  std::map<int, std::vector<std::pair<int, int>>> pixels;
+
+  // Whether (x, y) is a pixel of a line of `crowd` (its pixels above).
+  bool OnLineOf(const Row& crowd, int x, int y) const {
+    for (int p : crowd.p) {
+      const std::vector<std::pair<int, int>>& own = pixels.at(p);
+      if (std::binary_search(own.begin(), own.end(), std::make_pair(x, y))) return true;
+    }
+    return false;
+  }
 
   // The crowd of line `p` in row y; nullptr where the line is alone.
   const Row* Find(int y, int p) const {
@@ -184,56 +195,82 @@ struct CrowdedRows {
 CrowdedRows MeasureCrowdedRows(const cv::Mat& grey,
                                const std::vector<interpretation::LabelledLine>& lines,
                                const DecodeParams& params, int n) {
-  // Row -> (x, p): the middle of each line's skeleton run there.
-  std::vector<std::vector<std::pair<double, int>>> at_row(static_cast<size_t>(grey.rows));
-  for (const interpretation::LabelledLine& line : lines) {
-    if (line.pixels.empty()) continue;
+  // x_of[y * L + i]: the middle of line i's skeleton run in row y (NaN: none).
+  const size_t count = lines.size();
+  std::vector<double> x_of(static_cast<size_t>(grey.rows) * count,
+                           std::numeric_limits<double>::quiet_NaN());
+  for (size_t i = 0; i < count; ++i) {
+    const std::vector<cv::Point>& pixels = lines[i].pixels;
+    if (pixels.empty()) continue;
     int top = grey.rows, bottom = -1;
-    for (const cv::Point& q : line.pixels) {
+    for (const cv::Point& q : pixels) {
       top = std::min(top, q.y);
       bottom = std::max(bottom, q.y);
     }
     std::vector<std::pair<int, int>> span(static_cast<size_t>(bottom - top + 1),
                                           {std::numeric_limits<int>::max(), -1});
-    for (const cv::Point& q : line.pixels) {
+    for (const cv::Point& q : pixels) {
       auto& [lo, hi] = span[static_cast<size_t>(q.y - top)];
       lo = std::min(lo, q.x);
       hi = std::max(hi, q.x);
     }
     for (int y = top; y <= bottom; ++y) {
       const auto [lo, hi] = span[static_cast<size_t>(y - top)];
-      if (hi >= lo && hi - lo <= 2 * n)
-        at_row[static_cast<size_t>(y)].emplace_back(0.5 * (lo + hi), line.p);
+      if (hi >= lo && hi - lo <= 2 * n) x_of[static_cast<size_t>(y) * count + i] = 0.5 * (lo + hi);
     }
   }
-  std::vector<std::pair<int, CrowdedRows::Row>> crowds;  // (row, crowd) to fit
+  struct Crowd {
+    int y;
+    CrowdedRows::Row row;
+    std::vector<double> guess;  // the skeleton x of each member
+  };
+  std::vector<Crowd> crowds;
+  std::vector<std::pair<double, int>> found;  // (x, index of the line) in one row
   for (int y = 0; y < grey.rows; ++y) {
-    std::vector<std::pair<double, int>>& found = at_row[static_cast<size_t>(y)];
+    found.clear();
+    for (size_t i = 0; i < count; ++i)
+      if (const double x = x_of[static_cast<size_t>(y) * count + i]; !std::isnan(x))
+        found.emplace_back(x, static_cast<int>(i));
     std::sort(found.begin(), found.end());
     for (size_t i = 0; i < found.size();) {
       size_t j = i + 1;
       while (j < found.size() && found[j].first - found[j - 1].first <= params.crowd_distance) ++j;
       if (j - i >= 2) {
-        CrowdedRows::Row row;
-        for (size_t k = i; k < j; ++k) row.p.push_back(found[k].second);
-        crowds.emplace_back(y, std::move(row));
+        Crowd crowd{y, {}, {}};
+        for (size_t k = i; k < j; ++k) {
+          crowd.row.p.push_back(lines[static_cast<size_t>(found[k].second)].p);
+          crowd.guess.push_back(found[k].first);
+        }
+        crowds.push_back(std::move(crowd));
       }
       i = j;
     }
   }
-  cv::parallel_for_(cv::Range(0, static_cast<int>(crowds.size())), [&](const cv::Range& r) {
+  auto fit = [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
-      auto& [y, row] = crowds[static_cast<size_t>(i)];
-      const std::vector<std::pair<double, int>>& found = at_row[static_cast<size_t>(y)];
-      std::vector<double> guess;
-      for (int p : row.p)
-        for (const auto& [x, q] : found)
-          if (q == p) guess.push_back(x);
-      row.x = extraction::StripeCentresInRow(grey, y, guess, params.centre);
+      Crowd& c = crowds[static_cast<size_t>(i)];
+      c.row.x = extraction::StripeCentresInRow(grey, c.y, c.guess, params.centre);
     }
-  });
+  };
+  // A face has a handful of crowded rows: waking the thread pool for them
+  // costs more than the fits.
+  constexpr int kParallelFrom = 16;
+  const cv::Range all(0, static_cast<int>(crowds.size()));
+  if (all.end >= kParallelFrom)
+    cv::parallel_for_(all, fit);
+  else
+    fit(all);
   CrowdedRows out;
-  for (auto& [y, row] : crowds) out.rows[y].push_back(std::move(row));
+  for (Crowd& c : crowds) {
+    for (int p : c.row.p) out.pixels.try_emplace(p);
+    out.rows[c.y].push_back(std::move(c.row));
+  }
+  for (const interpretation::LabelledLine& line : lines) {
+    const auto it = out.pixels.find(line.p);
+    if (it == out.pixels.end()) continue;
+    for (const cv::Point& q : line.pixels) it->second.emplace_back(q.x, q.y);
+    std::sort(it->second.begin(), it->second.end());
+  }
   return out;
 }
 
@@ -257,14 +294,13 @@ enum class SegmentNear {
 
 // Whether the skeleton has a segment leaving the line near (x, y): set pixels
 // 2-4 columns to either side that are not part of the line itself nor of a
-// line crowding it in row y (`crowd`, measured with it; `line_of` holds
-// p + 1 on every labelled line's pixels), within
+// line crowding it in row y (`crowd` of `crowded`, measured with it), within
 // `clearance` rows, or within `wide_clearance` rows on the side of the
 // segment where a line leaning at `slope` (dx/dy) runs along it (the acute
 // angle between them; there a steep line's wide row profile takes in the
 // segment's light over many rows) or away from it.
 SegmentNear SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<int, int>>& own,
-                          const CrowdedRows::Row* crowd, const cv::Mat& line_of, int x, int y,
+                          const CrowdedRows& crowded, const CrowdedRows::Row* crowd, int x, int y,
                           int clearance, int wide_clearance, double slope) {
   const int reach = std::max(clearance, wide_clearance);
   SegmentNear out = SegmentNear::kNone;
@@ -272,13 +308,12 @@ SegmentNear SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<i
     const int yy = y + dy;
     if (yy < 0 || yy >= skeleton.rows) continue;
     const uchar* row = skeleton.ptr<uchar>(yy);
-    const short* lines = line_of.ptr<short>(yy);
     for (int k = 2; k <= 4; ++k)
       for (int side : {-1, 1}) {
         const int xx = x + side * k;
         if (xx < 0 || xx >= skeleton.cols || !row[xx] ||
             std::binary_search(own.begin(), own.end(), std::make_pair(xx, yy)) ||
-            (crowd && lines[xx] && crowd->Has(lines[xx] - 1)))
+            (crowd && crowded.OnLineOf(*crowd, xx, yy)))
           continue;
         if (std::abs(dy) <= clearance || dy * slope * side < 0) return SegmentNear::kNear;
         out = SegmentNear::kObtuse;
@@ -306,7 +341,7 @@ double LocalSlope(const RowValues& skeleton, int y, int reach) {
 // are n times larger.
 LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
                         const interpretation::LabelledLine& line, const CrowdedRows& crowded,
-                        const cv::Mat& line_of, const DecodeParams& params, int n) {
+                        const DecodeParams& params, int n) {
   // The line's pixels as sorted (x, y) for look-ups, and each row's span.
   std::vector<std::pair<int, int>> own;
   own.reserve(line.pixels.size());
@@ -358,7 +393,7 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
     const SegmentNear near =
         hi - lo > 2 * n
             ? SegmentNear::kNear
-            : SegmentNearby(skeleton, own, crowd, line_of, x, y, params.junction_clearance,
+            : SegmentNearby(skeleton, own, crowded, crowd, x, y, params.junction_clearance,
                             clearance, signed_slope);
     if (near == SegmentNear::kNear) {
       skip(y);
@@ -727,14 +762,11 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   // Lines, then junctions, are measured independently of each other: in
   // parallel (cv::parallel_for_, OpenCV's thread pool).
   const auto& lines = interp.labelling.lines;
-  cv::Mat line_of(grey.size(), CV_16SC1, cv::Scalar(0));  // p + 1 on each line's pixels
-  for (const interpretation::LabelledLine& line : lines)
-    for (const cv::Point& q : line.pixels) line_of.at<short>(q) = static_cast<short>(line.p + 1);
   const CrowdedRows crowded = MeasureCrowdedRows(grey, lines, subpixel, n);
   std::vector<LineCentres> measured(lines.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
-      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], crowded, line_of, subpixel, n);
+      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], crowded, subpixel, n);
   });
   std::map<int, LineCentres> centres;
   for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);
