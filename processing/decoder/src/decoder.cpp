@@ -22,26 +22,14 @@ double MsSince(Clock::time_point t) {
 
 // Says why a frame cannot carry the pattern, or returns an empty string.
 std::string CheckFrame(const cv::Mat& grey, const DecodeParams& params) {
-  int histogram[256] = {0};
-  for (int y = 0; y < grey.rows; ++y) {
-    const uchar* row = grey.ptr<uchar>(y);
-    for (int x = 0; x < grey.cols; ++x) ++histogram[row[x]];
-  }
-  const double total = static_cast<double>(grey.total());
-  auto percentile = [&](double f) {
-    double acc = 0;
-    for (int i = 0; i < 256; ++i) {
-      acc += histogram[i];
-      if (acc >= f * total) return i;
-    }
-    return 255;
-  };
-  const int lo = percentile(0.01), hi = percentile(0.99);
-  const double saturated = (histogram[254] + histogram[255]) / total;
+  const internal::GreyHistogram levels(grey);
+  const int lo = levels.Percentile(0.01), hi = levels.Percentile(0.99);
+  const double saturated = levels.ShareFrom(254);
   if (saturated > params.max_saturated_fraction)
     return "frame is saturated (" + std::to_string(static_cast<int>(saturated * 100)) +
            "% of pixels at full scale)";
-  if (hi - lo < params.min_dynamic_range && percentile(0.999) - lo < params.min_dynamic_range)
+  if (hi - lo < params.min_dynamic_range &&
+      levels.Percentile(0.999) - lo < params.min_dynamic_range)
     return "frame is blank (grey levels " + std::to_string(lo) + ".." + std::to_string(hi) +
            " hold 98% of pixels)";
   return {};
@@ -152,6 +140,42 @@ std::vector<std::pair<double, double>> RowsNear(const RowValues& rows, double ce
   return out;
 }
 
+// A labelled line's skeleton pixels as the sub-pixel stage reads them: as
+// sorted (x, y) for look-ups, and each row's run (min x, max x) from row
+// `top` on (min > max where the line has no pixel in the row).
+struct LinePixels {
+  std::vector<std::pair<int, int>> sorted;
+  int top = 0;
+  std::vector<std::pair<int, int>> runs;
+
+  // Whether (x, y) is a pixel of the line.
+  bool Has(int x, int y) const {
+    return std::binary_search(sorted.begin(), sorted.end(), std::make_pair(x, y));
+  }
+};
+
+// `line`'s pixels as LinePixels.
+LinePixels PrepareLine(const interpretation::LabelledLine& line) {
+  LinePixels out;
+  out.sorted.reserve(line.pixels.size());
+  for (const cv::Point& q : line.pixels) out.sorted.emplace_back(q.x, q.y);
+  std::sort(out.sorted.begin(), out.sorted.end());
+  if (out.sorted.empty()) return out;
+  int bottom = out.top = out.sorted.front().second;
+  for (const auto& [x, y] : out.sorted) {
+    out.top = std::min(out.top, y);
+    bottom = std::max(bottom, y);
+  }
+  out.runs.assign(static_cast<size_t>(bottom - out.top + 1),
+                  {std::numeric_limits<int>::max(), std::numeric_limits<int>::min()});
+  for (const auto& [x, y] : out.sorted) {
+    auto& [lo, hi] = out.runs[static_cast<size_t>(y - out.top)];
+    lo = std::min(lo, x);
+    hi = std::max(hi, x);
+  }
+  return out;
+}
+
 // Thesis 5.1.4.8, measured: the rows where labelled lines crowd (folds
 // that turn the face away squeeze neighbouring lines to a few pixels), each
 // row's crowd fitted once, jointly (extraction::StripeCentresInRow), so
@@ -167,15 +191,12 @@ struct CrowdedRows {
     }
   };
   std::map<int, std::vector<Row>> rows;  // image row -> its crowds
-  // The skeleton pixels, as sorted (x, y), of every line in a crowd.
-  std::map<int, std::vector<std::pair<int, int>>> pixels;
+  std::map<int, const LinePixels*> pixels;  // p -> the pixels of every line in a crowd
 
-  // Whether (x, y) is a pixel of a line of `crowd` (its pixels above).
+  // Whether (x, y) is a pixel of a line of `crowd`.
   bool OnLineOf(const Row& crowd, int x, int y) const {
-    for (int p : crowd.p) {
-      const std::vector<std::pair<int, int>>& own = pixels.at(p);
-      if (std::binary_search(own.begin(), own.end(), std::make_pair(x, y))) return true;
-    }
+    for (int p : crowd.p)
+      if (pixels.at(p)->Has(x, y)) return true;
     return false;
   }
 
@@ -194,29 +215,18 @@ struct CrowdedRows {
 // at most 2n px), grouped into chains of neighbours and fitted jointly.
 CrowdedRows MeasureCrowdedRows(const cv::Mat& grey,
                                const std::vector<interpretation::LabelledLine>& lines,
-                               const DecodeParams& params, int n) {
+                               const std::vector<LinePixels>& pixels, const DecodeParams& params,
+                               int n) {
   // x_of[y * L + i]: the middle of line i's skeleton run in row y (NaN: none).
   const size_t count = lines.size();
   std::vector<double> x_of(static_cast<size_t>(grey.rows) * count,
                            std::numeric_limits<double>::quiet_NaN());
   for (size_t i = 0; i < count; ++i) {
-    const std::vector<cv::Point>& pixels = lines[i].pixels;
-    if (pixels.empty()) continue;
-    int top = grey.rows, bottom = -1;
-    for (const cv::Point& q : pixels) {
-      top = std::min(top, q.y);
-      bottom = std::max(bottom, q.y);
-    }
-    std::vector<std::pair<int, int>> span(static_cast<size_t>(bottom - top + 1),
-                                          {std::numeric_limits<int>::max(), -1});
-    for (const cv::Point& q : pixels) {
-      auto& [lo, hi] = span[static_cast<size_t>(q.y - top)];
-      lo = std::min(lo, q.x);
-      hi = std::max(hi, q.x);
-    }
-    for (int y = top; y <= bottom; ++y) {
-      const auto [lo, hi] = span[static_cast<size_t>(y - top)];
-      if (hi >= lo && hi - lo <= 2 * n) x_of[static_cast<size_t>(y) * count + i] = 0.5 * (lo + hi);
+    const LinePixels& line = pixels[i];
+    for (size_t k = 0; k < line.runs.size(); ++k) {
+      const auto [lo, hi] = line.runs[k];
+      if (hi >= lo && hi - lo <= 2 * n)
+        x_of[static_cast<size_t>(line.top + static_cast<int>(k)) * count + i] = 0.5 * (lo + hi);
     }
   }
   struct Crowd {
@@ -261,16 +271,8 @@ CrowdedRows MeasureCrowdedRows(const cv::Mat& grey,
   else
     fit(all);
   CrowdedRows out;
-  for (Crowd& c : crowds) {
-    for (int p : c.row.p) out.pixels.try_emplace(p);
-    out.rows[c.y].push_back(std::move(c.row));
-  }
-  for (const interpretation::LabelledLine& line : lines) {
-    const auto it = out.pixels.find(line.p);
-    if (it == out.pixels.end()) continue;
-    for (const cv::Point& q : line.pixels) it->second.emplace_back(q.x, q.y);
-    std::sort(it->second.begin(), it->second.end());
-  }
+  for (Crowd& c : crowds) out.rows[c.y].push_back(std::move(c.row));
+  for (size_t i = 0; i < count; ++i) out.pixels[lines[i].p] = &pixels[i];
   return out;
 }
 
@@ -299,7 +301,7 @@ enum class SegmentNear {
 // segment where a line leaning at `slope` (dx/dy) runs along it (the acute
 // angle between them; there a steep line's wide row profile takes in the
 // segment's light over many rows) or away from it.
-SegmentNear SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<int, int>>& own,
+SegmentNear SegmentNearby(const cv::Mat& skeleton, const LinePixels& own,
                           const CrowdedRows& crowded, const CrowdedRows::Row* crowd, int x, int y,
                           int clearance, int wide_clearance, double slope) {
   const int reach = std::max(clearance, wide_clearance);
@@ -312,7 +314,7 @@ SegmentNear SegmentNearby(const cv::Mat& skeleton, const std::vector<std::pair<i
       for (int side : {-1, 1}) {
         const int xx = x + side * k;
         if (xx < 0 || xx >= skeleton.cols || !row[xx] ||
-            std::binary_search(own.begin(), own.end(), std::make_pair(xx, yy)) ||
+            own.Has(xx, yy) ||
             (crowd && crowded.OnLineOf(*crowd, xx, yy)))
           continue;
         if (std::abs(dy) <= clearance || dy * slope * side < 0) return SegmentNear::kNear;
@@ -339,41 +341,25 @@ double LocalSlope(const RowValues& skeleton, int y, int reach) {
 // the full frame (ScaledForBinning); `n` is the binning the skeleton was
 // found at: the skeleton's own pixel sizes (a row's run, the slope's reach)
 // are n times larger.
-LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
-                        const interpretation::LabelledLine& line, const CrowdedRows& crowded,
+LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p,
+                        const LinePixels& own, const CrowdedRows& crowded,
                         const DecodeParams& params, int n) {
-  // The line's pixels as sorted (x, y) for look-ups, and each row's span.
-  std::vector<std::pair<int, int>> own;
-  own.reserve(line.pixels.size());
-  for (const cv::Point& p : line.pixels) own.emplace_back(p.x, p.y);
-  std::sort(own.begin(), own.end());
-  std::vector<std::pair<int, std::pair<int, int>>> span;  // (row, (min x, max x)), by row
-  {
-    std::vector<std::pair<int, int>> by_row;  // (y, x)
-    by_row.reserve(own.size());
-    for (const auto& [x, y] : own) by_row.emplace_back(y, x);
-    std::sort(by_row.begin(), by_row.end());
-    for (const auto& [y, x] : by_row) {
-      if (!span.empty() && span.back().first == y)
-        span.back().second.second = x;  // sorted: the largest x comes last
-      else
-        span.push_back({y, {x, x}});
-    }
-  }
   LineCentres out;
-  const int first = span.empty() ? 0 : span.front().first;
-  const int count = span.empty() ? 0 : span.back().first - first + 1;
+  const int first = own.top;
+  const int count = static_cast<int>(own.runs.size());
   out.measured.Reset(first, count);
   out.clear.Reset(first, count);
   out.skeleton.Reset(first, count);
   out.slope.Reset(first, count);
   out.skipped.assign(static_cast<size_t>(count), 0);
   auto skip = [&](int y) { out.skipped[static_cast<size_t>(y - first)] = 1; };
-  for (const auto& [y, range] : span)
-    if (range.second - range.first <= 2 * n)
-      out.skeleton.Set(y, 0.5 * (range.first + range.second));
-  for (const auto& [y, range] : span) {
-    const auto [lo, hi] = range;
+  for (int y = first; y < first + count; ++y) {
+    const auto [lo, hi] = own.runs[static_cast<size_t>(y - first)];
+    if (hi >= lo && hi - lo <= 2 * n) out.skeleton.Set(y, 0.5 * (lo + hi));
+  }
+  for (int y = first; y < first + count; ++y) {
+    const auto [lo, hi] = own.runs[static_cast<size_t>(y - first)];
+    if (hi < lo) continue;  // no pixel of the line in this row
     // A steep line's row profile is wide, so a segment biases more rows of it
     // on the side where the line runs along it.
     const double signed_slope = LocalSlope(out.skeleton, y, 3 * n);
@@ -386,8 +372,8 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton,
     const int x = (lo + hi) / 2;
     // Where the joint fit of its crowd failed, the line is measured on its
     // own, as if it were alone.
-    const CrowdedRows::Row* crowd = crowded.Find(y, line.p);
-    const std::optional<double> joint = crowd ? crowd->At(line.p) : std::nullopt;
+    const CrowdedRows::Row* crowd = crowded.Find(y, p);
+    const std::optional<double> joint = crowd ? crowd->At(p) : std::nullopt;
     if (!joint) crowd = nullptr;
     // A row where the skeleton runs sideways is a segment, not the line.
     const SegmentNear near =
@@ -762,11 +748,16 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   // Lines, then junctions, are measured independently of each other: in
   // parallel (cv::parallel_for_, OpenCV's thread pool).
   const auto& lines = interp.labelling.lines;
-  const CrowdedRows crowded = MeasureCrowdedRows(grey, lines, subpixel, n);
+  std::vector<LinePixels> pixels(lines.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) pixels[i] = PrepareLine(lines[i]);
+  });
+  const CrowdedRows crowded = MeasureCrowdedRows(grey, lines, pixels, subpixel, n);
   std::vector<LineCentres> measured(lines.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
-      measured[i] = MeasureLine(grey, interp.skeleton, lines[i], crowded, subpixel, n);
+      measured[i] =
+          MeasureLine(grey, interp.skeleton, lines[i].p, pixels[i], crowded, subpixel, n);
   });
   std::map<int, LineCentres> centres;
   for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);

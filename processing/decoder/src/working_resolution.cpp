@@ -56,6 +56,28 @@ cv::Mat BinFrame(const cv::Mat& grey, int n) {
   return out;
 }
 
+GreyHistogram::GreyHistogram(const cv::Mat& grey) : total_(static_cast<double>(grey.total())) {
+  for (int y = 0; y < grey.rows; ++y) {
+    const uchar* row = grey.ptr<uchar>(y);
+    for (int x = 0; x < grey.cols; ++x) ++count_[row[x]];
+  }
+}
+
+int GreyHistogram::Percentile(double fraction) const {
+  double seen = 0;
+  for (int i = 0; i < 256; ++i) {
+    seen += count_[i];
+    if (seen >= fraction * total_) return i;
+  }
+  return 255;
+}
+
+double GreyHistogram::ShareFrom(int level) const {
+  double above = 0;
+  for (int i = std::max(level, 0); i < 256; ++i) above += count_[i];
+  return above / total_;
+}
+
 cv::Rect PatternColumns(const cv::Mat& grey, int n, double rise, int margin) {
   const cv::Rect whole(0, 0, grey.cols, grey.rows);
   constexpr int kBlock = 4;
@@ -66,14 +88,7 @@ cv::Rect PatternColumns(const cv::Mat& grey, int n, double rise, int margin) {
   cv::resize(grey(cv::Rect(0, 0, blocks.width * kBlock, blocks.height * kBlock)), means, blocks, 0,
              0, cv::INTER_AREA);
   // The dark ground: the 5th percentile of the block means.
-  int histogram[256] = {};
-  for (int y = 0; y < means.rows; ++y)
-    for (const uchar* m = means.ptr<uchar>(y); m != means.ptr<uchar>(y) + means.cols; ++m)
-      ++histogram[*m];
-  const int wanted = static_cast<int>(means.total() / 20);
-  int ground = 0;
-  for (int seen = histogram[0]; seen <= wanted && ground < 255;) seen += histogram[++ground];
-  const double above = ground + rise;
+  const double above = GreyHistogram(means).Percentile(0.05) + rise;
   int first = means.cols, last = -1;
   for (int y = 0; y < means.rows; ++y) {
     const uchar* m = means.ptr<uchar>(y);
@@ -96,46 +111,46 @@ cv::Point2d ToFullFrame(const cv::Point2d& p, int n) {
 
 void MapToFullFrame(int n, cv::Point offset, cv::Size full,
                     interpretation::InterpretationResult* r) {
-  if (n <= 1 && offset == cv::Point() && r->skeleton.size() == full) return;
-  const cv::Mat& binned = r->skeleton;
-  auto shifted = [offset](std::vector<cv::Point> pixels) {
-    for (cv::Point& p : pixels) p += offset;
-    return pixels;
+  auto shift = [offset](std::vector<cv::Point>* pixels) {
+    for (cv::Point& p : *pixels) p += offset;
   };
+  if (n <= 1) {  // the same pixels, moved by `offset`
+    if (offset == cv::Point() && r->skeleton.size() == full) return;
+    cv::Mat skeleton = cv::Mat::zeros(full, CV_8UC1);
+    r->skeleton.copyTo(skeleton(cv::Rect(offset, r->skeleton.size())));
+    r->skeleton = skeleton;
+    for (interpretation::LabelledLine& line : r->labelling.lines) shift(&line.pixels);
+    for (interpretation::LabelledJunction& j : r->labelling.junctions) {
+      j.position += cv::Point2d(offset);
+      shift(&j.segment);
+    }
+    return;
+  }
+  const cv::Mat& binned = r->skeleton;
   // The skeleton.
   std::vector<cv::Point> pixels;
   cv::findNonZero(binned, pixels);
   cv::Mat skeleton = cv::Mat::zeros(full, CV_8UC1);
-  if (n <= 1) {
-    binned.copyTo(skeleton(cv::Rect(offset, binned.size())));
-  } else {
-    for (const cv::Point& p : RedrawSet(pixels, binned, n)) skeleton.at<uchar>(p + offset) = 255;
-  }
+  for (const cv::Point& p : RedrawSet(pixels, binned, n)) skeleton.at<uchar>(p + offset) = 255;
   // Labelled lines: their own pixels only, so that a line does not take in
   // the segments that leave it.
   cv::Mat own = cv::Mat::zeros(binned.size(), CV_8UC1);
   for (interpretation::LabelledLine& line : r->labelling.lines) {
-    if (n <= 1) {
-      line.pixels = shifted(std::move(line.pixels));
-      continue;
-    }
     for (const cv::Point& p : line.pixels) own.at<uchar>(p) = 1;
     std::vector<cv::Point> redrawn = RedrawSet(line.pixels, own, n);
     for (const cv::Point& p : line.pixels) own.at<uchar>(p) = 0;
-    line.pixels = shifted(std::move(redrawn));
+    line.pixels = std::move(redrawn);
+    shift(&line.pixels);
   }
   // Junctions: positions, and segments in their order (from the junction on).
   for (interpretation::LabelledJunction& j : r->labelling.junctions) {
     j.position = ToFullFrame(j.position, n) + cv::Point2d(offset);
     if (j.segment.empty()) continue;
-    if (n <= 1) {
-      j.segment = shifted(std::move(j.segment));
-      continue;
-    }
     std::vector<cv::Point> segment{Centre(j.segment.front(), n)};
     for (size_t i = 1; i < j.segment.size(); ++i)
       AppendRun(Centre(j.segment[i - 1], n), Centre(j.segment[i], n), &segment);
-    j.segment = shifted(std::move(segment));
+    j.segment = std::move(segment);
+    shift(&j.segment);
   }
   r->skeleton = skeleton;
 }

@@ -23,6 +23,21 @@ namespace bsls::decoder::internal {
 // fill no whole block, are left out. n == 1 returns the frame itself.
 cv::Mat BinFrame(const cv::Mat& grey, int n);
 
+// The grey levels of a CV_8UC1 image counted: the frame check's range and
+// the dark ground of PatternColumns.
+class GreyHistogram {
+ public:
+  explicit GreyHistogram(const cv::Mat& grey);
+  // The lowest level at or below which at least `fraction` of the pixels lie.
+  int Percentile(double fraction) const;
+  // The share of the pixels at `level` or above.
+  double ShareFrom(int level) const;
+
+ private:
+  int count_[256] = {};
+  double total_ = 0.0;
+};
+
 // The columns of `grey` (CV_8UC1) that can hold the pattern, as a rectangle
 // of full height: from `margin` px left of the first to `margin` px right of
 // the last column of 4 x 4 blocks whose mean rises more than `rise` grey

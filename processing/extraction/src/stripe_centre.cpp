@@ -469,20 +469,23 @@ std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
   // noise sigma 3 leaves about 2 % of a 60 grey-level stripe). A fit that
   // fails these has taken in something else: a segment, a shadow edge, or
   // a stripe hidden behind another.
-  double lowest = std::numeric_limits<double>::infinity(), narrowest = lowest, widest = 0.0;
+  std::vector<double> height(static_cast<size_t>(k));  // of each fitted stripe
+  double narrowest = std::numeric_limits<double>::infinity(), widest = 0.0;
   for (int j = 0; j < k; ++j) {
     const double sg = theta[4 + 3 * j];
-    lowest = std::min(lowest, theta[2 + 3 * j] * (NormalCdf(0.5 / sg) - NormalCdf(-0.5 / sg)));
+    height[static_cast<size_t>(j)] =
+        theta[2 + 3 * j] * (NormalCdf(0.5 / sg) - NormalCdf(-0.5 / sg));
     narrowest = std::min(narrowest, sg);
     widest = std::max(widest, sg);
   }
+  const double lowest = *std::min_element(height.begin(), height.end());
   if (!(std::sqrt(cost / n) <= 0.07 * lowest) || narrowest < 0.4 * params.min_sigma ||
       widest > 2.0 * narrowest)
     return out;
+  // Each stripe (its FWHM is at most max_width: the search stayed feasible).
   for (int j = 0; j < k; ++j) {
-    const double area = theta[2 + 3 * j], c = theta[3 + 3 * j], sg = theta[4 + 3 * j];
-    const double height = area * (NormalCdf(0.5 / sg) - NormalCdf(-0.5 / sg));
-    if (!(height >= params.min_contrast) || !(2.3548 * sg <= params.max_width)) continue;
+    const double c = theta[3 + 3 * j];
+    if (!(height[static_cast<size_t>(j)] >= params.min_contrast)) continue;
     if (std::abs(c - approximate[static_cast<size_t>(j)]) > params.search_radius + 0.5) continue;
     if (j > 0 && c - theta[3 + 3 * (j - 1)] <= 1.0) continue;
     if (j + 1 < k && theta[3 + 3 * (j + 1)] - c <= 1.0) continue;
