@@ -41,6 +41,26 @@ class LesionFace : public ::testing::Test {
   static inline DecodeResult* result_ = nullptr;
 };
 
+// Below the nasolabial fold lines 4-6 run 3-8 px apart (rows 355-385), so
+// the segments between them are 2-6 px long and each pair of T-junctions
+// they join fell into one skeleton cluster of four branches, read as a
+// crossing: (4,8), (5,8), (5,9) and (6,9) were lost and lines 4 and 5 left
+// unlabelled there. Each such H is split into its two junctions
+// (interpretation::SkeletonGraph::Build).
+TEST_F(LesionFace, JunctionsJoinedByShortSegmentsBelowTheFoldAreFound) {
+  const DecodeResult& r = *result_;
+  ASSERT_TRUE(r.ok) << r.error;
+  const cv::Rect2d fold(295.0, 355.0, 35.0, 30.0);
+  std::vector<simulator::PointLabel> truth, decoded;
+  for (const simulator::PointLabel& l : simulator::VisibleJunctions(frame_->truth))
+    if (fold.contains(l.position)) truth.push_back(l);
+  for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
+  const simulator::LabelScore score = simulator::ScoreLabels(truth, decoded, kMatchReach);
+  EXPECT_GE(score.truth, 6) << score.Summary();
+  EXPECT_EQ(score.found, score.truth) << score.Summary();
+  EXPECT_EQ(score.Wrong(), 0) << score.Summary();
+}
+
 // The forehead cavity's wall crowds lines 3-5 within a few pixels, where a
 // line's chain can cross onto a neighbour's strand: a line walked from its
 // junctions must stop before a junction of another line, or it takes the

@@ -72,6 +72,68 @@ TEST(JunctionNetwork, ASteepLineIsFollowedPastASegmentNearlyAsFlat) {
   EXPECT_EQ(junctions, 1);
 }
 
+// Where a fold squeezes two lines to 3 px apart (the nasolabial fold of the
+// lesion frame), the segment between them is two pixels long and every pixel
+// of the H has three or more neighbours: one cluster of four branches, read
+// as a crossing, and both junctions were lost. Split, each is a T of the
+// pattern: a line up and down and the segment to the other.
+TEST(SkeletonGraph, TwoJunctionsJoinedByAShortSegmentAreTwoNodes) {
+  for (const int gap : {3, 4, 6}) {
+    SCOPED_TRACE(gap);
+    cv::Mat sk = cv::Mat::zeros(60, 60, CV_8UC1);
+    const int left = 25, right = left + gap;
+    cv::line(sk, {left, 5}, {left, 55}, 255);
+    cv::line(sk, {right, 5}, {right, 55}, 255);
+    cv::line(sk, {left, 30}, {right, 30}, 255);
+    const SkeletonGraph g = SkeletonGraph::Build(sk);
+    const JunctionNetwork net(g, pattern::Side::kLeft);
+    std::vector<int> junctions;
+    for (int n = 0; n < static_cast<int>(g.nodes().size()); ++n)
+      if (g.nodes()[n].kind == NodeKind::kJunction) junctions.push_back(n);
+    ASSERT_EQ(junctions.size(), 2u);
+    for (int n : junctions) {
+      EXPECT_EQ(g.Degree(n), 3);
+      EXPECT_TRUE(net.IsPatternJunction(n));
+      const bool is_left = g.nodes()[n].centre.x < left + gap / 2.0;
+      // Left side: a segment to the right is corresponding, to the left direct.
+      EXPECT_EQ(net.role(n).attribute,
+                is_left ? JunctionAttribute::kCorresponding : JunctionAttribute::kDirect);
+      const auto across = net.AcrossSegment(n);
+      ASSERT_TRUE(across.has_value());
+      EXPECT_TRUE(across->consistent);
+      EXPECT_NE(across->target, n);
+      for (const bool down : {false, true}) {
+        const auto along = net.AlongLine(n, down);
+        ASSERT_TRUE(along.has_value());
+        EXPECT_NEAR(g.nodes()[along->target].centre.x, is_left ? left : right, 0.5);
+      }
+    }
+  }
+}
+
+// Two lines crossing (thesis 5.1.4.8) are not taken for such an H: the
+// branch pixels of an X lie above one another, so its node (or the two nodes
+// of a shallow crossing, joined along the shared run) stays on the crossing.
+TEST(SkeletonGraph, LinesCrossingAreNotSplitSideways) {
+  for (const int half_width : {4, 10, 25}) {
+    SCOPED_TRACE(half_width);
+    cv::Mat sk = cv::Mat::zeros(60, 60, CV_8UC1);
+    cv::line(sk, {30 - half_width, 5}, {30 + half_width, 55}, 255);
+    cv::line(sk, {30 + half_width, 5}, {30 - half_width, 55}, 255);
+    const SkeletonGraph g = SkeletonGraph::Build(sk);
+    int junctions = 0, branches = 0;
+    for (int n = 0; n < static_cast<int>(g.nodes().size()); ++n)
+      if (g.nodes()[n].kind == NodeKind::kJunction) {
+        ++junctions;
+        branches += g.Degree(n);
+        EXPECT_NEAR(g.nodes()[n].centre.x, 30.0, 1.0);
+      }
+    EXPECT_GE(junctions, 1);
+    EXPECT_LE(junctions, 2);
+    EXPECT_EQ(branches, junctions == 1 ? 4 : 6);
+  }
+}
+
 TEST(SkeletonGraph, ClosedRingWithoutNodesGetsAnAnchor) {
   cv::Mat sk = cv::Mat::zeros(40, 40, CV_8UC1);
   cv::rectangle(sk, {10, 10}, {30, 25}, 255);

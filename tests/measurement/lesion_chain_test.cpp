@@ -44,8 +44,10 @@ struct Lesion {
   // Share of the region the measured surface covers today, less a margin
   // of about two points for other machines' floating point (OpenCV's SIMD
   // paths differ in the last bits): a floor that keeps what the decoder
-  // reaches (the lump: 74.7 % on 2026-11-26, 70.8 % before lines crowding
-  // at the nasolabial fold were fitted jointly); the whole region is lit and seen.
+  // reaches (the lump: 78.1 % on 2026-11-26, third session, since two
+  // junctions joined by a short segment are no longer one node; 74.7 % before,
+  // 70.8 % before lines crowding at the nasolabial fold were fitted jointly);
+  // the whole region is lit and seen.
   double min_coverage;
   // Whether the chain meets the acceptance for the area (3 %) and the
   // volume (5 %) both ways today; otherwise they are held one way (never
@@ -59,7 +61,7 @@ struct Lesion {
 const Lesion kLesions[] = {
     {"cheek lump",
      {.centre_xy_mm = {-42.0, -32.0}, .height_mm = 15.0, .radius_mm = 30.0, .top_radius_mm = 12.0},
-     0.72, false, false},
+     0.76, false, false},
     {"forehead cavity",
      {.centre_xy_mm = {-28.0, 50.0}, .height_mm = -15.0, .radius_mm = 28.0, .top_radius_mm = 11.0},
      0.99, true, true},
@@ -195,10 +197,10 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     EXPECT_LT(std::abs(e.peak_mm), 0.15);
     // Area and volume within the acceptance where the chain meets it (the
     // cavities: areas -1.0 and -2.1 %, volumes -0.3 and -2.0 %); where it does
-    // not yet (issue 3 notes: the cheek lump's surface covers 75 % of its
-    // region; lines 3-5 crowd at the nasolabial fold and are lost over
-    // 30-50 rows, lines 10-13 lean and fade on its lower skirt), held one
-    // way: never more than the truth.
+    // not yet (issue 3 notes: the cheek lump's surface covers 78 % of its
+    // region; lines 2-5 crowd at the nasolabial fold and lose 10-20 rows
+    // there, lines 7-12 lean and fade on its lower skirt), held one way:
+    // never more than the truth.
     EXPECT_LT(e.area_relative, kAreaRelativeTolerance);
     EXPECT_LT(e.volume_relative, kVolumeRelativeTolerance);
     if (lesion.area_met) {
@@ -209,11 +211,11 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     }
     EXPECT_GE(m.surface_coverage, lesion.min_coverage);
     // With the region's holes filled (LesionMeasurement::filled_*; the
-    // lump: 27 % of its region, where lines 3-5 pinch at the nasolabial fold
-    // and its lower outer skirt, where lines 10-13 bend and fade; flagged as
+    // lump: 23 % of its region, where lines 2-5 pinch at the nasolabial fold
+    // and its lower outer skirt, where lines 7-12 bend and fade; flagged as
     // interpolated; the cheek cavity: 6 % of its region, where the baseline
     // has no surface under the measured one): the acceptance both ways for
-    // every lesion (lump area +1.2 %, volume +1.4 %). Filling only adds area.
+    // every lesion (lump area +1.1 %, volume +1.4 %). Filling only adds area.
     const double filled_area = m.filled_area_mm2.value / truth.area_on_base_mm2 - 1.0;
     const double filled_volume = m.filled_volume_mm3.value / std::abs(truth.volume_mm3) - 1.0;
     EXPECT_GE(filled_area, e.area_relative);

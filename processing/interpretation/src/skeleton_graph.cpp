@@ -22,6 +22,78 @@ bool Inside(const cv::Mat& m, int x, int y) { return x >= 0 && y >= 0 && x < m.c
 int EncodeEdge(int e) { return -e - 2; }
 int DecodeEdge(int v) { return -v - 2; }
 
+// The crossing number of a pixel: how many separate runs of set pixels its
+// eight neighbours form, walked round (three or more: a branch point).
+template <typename IsSet>
+int CrossingNumber(cv::Point p, IsSet is_set) {
+  // Neighbours in circular order: E, NE, N, NW, W, SW, S, SE.
+  static constexpr int dx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+  static constexpr int dy[8] = {0, -1, -1, -1, 0, 1, 1, 1};
+  int runs = 0;
+  bool prev = is_set(p.x + dx[7], p.y + dy[7]);
+  for (int k = 0; k < 8; ++k) {
+    const bool cur = is_set(p.x + dx[k], p.y + dy[k]);
+    if (cur && !prev) ++runs;
+    prev = cur;
+  }
+  return runs;
+}
+
+// Splits a junction cluster that is two T-junctions joined by a short
+// segment: its branch pixels form exactly two 8-connected groups at least 3 px
+// apart, more side by side than one above the other. Every pixel of the
+// cluster goes to the half whose branch pixels lie nearer (chessboard
+// distance). Returns false, leaving *a and *b alone, for any other cluster.
+template <typename IsSet>
+bool SplitH(const std::vector<cv::Point>& cluster, IsSet is_set, std::vector<cv::Point>* a,
+            std::vector<cv::Point>* b) {
+  std::vector<cv::Point> branch;
+  for (const cv::Point& p : cluster)
+    if (CrossingNumber(p, is_set) >= 3) branch.push_back(p);
+  if (branch.size() < 2) return false;
+  auto touch = [](cv::Point p, cv::Point q) {
+    return std::max(std::abs(p.x - q.x), std::abs(p.y - q.y)) <= 1;
+  };
+  // Groups by flood over the (few) branch pixels.
+  std::vector<int> group(branch.size(), -1);
+  int groups = 0;
+  for (size_t s = 0; s < branch.size(); ++s) {
+    if (group[s] >= 0) continue;
+    if (groups == 2) return false;
+    std::vector<size_t> stack{s};
+    group[s] = groups;
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      for (size_t j = 0; j < branch.size(); ++j)
+        if (group[j] < 0 && touch(branch[i], branch[j])) group[j] = groups, stack.push_back(j);
+    }
+    ++groups;
+  }
+  if (groups != 2) return false;
+  cv::Point2d centre[2] = {{0, 0}, {0, 0}};
+  int count[2] = {0, 0};
+  for (size_t i = 0; i < branch.size(); ++i) {
+    centre[group[i]] += cv::Point2d(branch[i].x, branch[i].y);
+    ++count[group[i]];
+  }
+  centre[0] *= 1.0 / count[0];
+  centre[1] *= 1.0 / count[1];
+  const double dx = std::abs(centre[0].x - centre[1].x), dy = std::abs(centre[0].y - centre[1].y);
+  if (dx < 3.0 || 2.0 * dy > dx) return false;
+  std::vector<cv::Point> halves[2];
+  for (const cv::Point& p : cluster) {
+    int best[2] = {1 << 20, 1 << 20};
+    for (size_t i = 0; i < branch.size(); ++i)
+      best[group[i]] = std::min(best[group[i]], std::max(std::abs(p.x - branch[i].x),
+                                                         std::abs(p.y - branch[i].y)));
+    halves[best[1] < best[0] ? 1 : 0].push_back(p);
+  }
+  *a = std::move(halves[0]);
+  *b = std::move(halves[1]);
+  return true;
+}
+
 }  // namespace
 
 bool GraphParams::IsValid(std::string* error) const {
@@ -236,6 +308,34 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
       g.nodes_[cluster].pixels.push_back({x, y});
     }
   }
+  // Thesis 5.1.4.8: where two lines run a few pixels apart, the short segment
+  // between them puts its two T-junctions into one cluster (an H of four
+  // branches, which reads as a crossing). Such a cluster holds two groups of
+  // branch pixels (three or more separate runs of neighbours) side by side;
+  // it is split between them when each half keeps a line up and down.
+  const int clusters = static_cast<int>(g.nodes_.size());
+  for (int id = 0; id < clusters; ++id) {
+    std::vector<cv::Point> pixels = g.nodes_[id].pixels;
+    if (pixels.size() < 3) continue;
+    std::vector<cv::Point> halves[2];
+    if (!SplitH(pixels, [&](int x, int y) { return set(x, y); }, &halves[0], &halves[1])) continue;
+    // Each half must leave the cluster on exactly two pixels: its line.
+    auto exits = [&](const std::vector<cv::Point>& half) {
+      std::set<std::pair<int, int>> out;
+      for (const cv::Point& p : half)
+        for (int c = 0; c < 8; ++c) {
+          const int nx = p.x + kCodeDx[c], ny = p.y + kCodeDy[c];
+          if (set(nx, ny) && owner(nx, ny) != id) out.insert({nx, ny});
+        }
+      return out.size();
+    };
+    if (exits(halves[0]) != 2 || exits(halves[1]) != 2) continue;
+    const int other = new_node(NodeKind::kJunction);
+    g.nodes_[id].pixels = halves[0];
+    g.nodes_[other].pixels = halves[1];
+    for (const cv::Point& p : halves[1]) owner(p.x, p.y) = other;
+  }
+
   // Line ends.
   for (const cv::Point& p : lit)
     if (degree(p.x, p.y) == 1 && owner(p.x, p.y) == kNone) {
