@@ -7,10 +7,14 @@
 // Two references: a baseline scan of the same face without the lesions
 // (registered onto the surface outside each region) and, for comparison, the
 // single-scan cubic ring reference (docs/measurement.md says why the face's
-// own shape limits it).
+// own shape limits it). And one yardstick for the decoder: the same frames
+// reconstructed from a perfect decode (every lit and visible junction and
+// line point of the simulator's truth), which shows what the rest of the
+// chain can measure from these two views at all.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <numbers>
@@ -18,6 +22,8 @@
 #include "bsls/joining/join.h"
 #include "bsls/measurement/lesion_measure.h"
 #include "bsls/measurement/report.h"
+#include "bsls/reconstruction/calibrated_model.h"
+#include "bsls/reconstruction/reconstruction.h"
 #include "bsls/reconstruction/side_pipeline.h"
 #include "bsls/simulator/calibration_session.h"
 #include "bsls/simulator/lesion.h"
@@ -77,10 +83,39 @@ simulator::ThesisSceneOptions SceneOptions(bool with_lesions) {
   return options;
 }
 
+// What a perfect decoder would report for `frame`: every lit and visible
+// junction with its true label (q absolute: the slide row) and every true
+// line centre.
+decoder::DecodeResult PerfectDecode(const simulator::Frame& frame, Side side) {
+  decoder::DecodeResult d;
+  d.ok = true;
+  d.side = side;
+  d.width = frame.image.cols;
+  d.height = frame.image.rows;
+  d.q_absolute = true;
+  for (const simulator::TruthJunction& j : frame.truth.junctions)
+    if (j.visible) d.junctions.push_back({cv::Point2d(j.image.x(), j.image.y()), j.p, j.v, j.kind});
+  std::sort(d.junctions.begin(), d.junctions.end(), [](const auto& a, const auto& b) {
+    return a.p != b.p ? a.p < b.p : a.q < b.q;
+  });
+  for (const simulator::TruthLine& l : frame.truth.lines) {
+    decoder::DecodedLine line{l.p, {}};
+    for (const Eigen::Vector2d& q : l.points) line.points.emplace_back(q.x(), q.y());
+    d.lines.push_back(std::move(line));
+  }
+  std::sort(d.lines.begin(), d.lines.end(), [](const auto& a, const auto& b) { return a.p < b.p; });
+  return d;
+}
+
+// The joined face from the decoder, and from a perfect decode of the same frames.
+struct JoinedFaces {
+  geometry::SurfaceMesh decoded, perfect;
+};
+
 // Both sides rendered, reconstructed with their calibrations and joined, in
 // the calibration world frame; once per process and kind.
-const geometry::SurfaceMesh& JoinedFace(bool with_lesions) {
-  static std::map<bool, geometry::SurfaceMesh> cache;
+const JoinedFaces& Joined(bool with_lesions) {
+  static std::map<bool, JoinedFaces> cache;
   if (auto it = cache.find(with_lesions); it != cache.end()) return it->second;
   const calibration::SideCalibration& left_cal =
       calibration::testing::SessionCalibration(SessionKind::kLeftNoisy);
@@ -89,19 +124,25 @@ const geometry::SurfaceMesh& JoinedFace(bool with_lesions) {
   simulator::RenderParams render;
   render.noise_sigma = kNoiseSigma;
   render.seed = 5;
-  std::optional<geometry::SurfaceMesh> sides[2];
+  std::optional<geometry::SurfaceMesh> sides[2], perfect[2];
   for (Side side : {Side::kLeft, Side::kRight}) {
     const simulator::Frame frame = simulator::Render(
         simulator::ThesisScene(side, simulator::SurfaceKind::kFace, SceneOptions(with_lesions)),
         render);
-    const reconstruction::SideOutcome out = reconstruction::ProcessSide(
-        frame.image, side, side == Side::kLeft ? &left_cal : &right_cal);
+    const calibration::SideCalibration& cal = side == Side::kLeft ? left_cal : right_cal;
+    const reconstruction::SideOutcome out = reconstruction::ProcessSide(frame.image, side, &cal);
     EXPECT_TRUE(out.decode.ok) << out.decode.error;
-    sides[side == Side::kLeft ? 0 : 1] = out.surface;
+    const int k = side == Side::kLeft ? 0 : 1;
+    sides[k] = out.surface;
+    perfect[k] = reconstruction::Reconstruct(PerfectDecode(frame, side),
+                                             reconstruction::ModelOfCalibration(cal));
   }
   if (!sides[0] || !sides[1]) throw std::runtime_error("a side was not reconstructed");
-  return cache[with_lesions] = joining::JoinSharedFrame(*sides[0], *sides[1], {}).mesh;
+  return cache[with_lesions] = {joining::JoinSharedFrame(*sides[0], *sides[1], {}).mesh,
+                                joining::JoinSharedFrame(*perfect[0], *perfect[1], {}).mesh};
 }
+
+const geometry::SurfaceMesh& JoinedFace(bool with_lesions) { return Joined(with_lesions).decoded; }
 
 // The world frame of the calibrations: the rig frame moved to the target's origin.
 Eigen::Vector2d ToCalibrationWorld(const Eigen::Vector2d& rig_xy) {
@@ -240,6 +281,34 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     const Errors ring = Compare("cubic ring", lesion, truth, ring_m);
     EXPECT_LT(std::abs(ring.peak_mm), 2.5 * ring_m.peak_mm.uncertainty);
   }
+  // The lump through a perfect decode of the same frames: what any decoder
+  // could give the rest of the chain (its baseline scan decoded perfectly
+  // too). Its surface covers 83.5 % of the region and its area is 3.1 %
+  // short (volume 5.9 %): on the lower outer skirt the outermost lit and
+  // visible lines (10-13) end at different rows and a strip needs both its
+  // lines, and at the nasolabial fold line 4 passes behind the fold. So the
+  // 3 % acceptance as measured is at the edge of what these two views hold
+  // (issue notes); the decoder (78.1 %, area 4.7 % below the perfect
+  // decode's) is held within a few points of it.
+  {
+    const SurfaceQuery perfect(Joined(true).perfect);
+    const LesionMeasurement best =
+        MeasureLesionAgainstBaseline(perfect, Joined(false).perfect, Region(kLesions[0]));
+    const LesionMeasurement decoded =
+        MeasureLesionAgainstBaseline(surface, baseline, Region(kLesions[0]));
+    const simulator::LesionTruth truth = Truth(0);
+    std::printf(
+        "[ figures  ] %s, perfect decode: surface covers %.1f %% of the region; area %.1f (true "
+        "%.1f) mm^2 (%+.1f %%), volume %.0f (true %.0f) mm^3 (%+.1f %%)\n",
+        kLesions[0].name, 100.0 * best.surface_coverage, best.area_mm2.value,
+        truth.area_on_base_mm2, 100.0 * (best.area_mm2.value / truth.area_on_base_mm2 - 1.0),
+        best.volume_mm3.value, std::abs(truth.volume_mm3),
+        100.0 * (best.volume_mm3.value / std::abs(truth.volume_mm3) - 1.0));
+    EXPECT_LE(decoded.surface_coverage, best.surface_coverage + 0.01);
+    EXPECT_GE(decoded.surface_coverage, best.surface_coverage - 0.075);
+    EXPECT_GE(decoded.area_mm2.value, 0.95 * best.area_mm2.value);
+  }
+
   // Without registration the repositioned baseline is the wrong reference;
   // a baseline of something else (40 mm away) is refused.
   BaselineParams same_frame;
