@@ -44,10 +44,12 @@ int CrossingNumber(cv::Point p, IsSet is_set) {
 // apart, more side by side than one above the other. Every pixel of the
 // cluster goes to the half whose branch pixels lie nearer (chessboard
 // distance). Returns false, leaving *a and *b alone, for any other cluster.
+// `branch` is scratch space, reused from cluster to cluster.
 template <typename IsSet>
-bool SplitH(const std::vector<cv::Point>& cluster, IsSet is_set, std::vector<cv::Point>* a,
-            std::vector<cv::Point>* b) {
-  std::vector<cv::Point> branch;
+bool SplitH(const std::vector<cv::Point>& cluster, IsSet is_set, std::vector<cv::Point>* branch_out,
+            std::vector<cv::Point>* a, std::vector<cv::Point>* b) {
+  std::vector<cv::Point>& branch = *branch_out;
+  branch.clear();
   for (const cv::Point& p : cluster)
     if (CrossingNumber(p, is_set) >= 3) branch.push_back(p);
   if (branch.size() < 2) return false;
@@ -314,11 +316,13 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
   // branch pixels (three or more separate runs of neighbours) side by side;
   // it is split between them when each half keeps a line up and down.
   const int clusters = static_cast<int>(g.nodes_.size());
+  std::vector<cv::Point> branch;
   for (int id = 0; id < clusters; ++id) {
-    std::vector<cv::Point> pixels = g.nodes_[id].pixels;
+    const std::vector<cv::Point>& pixels = g.nodes_[id].pixels;  // until a node is added
     if (pixels.size() < 3) continue;
     std::vector<cv::Point> halves[2];
-    if (!SplitH(pixels, [&](int x, int y) { return set(x, y); }, &halves[0], &halves[1])) continue;
+    if (!SplitH(pixels, [&](int x, int y) { return set(x, y); }, &branch, &halves[0], &halves[1]))
+      continue;
     // Each half must leave the cluster on exactly two pixels: its line.
     auto exits = [&](const std::vector<cv::Point>& half) {
       std::set<std::pair<int, int>> out;
