@@ -111,6 +111,57 @@ TEST(SkeletonGraph, TwoJunctionsJoinedByAShortSegmentAreTwoNodes) {
   }
 }
 
+// At the nasolabial fold line 3 comes out from behind the fold beside line 5
+// and its end merges into line 5's strand: a Y whose short way on to line
+// 5's next junction (3 px) read as its segment, so line 5 was walked into
+// line 3 below the Y and its own rows were lost. The junction at the end
+// of that short way has a segment of its own and takes the edge for its
+// line: the Y is a crossing point on line 5, which goes on through it.
+TEST(JunctionNetwork, ALineMergingAtAFoldIsNotTakenForASegment) {
+  cv::Mat sk = cv::Mat::zeros(90, 60, CV_8UC1);
+  const cv::Point y_node{30, 40}, junction{26, 44};
+  cv::line(sk, {30, 5}, y_node, 255);        // line 5 from above
+  cv::line(sk, y_node, junction, 255);       // its short way on (3 px between)
+  cv::line(sk, junction, {26, 85}, 255);     // line 5 below its junction
+  cv::line(sk, junction, {8, 44}, 255);      // that junction's segment
+  cv::line(sk, y_node, {42, 80}, 255);       // line 3, come out from behind the fold
+  const SkeletonGraph g = SkeletonGraph::Build(sk);
+  const JunctionNetwork net(g, pattern::Side::kLeft);
+  auto node_near = [&](cv::Point p) {
+    for (int n = 0; n < static_cast<int>(g.nodes().size()); ++n)
+      if (cv::norm(g.nodes()[n].centre - cv::Point2d(p)) < 1.5) return n;
+    return -1;
+  };
+  const int y = node_near(y_node), j = node_near(junction), top = node_near({30, 5});
+  const int emerging = node_near({42, 80});
+  ASSERT_GE(y, 0);
+  ASSERT_GE(j, 0);
+  ASSERT_GE(top, 0);
+  ASSERT_GE(emerging, 0);
+  EXPECT_FALSE(net.IsPatternJunction(y));
+  EXPECT_TRUE(net.IsPatternJunction(j));
+  // Line 5 runs from the top through the Y to its junction and on.
+  const auto into_y = net.AlongLine(top, true);
+  ASSERT_TRUE(into_y.has_value());
+  EXPECT_EQ(into_y->target, y);
+  EXPECT_TRUE(into_y->consistent);
+  const auto on = net.AlongLine(y, true);
+  ASSERT_TRUE(on.has_value());
+  EXPECT_EQ(on->target, j);
+  EXPECT_TRUE(on->consistent);
+  // Line 3 ends at the Y.
+  const auto up = net.AlongLine(emerging, false);
+  ASSERT_TRUE(up.has_value());
+  EXPECT_EQ(up->target, y);
+  EXPECT_FALSE(up->consistent);
+
+  // With no merge edge allowed the Y is the junction it looked like.
+  JunctionParams strict;
+  strict.max_merge_edge = 0;
+  const JunctionNetwork as_before(g, pattern::Side::kLeft, strict);
+  EXPECT_TRUE(as_before.IsPatternJunction(y));
+}
+
 // Two lines crossing (thesis 5.1.4.8) are not taken for such an H: the
 // branch pixels of an X lie above one another, so its node (or the two nodes
 // of a shallow crossing, joined along the shared run) stays on the crossing.

@@ -50,10 +50,11 @@ struct Lesion {
   // Share of the region the measured surface covers today, less a margin
   // of about two points for other machines' floating point (OpenCV's SIMD
   // paths differ in the last bits): a floor that keeps what the decoder
-  // reaches (the lump: 78.1 % on 2026-11-26, third session, since two
-  // junctions joined by a short segment are no longer one node; 74.7 % before,
-  // 70.8 % before lines crowding at the nasolabial fold were fitted jointly);
-  // the whole region is lit and seen.
+  // reaches (the lump: 82.4 % on 2026-11-26, third session, since a line
+  // merging at the fold no longer takes its neighbour's label; 78.1 % since
+  // two junctions joined by a short segment are no longer one node, 74.7 %
+  // before, 70.8 % before lines crowding at the nasolabial fold were fitted
+  // jointly); the whole region is lit and seen.
   double min_coverage;
   // Whether the chain meets the acceptance for the area (3 %) and the
   // volume (5 %) both ways today; otherwise they are held one way (never
@@ -67,7 +68,7 @@ struct Lesion {
 const Lesion kLesions[] = {
     {"cheek lump",
      {.centre_xy_mm = {-42.0, -32.0}, .height_mm = 15.0, .radius_mm = 30.0, .top_radius_mm = 12.0},
-     0.76, false, false},
+     0.80, false, false},
     {"forehead cavity",
      {.centre_xy_mm = {-28.0, 50.0}, .height_mm = -15.0, .radius_mm = 28.0, .top_radius_mm = 11.0},
      0.99, true, true},
@@ -238,10 +239,9 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     EXPECT_LT(std::abs(e.peak_mm), 0.15);
     // Area and volume within the acceptance where the chain meets it (the
     // cavities: areas -1.0 and -2.1 %, volumes -0.3 and -2.0 %); where it does
-    // not yet (issue 3 notes: the cheek lump's surface covers 78 % of its
-    // region; lines 2-5 crowd at the nasolabial fold and lose 10-20 rows
-    // there, lines 7-12 lean and fade on its lower skirt), held one way:
-    // never more than the truth.
+    // not yet (issue 3 notes: the cheek lump's surface covers 82 % of its
+    // region, area -3.8 %; even a perfect decode covers only 83.5 %, below),
+    // held one way: never more than the truth.
     EXPECT_LT(e.area_relative, kAreaRelativeTolerance);
     EXPECT_LT(e.volume_relative, kVolumeRelativeTolerance);
     if (lesion.area_met) {
@@ -252,11 +252,11 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     }
     EXPECT_GE(m.surface_coverage, lesion.min_coverage);
     // With the region's holes filled (LesionMeasurement::filled_*; the
-    // lump: 23 % of its region, where lines 2-5 pinch at the nasolabial fold
-    // and its lower outer skirt, where lines 7-12 bend and fade; flagged as
+    // lump: 19 % of its region, where line 4 passes behind the nasolabial
+    // fold and on its lower outer skirt, where lines 10-13 end; flagged as
     // interpolated; the cheek cavity: 6 % of its region, where the baseline
     // has no surface under the measured one): the acceptance both ways for
-    // every lesion (lump area +1.1 %, volume +1.4 %). Filling only adds area.
+    // every lesion (lump area +1.8 %, volume +1.8 %). Filling only adds area.
     const double filled_area = m.filled_area_mm2.value / truth.area_on_base_mm2 - 1.0;
     const double filled_volume = m.filled_volume_mm3.value / std::abs(truth.volume_mm3) - 1.0;
     EXPECT_GE(filled_area, e.area_relative);
@@ -288,7 +288,7 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
   // visible lines (10-13) end at different rows and a strip needs both its
   // lines, and at the nasolabial fold line 4 passes behind the fold. So the
   // 3 % acceptance as measured is at the edge of what these two views hold
-  // (issue notes); the decoder (78.1 %, area 4.7 % below the perfect
+  // (issue notes); the decoder (82.4 %, area 0.7 % below the perfect
   // decode's) is held within a few points of it.
   {
     const SurfaceQuery perfect(Joined(true).perfect);
@@ -305,8 +305,8 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
         best.volume_mm3.value, std::abs(truth.volume_mm3),
         100.0 * (best.volume_mm3.value / std::abs(truth.volume_mm3) - 1.0));
     EXPECT_LE(decoded.surface_coverage, best.surface_coverage + 0.01);
-    EXPECT_GE(decoded.surface_coverage, best.surface_coverage - 0.075);
-    EXPECT_GE(decoded.area_mm2.value, 0.95 * best.area_mm2.value);
+    EXPECT_GE(decoded.surface_coverage, best.surface_coverage - 0.03);
+    EXPECT_GE(decoded.area_mm2.value, 0.97 * best.area_mm2.value);
   }
 
   // Without registration the repositioned baseline is the wrong reference;

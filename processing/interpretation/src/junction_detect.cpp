@@ -102,6 +102,8 @@ bool JunctionParams::IsValid(std::string* error) const {
       horizontal_tolerance_deg <= 0 || horizontal_tolerance_deg >= 90 ||
       opposite_tolerance_deg <= 0 || opposite_tolerance_deg >= 90)
     return fail("junction angle tolerances must lie in (0, 90) degrees");
+  if (max_merge_edge < 0 || max_merge_edge > 50)
+    return fail("max_merge_edge must lie in 0..50 pixels");
   return true;
 }
 

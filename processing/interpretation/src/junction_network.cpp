@@ -86,6 +86,30 @@ JunctionNetwork::JunctionNetwork(const SkeletonGraph& graph, pattern::Side side,
     role.side = others[0];
     role.attribute = AttributeForSegment(side, sd.x);
   }
+  // Thesis 5.1.4.8: where a line comes out from behind a fold beside its
+  // neighbour, its end merges into the neighbour's strand in a Y that reads
+  // as a junction, the neighbour's short way on to its next junction taken
+  // for the segment. That junction knows better: it has a segment of its
+  // own and takes the edge for its line. The Y is then a crossing point on
+  // the neighbour's line (up, and down through the edge), and the emerging
+  // line ends at it.
+  std::vector<std::pair<int, int>> merges;  // (node, half-edge its line continues along)
+  for (int n = 0; n < static_cast<int>(roles_.size()); ++n) {
+    const NodeRole& role = roles_[n];
+    if (role.side < 0 || !IsPatternJunction(n) || role.up < 0 || role.down < 0) continue;
+    if (graph.Length(role.side) > params.max_merge_edge) continue;
+    const int t = graph.Target(role.side);
+    const int back = SkeletonGraph::Twin(role.side);
+    if (t == n || !IsPatternJunction(t) || roles_[t].side < 0) continue;
+    if (roles_[t].up == back || roles_[t].down == back) merges.emplace_back(n, role.side);
+  }
+  for (const auto& [n, h] : merges) {
+    NodeRole& role = roles_[n];
+    const bool edge_goes_down = roles_[graph.Target(h)].up == SkeletonGraph::Twin(h);
+    (edge_goes_down ? role.down : role.up) = h;
+    role.side = -1;
+    role.attribute = JunctionAttribute::kCross3;
+  }
 }
 
 bool JunctionNetwork::IsPatternJunction(int node) const {

@@ -33,6 +33,9 @@ struct JunctionParams {
   // How far (degrees) the two line paths may be from opposite (a line can
   // fold sharply at a junction, e.g. at the lips).
   double opposite_tolerance_deg = 89.0;
+  // px: the longest edge from a junction to a neighbouring junction that
+  // takes it for its line, read as a line merging at a fold (JunctionNetwork).
+  int max_merge_edge = 4;
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;
