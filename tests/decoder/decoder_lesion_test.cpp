@@ -37,6 +37,28 @@ class LesionFace : public ::testing::Test {
     delete result_;
     delete frame_;
   }
+  // The decoded points of lines first_p..last_p in rows first_y..last_y that
+  // have a true crossing in their row, and their RMS distance from it (px).
+  static std::pair<int, double> ScoreStretch(const DecodeResult& r, int first_p, int last_p,
+                                             int first_y, int last_y) {
+    std::map<int, std::map<int, double>> truth;  // p -> row -> x
+    for (const simulator::LinePoints& line : simulator::TruthLines(frame_->truth))
+      for (const cv::Point2d& q : line.points)
+        truth[line.p][static_cast<int>(std::lround(q.y))] = q.x;
+    int points = 0;
+    double sum_sq = 0.0;
+    for (const DecodedLine& line : r.lines) {
+      if (line.p < first_p || line.p > last_p) continue;
+      for (const cv::Point2d& q : line.points) {
+        const int y = static_cast<int>(std::lround(q.y));
+        if (y < first_y || y > last_y || !truth[line.p].contains(y)) continue;
+        ++points;
+        sum_sq += std::pow(q.x - truth[line.p][y], 2);
+      }
+    }
+    return {points, std::sqrt(sum_sq / std::max(points, 1))};
+  }
+
   static inline simulator::Frame* frame_ = nullptr;
   static inline DecodeResult* result_ = nullptr;
 };
@@ -73,24 +95,8 @@ TEST_F(LesionFace, ALineComingOutFromBehindTheFoldLeavesItsNeighbourWhole) {
   before.interpretation.junction.max_merge_edge = 0;
   const DecodeResult as_before = Decode(frame_->image, Side::kLeft, before);
   ASSERT_TRUE(result_->ok && as_before.ok);
-  std::map<int, std::map<int, double>> truth;  // p -> row -> x
-  for (const simulator::LinePoints& line : simulator::TruthLines(frame_->truth))
-    for (const cv::Point2d& q : line.points) truth[line.p][static_cast<int>(std::lround(q.y))] = q.x;
-  // Points of lines 3-5 in rows 336-348, and their RMS error.
-  auto score = [&](const DecodeResult& r) {
-    int points = 0;
-    double sum_sq = 0.0;
-    for (const DecodedLine& line : r.lines) {
-      if (line.p < 3 || line.p > 5) continue;
-      for (const cv::Point2d& q : line.points) {
-        const int y = static_cast<int>(std::lround(q.y));
-        if (y < 336 || y > 348 || !truth[line.p].contains(y)) continue;
-        ++points;
-        sum_sq += std::pow(q.x - truth[line.p][y], 2);
-      }
-    }
-    return std::pair{points, std::sqrt(sum_sq / std::max(points, 1))};
-  };
+  // Lines 3-5 in rows 336-348.
+  auto score = [](const DecodeResult& r) { return ScoreStretch(r, 3, 5, 336, 348); };
   const auto [now_points, now_rms] = score(*result_);
   const auto [before_points, before_rms] = score(as_before);
   std::printf("[ figures  ] lines 3-5, rows 336-348: %d points, RMS %.3f px; as before %d, RMS %.3f px\n",
@@ -149,24 +155,8 @@ TEST_F(LesionFace, LinesCrowdedAtAFoldAreMeasuredTogether) {
   alone.crowd_distance = 0.0;
   const DecodeResult one_by_one = Decode(frame_->image, Side::kLeft, alone);
   ASSERT_TRUE(result_->ok && one_by_one.ok);
-  std::map<int, std::map<int, double>> truth;  // p -> row -> x
-  for (const simulator::LinePoints& line : simulator::TruthLines(frame_->truth))
-    for (const cv::Point2d& q : line.points) truth[line.p][static_cast<int>(std::lround(q.y))] = q.x;
-  // Points of lines 4 and 5 in rows 300-335, and their RMS error.
-  auto score = [&](const DecodeResult& r) {
-    int points = 0;
-    double sum_sq = 0.0;
-    for (const DecodedLine& line : r.lines) {
-      if (line.p != 4 && line.p != 5) continue;
-      for (const cv::Point2d& q : line.points) {
-        const int y = static_cast<int>(std::lround(q.y));
-        if (y < 300 || y > 335 || !truth[line.p].contains(y)) continue;
-        ++points;
-        sum_sq += std::pow(q.x - truth[line.p][y], 2);
-      }
-    }
-    return std::pair{points, std::sqrt(sum_sq / std::max(points, 1))};
-  };
+  // Lines 4 and 5 in rows 300-335.
+  auto score = [](const DecodeResult& r) { return ScoreStretch(r, 4, 5, 300, 335); };
   const auto [joint_points, joint_rms] = score(*result_);
   const auto [alone_points, alone_rms] = score(one_by_one);
   std::printf("[ figures  ] lines 4-5, rows 300-335: jointly %d points, RMS %.3f px; one by one %d, RMS %.3f px\n",
