@@ -9,6 +9,7 @@
 #include <numeric>
 #include <set>
 #include <stdexcept>
+#include <utility>
 
 #include "bsls/interpretation/chain_code.h"
 
@@ -26,13 +27,11 @@ int DecodeEdge(int v) { return -v - 2; }
 // eight neighbours form, walked round (three or more: a branch point).
 template <typename IsSet>
 int CrossingNumber(cv::Point p, IsSet is_set) {
-  // Neighbours in circular order: E, NE, N, NW, W, SW, S, SE.
-  static constexpr int dx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
-  static constexpr int dy[8] = {0, -1, -1, -1, 0, 1, 1, 1};
+  // The neighbours in chain-code order run round the pixel.
   int runs = 0;
-  bool prev = is_set(p.x + dx[7], p.y + dy[7]);
+  bool prev = is_set(p.x + kCodeDx[7], p.y + kCodeDy[7]);
   for (int k = 0; k < 8; ++k) {
-    const bool cur = is_set(p.x + dx[k], p.y + dy[k]);
+    const bool cur = is_set(p.x + kCodeDx[k], p.y + kCodeDy[k]);
     if (cur && !prev) ++runs;
     prev = cur;
   }
@@ -335,9 +334,9 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     };
     if (exits(halves[0]) != 2 || exits(halves[1]) != 2) continue;
     const int other = new_node(NodeKind::kJunction);
-    g.nodes_[id].pixels = halves[0];
-    g.nodes_[other].pixels = halves[1];
     for (const cv::Point& p : halves[1]) owner(p.x, p.y) = other;
+    g.nodes_[id].pixels = std::move(halves[0]);
+    g.nodes_[other].pixels = std::move(halves[1]);
   }
 
   // Line ends.
