@@ -9,6 +9,9 @@
 // stages use cv::parallel_for_); BM_DecodeSingleThread sets
 // cv::setNumThreads(1) for both the baseline and the decode, so its ratio
 // compares single-threaded code with single-threaded OpenCV.
+// BM_DecodeNothingAhead is BM_Decode with DecodeParams::measure_ahead off:
+// the sub-pixel centres measured after the interpretation instead of on the
+// second thread during it (counter ahead: centres measured ahead).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -65,8 +68,10 @@ void BM_GaussianBlurCanny(benchmark::State& state) {
 }
 
 // Decodes the face frame of side state.range(0) with `threads` OpenCV
-// threads (0: leave OpenCV's default) and reports the counters above.
-void DecodeWithThreads(benchmark::State& state, int threads) {
+// threads (0: leave OpenCV's default) and `params`, and reports the
+// counters above.
+void DecodeWithThreads(benchmark::State& state, int threads,
+                       const bsls::decoder::DecodeParams& params = {}) {
   const cv::Mat& frame = FaceFrame(static_cast<int>(state.range(0)));
   const int default_threads = cv::getNumThreads();
   if (threads > 0) cv::setNumThreads(threads);
@@ -74,15 +79,17 @@ void DecodeWithThreads(benchmark::State& state, int threads) {
   std::vector<double> base;
   for (int i = 0; i < 30; ++i) base.push_back(BaselineOnce(frame));
   std::vector<double> ms, extraction, interpretation, subpixel;
-  int junctions = 0;
+  int junctions = 0, ahead = 0;
   for (auto _ : state) {
     const auto t = Clock::now();
-    const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame, bsls::pattern::Side::kLeft);
+    const bsls::decoder::DecodeResult r =
+        bsls::decoder::Decode(frame, bsls::pattern::Side::kLeft, params);
     ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
     extraction.push_back(r.times.extraction_ms);
     interpretation.push_back(r.times.interpretation_ms);
     subpixel.push_back(r.times.subpixel_ms);
     junctions = static_cast<int>(r.junctions.size());
+    ahead = r.centres_measured_ahead;
     benchmark::DoNotOptimize(junctions);
   }
   cv::setNumThreads(default_threads);
@@ -95,6 +102,7 @@ void DecodeWithThreads(benchmark::State& state, int threads) {
   state.counters["subpixel_ms"] = Median(subpixel);
   state.counters["threads"] = threads > 0 ? threads : default_threads;
   state.counters["junctions"] = junctions;
+  state.counters["ahead"] = ahead;
   state.counters["pixels"] = static_cast<double>(frame.total());
 }
 
@@ -102,10 +110,17 @@ void BM_Decode(benchmark::State& state) { DecodeWithThreads(state, 0); }
 
 void BM_DecodeSingleThread(benchmark::State& state) { DecodeWithThreads(state, 1); }
 
+void BM_DecodeNothingAhead(benchmark::State& state) {
+  bsls::decoder::DecodeParams params;
+  params.measure_ahead = false;
+  DecodeWithThreads(state, 0, params);
+}
+
 }  // namespace
 
 BENCHMARK(BM_GaussianBlurCanny)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Decode)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_DecodeNothingAhead)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_Decode)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_DecodeSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_DecodeSingleThread)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);

@@ -246,6 +246,39 @@ TEST(Decoder, ColumnsBesideThePatternAreLeftOutWithTheSameResult) {
   }
 }
 
+// The sub-pixel centres measured ahead on a second thread while the frame is
+// interpreted (DecodeParams::measure_ahead) change nothing: the same
+// junctions, labels and centres to the last bit as measured afterwards.
+TEST(Decoder, CentresMeasuredAheadGiveTheSameResult) {
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(2);  // a second thread even on a machine of one core
+  for (const Side side : {Side::kLeft, Side::kRight}) {
+    SCOPED_TRACE(std::string(pattern::ToString(side)));
+    const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, 2);
+    const DecodeResult ahead = Decode(frame.image, side);
+    DecodeParams after_params;
+    after_params.measure_ahead = false;
+    const DecodeResult after = Decode(frame.image, side, after_params);
+    ASSERT_TRUE(ahead.ok && after.ok);
+    // Most of the row and column centres were measured ahead (a face: about
+    // 5000 rows and 4500 columns planned).
+    EXPECT_GT(ahead.centres_measured_ahead, 1000);
+    EXPECT_EQ(after.centres_measured_ahead, 0);
+    ASSERT_EQ(ahead.junctions.size(), after.junctions.size());
+    for (size_t i = 0; i < ahead.junctions.size(); ++i) {
+      EXPECT_EQ(ahead.junctions[i].p, after.junctions[i].p);
+      EXPECT_EQ(ahead.junctions[i].q, after.junctions[i].q);
+      EXPECT_EQ(ahead.junctions[i].position, after.junctions[i].position);
+    }
+    ASSERT_EQ(ahead.lines.size(), after.lines.size());
+    for (size_t i = 0; i < ahead.lines.size(); ++i) {
+      EXPECT_EQ(ahead.lines[i].p, after.lines[i].p);
+      EXPECT_EQ(ahead.lines[i].points, after.lines[i].points);
+    }
+  }
+  cv::setNumThreads(threads);
+}
+
 TEST(Decoder, ThesisChainStillLabelsAPlaneRightly) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kPlane, Side::kLeft, 3);
   DecodeParams params;

@@ -1,14 +1,17 @@
 #include "bsls/decoder/decoder.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <map>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <stdexcept>
 
+#include "centres_ahead.h"
 #include "working_resolution.h"
 
 namespace bsls::decoder {
@@ -343,7 +346,7 @@ double LocalSlope(const RowValues& skeleton, int y, int reach) {
 // are n times larger.
 LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p,
                         const LinePixels& own, const CrowdedRows& crowded,
-                        const DecodeParams& params, int n) {
+                        const internal::CentresAhead& ahead, const DecodeParams& params, int n) {
   LineCentres out;
   const int first = own.top;
   const int count = static_cast<int>(own.runs.size());
@@ -386,7 +389,7 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p,
       continue;
     }
     if (auto cx = joint ? joint
-                        : extraction::StripeCentreInRow(grey, y, 0.5 * (lo + hi), params.centre)) {
+                        : ahead.InRow(grey, y, 0.5 * (lo + hi), params.centre)) {
       out.measured.Set(y, *cx);
       if (near == SegmentNear::kNone) out.clear.Set(y, *cx);
     } else {
@@ -727,10 +730,33 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       extraction::ExtractFeatures(working, params.extraction);
   result.times.extraction_ms = MsSince(t);
 
+  // Where a second core is free, the sub-pixel centres of the skeleton's
+  // runs are measured on it while this one interprets (centres_ahead.h).
+  // It stops when the interpretation ends, however that ends.
+  const DecodeParams subpixel = ScaledForBinning(params, n);
+  internal::CentresAhead ahead;
+  std::atomic<bool> stop_ahead{false};
+  std::future<void> measuring;
+  struct StopAndWait {
+    std::atomic<bool>& stop;
+    std::future<void>& done;
+    ~StopAndWait() {
+      stop = true;
+      if (done.valid()) done.wait();
+    }
+  } stop_and_wait{stop_ahead, measuring};
+  if (params.measure_ahead && n == 1 && cv::getNumThreads() > 1)
+    measuring = std::async(std::launch::async, [&] {
+      ahead = internal::CentresAhead(features.skeleton, region.tl());
+      result.centres_measured_ahead = ahead.Measure(grey, subpixel.centre, stop_ahead);
+    });
+
   t = Clock::now();
   interpretation::InterpretationResult interp = interpretation::Interpret(
       features.skeleton, side, params.spec, params.interpretation, features.mask);
   internal::MapToFullFrame(n, region.tl(), grey.size(), &interp);
+  stop_ahead = true;
+  if (measuring.valid()) measuring.get();
   result.times.interpretation_ms = MsSince(t);
   result.skeleton = interp.skeleton;
   result.repairs = static_cast<int>(interp.repairs.size());
@@ -743,7 +769,6 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   }
 
   t = Clock::now();
-  const DecodeParams subpixel = ScaledForBinning(params, n);
   const int q_offset = params.q_offset.value_or(0);
   // Lines, then junctions, are measured independently of each other: in
   // parallel (cv::parallel_for_, OpenCV's thread pool).
@@ -757,7 +782,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
       measured[i] =
-          MeasureLine(grey, interp.skeleton, lines[i].p, pixels[i], crowded, subpixel, n);
+          MeasureLine(grey, interp.skeleton, lines[i].p, pixels[i], crowded, ahead, subpixel, n);
   });
   std::map<int, LineCentres> centres;
   for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);
@@ -781,7 +806,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
       const auto [x, y] = columns.keys[i];
-      columns.centres[i] = extraction::StripeCentreInColumn(grey, x, y, subpixel.centre);
+      columns.centres[i] = ahead.InColumn(grey, x, y, subpixel.centre);
     }
   });
   result.junctions.resize(junctions.size());

@@ -94,6 +94,8 @@ SessionOutcome ReconstructSession(const cv::Mat& left, const calibration::SideCa
 
   reconstruction::SidePipelineParams side_params = params.side;
   side_params.reconstruct = true;
+  // Each side has a core of its own: no third thread measuring ahead.
+  side_params.decode.measure_ahead = false;
   const double measure_share = params.measurements.empty() ? 0.0 : 0.15;
   observer.CheckCancelled("the sides");
   observer.Report("both sides", 0.0);

@@ -19,7 +19,9 @@
 // top-left pixel. Labels: p absolute (0 = reference line); q relative unless
 // DecodeParams::q_offset is set (contracts section 2).
 //
-// Thread-safety: Decode is a pure function of its arguments.
+// Thread-safety: Decode is a pure function of its arguments. It runs on the
+// calling thread and OpenCV's pool (cv::parallel_for_), and on one thread
+// of its own while it interprets (DecodeParams::measure_ahead).
 #ifndef BSLS_DECODER_DECODER_H_
 #define BSLS_DECODER_DECODER_H_
 
@@ -81,6 +83,13 @@ struct DecodeParams {
   // contrast window).
   double region_rise = 6.0;  // grey levels, >= 0
   int region_margin = 32;    // working px, >= 0
+  // Where OpenCV has a second thread (cv::getNumThreads() > 1) and the frame
+  // is not binned, the sub-pixel centres across the extraction's skeleton
+  // runs are measured on a thread of their own while the interpretation runs
+  // (docs/decoding.md, "Centres measured ahead"); the output is the same
+  // either way. Off where the caller already keeps every core busy (both
+  // sides of a session decoded side by side).
+  bool measure_ahead = true;
   // A frame whose 1st-99th percentile range is narrower (grey levels) is blank.
   double min_dynamic_range = 16.0;
   // A frame with a larger fraction of pixels at 254-255 is saturated.
@@ -127,6 +136,9 @@ struct DecodeResult {
   double pitch = 0.0;  // measured stripe pitch, px of the frame (0: none found)
   int binning = 1;     // n: extraction and interpretation ran on the frame binned n x n
   cv::Rect region;     // the part of the frame they ran on (DecodeParams::region_rise)
+  // Sub-pixel centres measured ahead while the frame was interpreted
+  // (DecodeParams::measure_ahead; 0: none). The output does not depend on it.
+  int centres_measured_ahead = 0;
   int repairs = 0;
   int label_conflicts = 0;
   std::map<interpretation::LoopClass, int> loop_classes;
