@@ -108,6 +108,21 @@ std::optional<double> FitAtZero(const std::vector<std::pair<double, double>>& s)
   return a;
 }
 
+// The parabola's value at t = 0 (FitParabola) where its RMS residual over the
+// samples is at most max_rms; nullopt otherwise (also for max_rms <= 0).
+std::optional<double> CloseParabolaAtZero(const std::vector<std::pair<double, double>>& s,
+                                          double max_rms) {
+  cv::Vec3d c;
+  if (!(max_rms > 0.0) || !FitParabola(s, &c)) return std::nullopt;
+  double squares = 0.0;
+  for (const auto& [t, x] : s) {
+    const double e = x - (c[0] + c[1] * t + c[2] * t * t);
+    squares += e * e;
+  }
+  if (std::sqrt(squares / static_cast<double>(s.size())) > max_rms) return std::nullopt;
+  return c[0];
+}
+
 // Values by image row over a range of rows, each row holding one value or
 // none (a line's rows: dense, so look-ups need no search).
 class RowValues {
@@ -436,13 +451,19 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p,
       continue;
     }
     if (!out.skipped[static_cast<size_t>(y - first)]) continue;
-    // Rows of a steep stretch are not invented: its fit is not good enough.
-    if (out.slope.Has(y) && out.slope.At(y) > params.max_fill_slope) continue;
     const auto s = RowsNear(out.measured, y, params.junction_fit_rows, 0.0);
-    const bool above = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first < 0; });
-    const bool below = std::any_of(s.begin(), s.end(), [](const auto& r) { return r.first > 0; });
-    if (!above || !below || s.size() < 4) continue;
-    if (const auto fit = FitAtZero(s)) out.points.emplace_back(*fit, y);
+    const auto above = std::count_if(s.begin(), s.end(), [](const auto& r) { return r.first < 0; });
+    const auto below = std::count_if(s.begin(), s.end(), [](const auto& r) { return r.first > 0; });
+    if (above == 0 || below == 0 || s.size() < 4) continue;
+    if (!(out.slope.Has(y) && out.slope.At(y) > params.max_fill_slope)) {
+      if (const auto fit = FitAtZero(s)) out.points.emplace_back(*fit, y);
+      continue;
+    }
+    // A steep stretch's fit is good enough only where it holds its measured
+    // rows closely, with two of them on each side at least.
+    if (above < 2 || below < 2) continue;
+    if (const auto fit = CloseParabolaAtZero(s, params.steep_fill_residual))
+      out.points.emplace_back(*fit, y);
   }
   return out;
 }
@@ -648,6 +669,7 @@ DecodeParams ScaledForBinning(const DecodeParams& params, int n) {
   out.segment_fit_columns *= n;
   out.junction_clearance *= n;
   out.max_centre_residual *= n;
+  out.steep_fill_residual *= n;
   out.fold_tip_spread *= n;
   out.crowd_distance *= n;
   out.centre.search_radius *= n;
@@ -679,6 +701,8 @@ bool DecodeParams::IsValid(std::string* error) const {
     return fail("junction_fit_rows must lie in 2..50");
   if (segment_fit_columns < 2) return fail("segment_fit_columns must be at least 2");
   if (!(max_fill_slope >= 0)) return fail("max_fill_slope must not be negative");
+  if (!(steep_fill_residual >= 0 && std::isfinite(steep_fill_residual)))
+    return fail("steep_fill_residual must be finite and not negative");
   if (!(fold_slope_change > 0)) return fail("fold_slope_change must be positive");
   if (!(fold_tip_spread >= 0)) return fail("fold_tip_spread must not be negative");
   if (!(crowd_distance >= 0)) return fail("crowd_distance must not be negative");

@@ -53,8 +53,12 @@ struct DecodeParams {
   // px: a line centre further from its neighbours' fit is dropped.
   double max_centre_residual = 0.35;
   // Rows skipped beside a segment are refilled from the line's fit only where
-  // the line is steeper than this (|dx/dy|) nowhere near.
+  // the line is steeper than this (|dx/dy|) nowhere near...
   double max_fill_slope = 0.5;
+  // ... or, where it is steeper, from a parabola through at least two
+  // measured rows on each side that holds all of them within this RMS (px;
+  // 0: steep stretches are never refilled).
+  double steep_fill_residual = 0.05;
   // A line whose slope (dx/dy) above and below a junction differs by more
   // folds there; otherwise it is fitted as one smooth curve through it.
   double fold_slope_change = 0.5;
