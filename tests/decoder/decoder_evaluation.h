@@ -3,6 +3,8 @@
 // against its ground truth.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
 #include <vector>
 
@@ -59,6 +61,18 @@ inline Evaluation Evaluate(const simulator::Frame& frame, const DecodeResult& r)
   e.line_rms = lines.rms;
   e.line_points = lines.points;
   return e;
+}
+
+// Expects `b` to hold the junctions of `a`: the same labels at the same
+// positions, to the last bit (a fatal failure when their counts differ;
+// callers wrap it in ASSERT_NO_FATAL_FAILURE).
+inline void ExpectSameJunctions(const DecodeResult& a, const DecodeResult& b) {
+  ASSERT_EQ(a.junctions.size(), b.junctions.size());
+  for (size_t i = 0; i < a.junctions.size(); ++i) {
+    EXPECT_EQ(a.junctions[i].p, b.junctions[i].p);
+    EXPECT_EQ(a.junctions[i].q, b.junctions[i].q);
+    EXPECT_EQ(a.junctions[i].position, b.junctions[i].position);
+  }
 }
 
 }  // namespace bsls::decoder::test

@@ -184,12 +184,7 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
   EXPECT_LE(rms, 0.12);
   EXPECT_LE(with.line_rms, without.line_rms + 0.002);
   // Only points are added; junctions and labels are the same.
-  ASSERT_EQ(result_->junctions.size(), unfilled.junctions.size());
-  for (size_t i = 0; i < unfilled.junctions.size(); ++i) {
-    EXPECT_EQ(result_->junctions[i].p, unfilled.junctions[i].p);
-    EXPECT_EQ(result_->junctions[i].q, unfilled.junctions[i].q);
-    EXPECT_EQ(result_->junctions[i].position, unfilled.junctions[i].position);
-  }
+  ASSERT_NO_FATAL_FAILURE(ExpectSameJunctions(*result_, unfilled));
 }
 
 // Where the lump's edge meets the nasolabial fold, lines 3-5 crowd to 4-7 px

@@ -54,9 +54,9 @@ CentresAhead::CentresAhead(const cv::Mat& skeleton, cv::Point offset) {
     return x >= 0 && y >= 0 && x < skeleton.cols && y < skeleton.rows &&
            skeleton.at<uchar>(y, x) != 0;
   };
-  // Whether a set pixel lies kBeside columns to either side of from .. to
-  // within kBeside.rows rows of y: a segment leaving there or a line
-  // crowding, where the sub-pixel stage does not measure the row alone.
+  // Whether a set pixel lies kBesideFrom .. kBesideTo columns to either side
+  // of from .. to within kBesideRows rows of y: a segment leaving there or a
+  // line crowding, where the sub-pixel stage does not measure the row alone.
   auto beside = [&](int y, int from, int to) {
     for (int dy = -kBesideRows; dy <= kBesideRows; ++dy)
       for (int d = kBesideFrom; d <= kBesideTo; ++d)
@@ -74,7 +74,9 @@ CentresAhead::CentresAhead(const cv::Mat& skeleton, cv::Point offset) {
       if (set(x - 1, y) || set(x + 1, y)) columns_.keys.emplace_back(x + offset.x, y + offset.y);
   });
   for (Table* t : {&rows_, &columns_}) {
-    std::sort(t->keys.begin(), t->keys.end());  // rows come sorted; columns by x, then y
+    // Both come sorted, as Find needs: runs are walked line by line, and
+    // along each line in order.
+    CV_DbgAssert(std::is_sorted(t->keys.begin(), t->keys.end()));
     t->centres.assign(t->keys.size(), std::nullopt);
     t->done.assign(t->keys.size(), 0);
   }

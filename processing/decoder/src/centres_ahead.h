@@ -59,10 +59,6 @@ class CentresAhead {
   std::optional<double> InColumn(const cv::Mat& grey, int x, int y,
                                  const extraction::StripeCentreParams& params) const;
 
-  // Keys planned for rows and columns (for the benchmark's counters).
-  int RowKeys() const { return static_cast<int>(rows_.keys.size()); }
-  int ColumnKeys() const { return static_cast<int>(columns_.keys.size()); }
-
  private:
   // Sorted keys, each with its centre once measured.
   struct Table {
