@@ -1,6 +1,7 @@
 #include "centres_ahead.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace bsls::decoder::internal {
@@ -76,7 +77,7 @@ CentresAhead::CentresAhead(const cv::Mat& skeleton, cv::Point offset) {
   for (Table* t : {&rows_, &columns_}) {
     // Both come sorted, as Find needs: runs are walked line by line, and
     // along each line in order.
-    CV_DbgAssert(std::is_sorted(t->keys.begin(), t->keys.end()));
+    assert(std::is_sorted(t->keys.begin(), t->keys.end()));
     t->centres.assign(t->keys.size(), std::nullopt);
     t->done.assign(t->keys.size(), 0);
   }
