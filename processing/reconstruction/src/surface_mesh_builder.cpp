@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -47,6 +48,186 @@ class RowIndex {
   std::vector<int> local_;
 };
 
+
+// The median of the samples of strips p - kSpacingStrips .. p + kSpacingStrips
+// (`samples` by strip), so that one or two strips lying wholly across a depth
+// jump do not set their own reference; 0 when strip p has none.
+double LocalSpacing(const std::map<int, std::vector<double>>& samples, int p) {
+  const auto own = samples.find(p);
+  if (own == samples.end() || own->second.empty()) return 0.0;
+  std::vector<double> around;
+  for (int k = p - kSpacingStrips; k <= p + kSpacingStrips; ++k)
+    if (const auto it = samples.find(k); it != samples.end())
+      around.insert(around.end(), it->second.begin(), it->second.end());
+  return Median(std::move(around));
+}
+
+// What both strip methods share: the lines' vertices and where they may go.
+struct StripInput {
+  const std::vector<TriangulatedLine>& lines;
+  const std::vector<RowIndex>& rows;
+  const std::map<int, int>& line_of_p;      // p -> index into lines
+  const std::vector<bool>& along_ok;        // edge (v, v + 1) usable
+  const std::vector<Eigen::Vector3d>& pos;  // every vertex, line by line
+  const std::vector<int>& line_of_vertex;   // its p
+  const MeshParams& params;
+
+  double Length(int a, int b) const { return (pos[a] - pos[b]).norm(); }
+};
+
+// Thesis 5.2.1: the quads of samples on the same rows, split along the
+// shorter diagonal, unless an edge between the lines is longer than
+// max_across_ratio times the local spacing (median row-aligned edge).
+template <typename AddFace>
+void PairRows(const StripInput& in, const AddFace& add_face, MeshReport* r) {
+  std::map<int, std::vector<double>> strip_edges;
+  for (const auto& [p, la] : in.line_of_p) {
+    const auto next = in.line_of_p.find(p + 1);
+    if (next == in.line_of_p.end()) continue;
+    const RowIndex& ra = in.rows[la];
+    const RowIndex& rb = in.rows[next->second];
+    std::vector<double>& edges = strip_edges[p];
+    for (std::size_t i = 0; i < in.lines[la].vertices.size(); ++i) {
+      const int j = rb.Local(in.lines[la].vertices[i].row);
+      if (j >= 0) edges.push_back(in.Length(ra.Global(static_cast<int>(i)), rb.Global(j)));
+    }
+  }
+  for (const auto& [p, la] : in.line_of_p) {
+    const auto next = in.line_of_p.find(p + 1);
+    if (next == in.line_of_p.end()) continue;
+    const TriangulatedLine& a = in.lines[la];
+    const RowIndex& ra = in.rows[la];
+    const RowIndex& rb = in.rows[next->second];
+    const double spacing = LocalSpacing(strip_edges, p);
+    if (!(spacing > 0.0)) continue;
+    const double max_across = in.params.max_across_ratio * spacing;
+    for (std::size_t i = 0; i < a.vertices.size(); ++i) {
+      const int row = a.vertices[i].row;
+      const int j = rb.Local(row), j1 = rb.Local(row + 1);
+      if (j < 0 || j1 < 0 || ra.Local(row + 1) < 0) continue;
+      const int a0 = ra.Global(static_cast<int>(i)), a1 = a0 + 1;
+      const int b0 = rb.Global(j), b1 = rb.Global(j1);
+      if (!in.along_ok[a0] || !in.along_ok[b0]) {
+        ++r->dropped_along;
+        continue;
+      }
+      // Two triangles per quad; split along the shorter diagonal.
+      Eigen::Vector3i tris[2];
+      if (in.Length(a0, b1) <= in.Length(a1, b0)) {
+        tris[0] = {a0, a1, b1};
+        tris[1] = {a0, b1, b0};
+      } else {
+        tris[0] = {a0, a1, b0};
+        tris[1] = {a1, b1, b0};
+      }
+      for (const Eigen::Vector3i& t : tris) {
+        // Every triangle has two edges between the lines; both must be short.
+        bool ok = true;
+        for (int k = 0; k < 3; ++k) {
+          const int u = t[k], w = t[(k + 1) % 3];
+          if (in.line_of_vertex[u] != in.line_of_vertex[w] && in.Length(u, w) > max_across)
+            ok = false;
+        }
+        if (!ok) {
+          ++r->dropped_across;
+          continue;
+        }
+        add_face(t);
+      }
+    }
+  }
+}
+
+// For every vertex of line `from` (global indices first .. first + count - 1),
+// the distance to the nearest vertex of line `to` (to_first .. + to_count - 1),
+// found by descent from the previous vertex's nearest (the lines run side by
+// side), checked over a window around it.
+std::vector<double> NearestAcross(const StripInput& in, int first, int count, int to_first,
+                                  int to_count) {
+  constexpr int kWindow = 8;
+  std::vector<double> nearest(static_cast<std::size_t>(count));
+  int k = 0;
+  for (int i = 0; i < count; ++i) {
+    const int v = first + i;
+    while (k + 1 < to_count && in.Length(v, to_first + k + 1) <= in.Length(v, to_first + k)) ++k;
+    while (k > 0 && in.Length(v, to_first + k - 1) < in.Length(v, to_first + k)) --k;
+    double best = in.Length(v, to_first + k);
+    int best_k = k;
+    for (int w = std::max(0, k - kWindow); w <= std::min(to_count - 1, k + kWindow); ++w)
+      if (const double d = in.Length(v, to_first + w); d < best) best = d, best_k = w;
+    k = best_k;
+    nearest[static_cast<std::size_t>(i)] = best;
+  }
+  return nearest;
+}
+
+// Each strip stitched (Christiansen and Sederberg 1978): from the lines'
+// first vertices on, the next triangle takes the next vertex of whichever
+// line makes the new edge between the lines shorter. A step across a gap in
+// a line (a missing row, a depth jump along it) makes no triangle; nor does
+// one whose edges between the lines are longer than max_across_ratio times
+// the local spacing (the median nearest distance between neighbouring
+// lines: a depth jump or shadow) or max_stitch_ratio times the nearest
+// distance at either of their ends (a fan from a line's end).
+template <typename AddFace>
+void StitchStrips(const StripInput& in, const AddFace& add_face, MeshReport* r) {
+  struct Strip {
+    int a = 0, na = 0, b = 0, nb = 0;  // first global vertex and count of lines p, p + 1
+    std::vector<double> near_a, near_b;
+  };
+  std::map<int, Strip> strips;
+  std::map<int, std::vector<double>> nearest;
+  for (const auto& [p, la] : in.line_of_p) {
+    const auto next = in.line_of_p.find(p + 1);
+    if (next == in.line_of_p.end()) continue;
+    Strip s;
+    s.na = static_cast<int>(in.lines[la].vertices.size());
+    s.nb = static_cast<int>(in.lines[next->second].vertices.size());
+    if (s.na == 0 || s.nb == 0) continue;
+    s.a = in.rows[la].Global(0);
+    s.b = in.rows[next->second].Global(0);
+    s.near_a = NearestAcross(in, s.a, s.na, s.b, s.nb);
+    s.near_b = NearestAcross(in, s.b, s.nb, s.a, s.na);
+    std::vector<double>& samples = nearest[p];
+    samples.insert(samples.end(), s.near_a.begin(), s.near_a.end());
+    samples.insert(samples.end(), s.near_b.begin(), s.near_b.end());
+    strips.emplace(p, std::move(s));
+  }
+  for (const auto& [p, s] : strips) {
+    const double max_across = in.params.max_across_ratio * LocalSpacing(nearest, p);
+    // Edge (a + i, b + j) between the lines: short enough to take part.
+    const auto across_ok = [&](int i, int j) {
+      const double d = in.Length(s.a + i, s.b + j);
+      return d <= max_across &&
+             d <= in.params.max_stitch_ratio * std::min(s.near_a[i], s.near_b[j]);
+    };
+    int i = 0, j = 0;
+    while (i + 1 < s.na || j + 1 < s.nb) {
+      const double step_a = i + 1 < s.na ? in.Length(s.a + i + 1, s.b + j)
+                                         : std::numeric_limits<double>::infinity();
+      const double step_b = j + 1 < s.nb ? in.Length(s.a + i, s.b + j + 1)
+                                         : std::numeric_limits<double>::infinity();
+      // The triangle of the step along `along` (its next sample `next`),
+      // with the other line's sample `apex`, if its edges may be used.
+      const auto step = [&](int along, int next, int apex, int i_next, int j_next) {
+        if (!in.along_ok[along])
+          ++r->dropped_along;
+        else if (!across_ok(i, j) || !across_ok(i_next, j_next))
+          ++r->dropped_across;
+        else
+          add_face({along, next, apex});
+      };
+      if (step_a <= step_b) {
+        step(s.a + i, s.a + i + 1, s.b + j, i + 1, j);
+        ++i;
+      } else {
+        step(s.b + j, s.b + j + 1, s.a + i, i, j + 1);
+        ++j;
+      }
+    }
+  }
+}
+
 }  // namespace
 
 bool MeshParams::IsValid(std::string* error) const {
@@ -56,6 +237,8 @@ bool MeshParams::IsValid(std::string* error) const {
     return Fail(error, "mesh: max_along_ratio must be finite and > 1");
   if (!std::isfinite(min_along_jump_mm) || min_along_jump_mm < 0.0)
     return Fail(error, "mesh: min_along_jump_mm must be finite and >= 0");
+  if (!std::isfinite(max_stitch_ratio) || max_stitch_ratio < 1.0)
+    return Fail(error, "mesh: max_stitch_ratio must be finite and >= 1");
   return true;
 }
 
@@ -96,74 +279,19 @@ geometry::SurfaceMesh BuildSurfaceMesh(const std::vector<TriangulatedLine>& line
     }
   }
   const auto& pos = mesh.positions;
-  const auto length = [&pos](int a, int b) { return (pos[a] - pos[b]).norm(); };
 
-  // Row-aligned edges between the lines of each strip (p, p + 1).
-  std::map<int, std::vector<double>> strip_edges;
-  for (const auto& [p, la] : line_of_p) {
-    const auto next = line_of_p.find(p + 1);
-    if (next == line_of_p.end()) continue;
-    const RowIndex& ra = rows[la];
-    const RowIndex& rb = rows[next->second];
-    std::vector<double>& edges = strip_edges[p];
-    for (std::size_t i = 0; i < lines[la].vertices.size(); ++i) {
-      const int j = rb.Local(lines[la].vertices[i].row);
-      if (j >= 0) edges.push_back(length(ra.Global(static_cast<int>(i)), rb.Global(j)));
-    }
-  }
-  for (const auto& [p, la] : line_of_p) {
-    const auto next = line_of_p.find(p + 1);
-    if (next == line_of_p.end()) continue;
-    const int lb = next->second;
-    const TriangulatedLine& a = lines[la];
-    const RowIndex& ra = rows[la];
-    const RowIndex& rb = rows[lb];
-    // The local spacing: the median row-aligned edge of this strip and the
-    // strips up to kSpacingStrips on either side, so that one or two strips
-    // lying wholly across a depth jump do not set their own reference.
-    std::vector<double> around;
-    for (int k = p - kSpacingStrips; k <= p + kSpacingStrips; ++k)
-      if (const auto it = strip_edges.find(k); it != strip_edges.end())
-        around.insert(around.end(), it->second.begin(), it->second.end());
-    if (strip_edges[p].empty()) continue;
-    const double max_across = params.max_across_ratio * Median(around);
-    for (std::size_t i = 0; i < a.vertices.size(); ++i) {
-      const int row = a.vertices[i].row;
-      const int j = rb.Local(row), j1 = rb.Local(row + 1);
-      if (j < 0 || j1 < 0 || ra.Local(row + 1) < 0) continue;
-      const int a0 = ra.Global(static_cast<int>(i)), a1 = a0 + 1;
-      const int b0 = rb.Global(j), b1 = rb.Global(j1);
-      if (!along_ok[a0] || !along_ok[b0]) {
-        ++r.dropped_along;
-        continue;
-      }
-      // Thesis 5.2.1: two triangles per quad; split along the shorter diagonal.
-      Eigen::Vector3i tris[2];
-      if (length(a0, b1) <= length(a1, b0)) {
-        tris[0] = {a0, a1, b1};
-        tris[1] = {a0, b1, b0};
-      } else {
-        tris[0] = {a0, a1, b0};
-        tris[1] = {a1, b1, b0};
-      }
-      for (Eigen::Vector3i t : tris) {
-        // Every triangle has two edges between the lines; both must be short.
-        bool ok = true;
-        for (int k = 0; k < 3; ++k) {
-          const int u = t[k], w = t[(k + 1) % 3];
-          if (mesh.line[u] != mesh.line[w] && length(u, w) > max_across) ok = false;
-        }
-        if (!ok) {
-          ++r.dropped_across;
-          continue;
-        }
-        const Eigen::Vector3d n = (pos[t[1]] - pos[t[0]]).cross(pos[t[2]] - pos[t[0]]);
-        const Eigen::Vector3d centroid = (pos[t[0]] + pos[t[1]] + pos[t[2]]) / 3.0;
-        if (n.dot(camera_centre - centroid) < 0.0) std::swap(t[1], t[2]);
-        mesh.faces.push_back(t);
-      }
-    }
-  }
+  // Adds triangle t, wound counter-clockwise seen from the camera.
+  const auto add_face = [&](Eigen::Vector3i t) {
+    const Eigen::Vector3d n = (pos[t[1]] - pos[t[0]]).cross(pos[t[2]] - pos[t[0]]);
+    const Eigen::Vector3d centroid = (pos[t[0]] + pos[t[1]] + pos[t[2]]) / 3.0;
+    if (n.dot(camera_centre - centroid) < 0.0) std::swap(t[1], t[2]);
+    mesh.faces.push_back(t);
+  };
+  const StripInput in{lines, rows, line_of_p, along_ok, pos, mesh.line, params};
+  if (params.strips == StripMethod::kStitched)
+    StitchStrips(in, add_face, &r);
+  else
+    PairRows(in, add_face, &r);
 
   // Gouraud: the mean of the unit normals of the faces around a vertex.
   std::vector<Eigen::Vector3d> sum(pos.size(), Eigen::Vector3d::Zero());
