@@ -29,6 +29,7 @@ struct ProcessOptions {
   std::string calibration;
   std::string surface;
   std::string plane_model = "perspective";
+  std::string strips = "rows";
   bool geometric_setup = false;
   bool smooth = false;
   bool ascii = false;
@@ -98,6 +99,9 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
                                                  ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
                                                  : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
   request.mutable_surface()->set_smooth_lines(o.smooth);
+  request.mutable_surface()->set_strips(o.strips == "stitched"
+                                            ? v1::SurfaceOptions::STRIP_METHOD_STITCHED
+                                            : v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS);
   request.mutable_surface()->set_ascii_ply(o.ascii);
   request.set_request_tag(o.image.substr(0, 256));
 
@@ -158,6 +162,9 @@ void RunProcess(const ProcessOptions& o) {
   params.planes = o.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
                                               : reconstruction::PlaneModelKind::kPerspective;
   params.reconstruction.smooth_lines = o.smooth;
+  params.reconstruction.mesh.strips = o.strips == "stitched"
+                                           ? reconstruction::StripMethod::kStitched
+                                           : reconstruction::StripMethod::kRowPairs;
   params.reconstruct = !o.surface.empty();
 
   std::optional<calibration::SideCalibration> cal;
@@ -243,6 +250,10 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_flag("--geometric-setup", opts->geometric_setup,
                 "No calibration: the thesis height formula (eq. 2.1-2.12) from the set-up of "
                 "Tables 2.1/2.2 (a fallback: millimetres only as good as those distances)");
+  cmd->add_option("--strips", opts->strips,
+                  "Mesh strips: rows (the samples of the same image row, thesis 5.2.1, default) "
+                  "or stitched (the samples facing each other; docs/reconstruction.md)")
+      ->check(CLI::IsMember({"rows", "stitched"}));
   cmd->add_flag("--smooth", opts->smooth, "Smooth along each line (thesis eq. 5.32) first");
   cmd->add_flag("--ascii", opts->ascii, "Write an ASCII PLY instead of binary");
   cmd->add_flag("--no-repair", opts->no_repair, "Label what is seen; seal no discontinuity");

@@ -34,6 +34,7 @@ struct ReconstructOptions {
   std::string report;
   std::string join = "auto";
   std::string plane_model = "perspective";
+  std::string strips = "rows";
   bool smooth = false;
   bool ascii = false;
   bool quiet = false;
@@ -93,6 +94,9 @@ void RunReconstructRemote(const ReconstructOptions& o) {
                                                  ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
                                                  : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
   request.mutable_surface()->set_smooth_lines(o.smooth);
+  request.mutable_surface()->set_strips(o.strips == "stitched"
+                                            ? v1::SurfaceOptions::STRIP_METHOD_STITCHED
+                                            : v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS);
   request.mutable_surface()->set_ascii_ply(o.ascii);
   request.set_want_side_surfaces(!o.left_surface.empty() || !o.right_surface.empty());
   request.set_request_tag((o.left_image + " + " + o.right_image).substr(0, 256));
@@ -130,6 +134,9 @@ void RunReconstruct(const ReconstructOptions& o) {
   params.side.planes = o.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
                                                    : reconstruction::PlaneModelKind::kPerspective;
   params.side.reconstruction.smooth_lines = o.smooth;
+  params.side.reconstruction.mesh.strips = o.strips == "stitched"
+                                           ? reconstruction::StripMethod::kStitched
+                                           : reconstruction::StripMethod::kRowPairs;
   params.join = o.join == "shared"     ? session::JoinMode::kShared
                 : o.join == "features" ? session::JoinMode::kFeatures
                                        : session::JoinMode::kAuto;
@@ -197,6 +204,10 @@ void AddReconstructCommand(CLI::App& app) {
   cmd->add_option("--plane-model", opts->plane_model,
                   "Light planes: perspective (thesis 6.2.2, default) or parallel (6.2.1)")
       ->check(CLI::IsMember({"perspective", "parallel"}));
+  cmd->add_option("--strips", opts->strips,
+                  "Mesh strips: rows (the samples of the same image row, thesis 5.2.1, default) "
+                  "or stitched (the samples facing each other; docs/reconstruction.md)")
+      ->check(CLI::IsMember({"rows", "stitched"}));
   cmd->add_flag("--smooth", opts->smooth, "Smooth along each line (thesis eq. 5.32) first");
   cmd->add_flag("--ascii", opts->ascii, "Write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");

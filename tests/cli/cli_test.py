@@ -557,6 +557,31 @@ class SurfaceCliTest(unittest.TestCase):
         with open(surface, "rb") as f, open(self.surface, "rb") as g:
             self.assertEqual(f.read(), g.read())
 
+    def test_stitched_strips_here_and_on_the_service(self):
+        """--strips stitched: the same samples, strips that reach further (more faces)."""
+        rows, stitched = self.path("face_rows.ply"), self.path("face_stitched.ply")
+        common = ("process", self.faces["left"], "--side", "left", "--calibration",
+                  self.calibration, "--ascii")
+        r = run(*common, "--junctions", self.path("fr.json"), "--surface", rows)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        r = run(*common, "--junctions", self.path("fs.json"), "--surface", stitched,
+                "--strips", "stitched")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        _, row_vertices, row_faces = read_ascii_ply(rows)
+        _, stitched_vertices, stitched_faces = read_ascii_ply(stitched)
+        self.assertEqual(len(stitched_vertices), len(row_vertices))
+        self.assertGreater(stitched_faces, row_faces)
+        server = self.start_processd()
+        remote = self.path("face_stitched_remote.ply")
+        r = run(*common, "--junctions", self.path("fsr.json"), "--surface", remote,
+                "--strips", "stitched", "--server", server, "-q")
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        with open(remote, "rb") as f, open(stitched, "rb") as g:
+            self.assertEqual(f.read(), g.read())
+        r = run(*common, "--junctions", self.path("fb.json"), "--surface", self.path("b.ply"),
+                "--strips", "diagonal")
+        self.assertEqual(r.returncode, EXIT_USAGE)
+
     def test_reconstruct_on_the_service(self):
         server = self.start_processd()
         out, report = self.path("remote_face.obj"), self.path("remote_face.json")

@@ -193,7 +193,11 @@ void StitchStrips(const StripInput& in, const AddFace& add_face, MeshReport* r) 
     samples.insert(samples.end(), s.near_b.begin(), s.near_b.end());
     strips.emplace(p, std::move(s));
   }
-  for (const auto& [p, s] : strips) {
+  for (const auto& entry : strips) {
+    // Named, not a structured binding: the lambdas below capture them
+    // (clang before 16 refuses to capture a structured binding).
+    const int p = entry.first;
+    const Strip& s = entry.second;
     const double max_across = in.params.max_across_ratio * LocalSpacing(nearest, p);
     // Edge (a + i, b + j) between the lines: short enough to take part.
     const auto across_ok = [&](int i, int j) {

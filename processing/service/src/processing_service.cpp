@@ -88,6 +88,9 @@ reconstruction::SidePipelineParams SideParams(const v1::DecodeOptions& decode,
                       ? reconstruction::PlaneModelKind::kParallel
                       : reconstruction::PlaneModelKind::kPerspective;
   params.reconstruction.smooth_lines = surface.smooth_lines();
+  params.reconstruction.mesh.strips = surface.strips() == v1::SurfaceOptions::STRIP_METHOD_STITCHED
+                                          ? reconstruction::StripMethod::kStitched
+                                          : reconstruction::StripMethod::kRowPairs;
   return params;
 }
 
