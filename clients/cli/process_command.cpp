@@ -15,6 +15,7 @@
 #include "bsls/rpc/frame_message.h"
 #include "command.h"
 #include "daemon_connection.h"
+#include "surface_choices.h"
 
 namespace bsls::cli {
 namespace {
@@ -28,10 +29,8 @@ struct ProcessOptions {
   std::string method = "modern";
   std::string calibration;
   std::string surface;
-  std::string plane_model = "perspective";
-  std::string strips = "rows";
+  SurfaceChoices surface_choices;
   bool geometric_setup = false;
-  bool smooth = false;
   bool ascii = false;
   bool no_repair = false;
   bool json_summary = false;
@@ -95,13 +94,7 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   request.mutable_decode()->set_method(o.method == "thesis" ? v1::DecodeOptions::METHOD_THESIS
                                                             : v1::DecodeOptions::METHOD_MODERN);
   request.mutable_decode()->set_no_repair(o.no_repair);
-  request.mutable_surface()->set_plane_model(o.plane_model == "parallel"
-                                                 ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
-                                                 : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
-  request.mutable_surface()->set_smooth_lines(o.smooth);
-  request.mutable_surface()->set_strips(o.strips == "stitched"
-                                            ? v1::SurfaceOptions::STRIP_METHOD_STITCHED
-                                            : v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS);
+  ApplySurfaceChoices(o.surface_choices, request.mutable_surface());
   request.mutable_surface()->set_ascii_ply(o.ascii);
   request.set_request_tag(o.image.substr(0, 256));
 
@@ -159,12 +152,7 @@ void RunProcess(const ProcessOptions& o) {
   params.decode.extraction.method =
       o.method == "thesis" ? extraction::ExtractionMethod::kThesis : extraction::ExtractionMethod::kModern;
   params.decode.interpretation.enable_repair = !o.no_repair;
-  params.planes = o.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
-                                              : reconstruction::PlaneModelKind::kPerspective;
-  params.reconstruction.smooth_lines = o.smooth;
-  params.reconstruction.mesh.strips = o.strips == "stitched"
-                                           ? reconstruction::StripMethod::kStitched
-                                           : reconstruction::StripMethod::kRowPairs;
+  ApplySurfaceChoices(o.surface_choices, &params);
   params.reconstruct = !o.surface.empty();
 
   std::optional<calibration::SideCalibration> cal;
@@ -244,17 +232,10 @@ void AddProcessCommand(CLI::App& app) {
                   "Calibration of this side (bsls calibrate): absolute q and the surface");
   cmd->add_option("--surface", opts->surface,
                   "Output surface in world mm: .ply (binary), .obj or .stl; needs --calibration");
-  cmd->add_option("--plane-model", opts->plane_model,
-                  "Light planes: perspective (thesis 6.2.2, default) or parallel (6.2.1)")
-      ->check(CLI::IsMember({"perspective", "parallel"}));
   cmd->add_flag("--geometric-setup", opts->geometric_setup,
                 "No calibration: the thesis height formula (eq. 2.1-2.12) from the set-up of "
                 "Tables 2.1/2.2 (a fallback: millimetres only as good as those distances)");
-  cmd->add_option("--strips", opts->strips,
-                  "Mesh strips: rows (the samples of the same image row, thesis 5.2.1, default) "
-                  "or stitched (the samples facing each other; docs/reconstruction.md)")
-      ->check(CLI::IsMember({"rows", "stitched"}));
-  cmd->add_flag("--smooth", opts->smooth, "Smooth along each line (thesis eq. 5.32) first");
+  AddSurfaceChoices(cmd, &opts->surface_choices);
   cmd->add_flag("--ascii", opts->ascii, "Write an ASCII PLY instead of binary");
   cmd->add_flag("--no-repair", opts->no_repair, "Label what is seen; seal no discontinuity");
   cmd->add_flag("--json", opts->json_summary, "Print the summary as one JSON object");

@@ -19,6 +19,7 @@
 #include "bsls/rpc/frame_message.h"
 #include "command.h"
 #include "daemon_connection.h"
+#include "surface_choices.h"
 
 namespace bsls::cli {
 namespace {
@@ -33,9 +34,7 @@ struct ReconstructOptions {
   std::string right_surface;
   std::string report;
   std::string join = "auto";
-  std::string plane_model = "perspective";
-  std::string strips = "rows";
-  bool smooth = false;
+  SurfaceChoices surface_choices;
   bool ascii = false;
   bool quiet = false;
   bool json = false;      // the report on stdout instead of the summary
@@ -90,13 +89,7 @@ void RunReconstructRemote(const ReconstructOptions& o) {
   request.set_join(o.join == "shared"     ? v1::ReconstructSessionRequest::JOIN_SHARED
                    : o.join == "features" ? v1::ReconstructSessionRequest::JOIN_FEATURES
                                           : v1::ReconstructSessionRequest::JOIN_AUTO);
-  request.mutable_surface()->set_plane_model(o.plane_model == "parallel"
-                                                 ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
-                                                 : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
-  request.mutable_surface()->set_smooth_lines(o.smooth);
-  request.mutable_surface()->set_strips(o.strips == "stitched"
-                                            ? v1::SurfaceOptions::STRIP_METHOD_STITCHED
-                                            : v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS);
+  ApplySurfaceChoices(o.surface_choices, request.mutable_surface());
   request.mutable_surface()->set_ascii_ply(o.ascii);
   request.set_want_side_surfaces(!o.left_surface.empty() || !o.right_surface.empty());
   request.set_request_tag((o.left_image + " + " + o.right_image).substr(0, 256));
@@ -131,12 +124,7 @@ void RunReconstruct(const ReconstructOptions& o) {
   const calibration::SideCalibration left_cal = LoadCalibrationFile(o.left_calibration);
   const calibration::SideCalibration right_cal = LoadCalibrationFile(o.right_calibration);
   session::SessionParams params;
-  params.side.planes = o.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
-                                                   : reconstruction::PlaneModelKind::kPerspective;
-  params.side.reconstruction.smooth_lines = o.smooth;
-  params.side.reconstruction.mesh.strips = o.strips == "stitched"
-                                           ? reconstruction::StripMethod::kStitched
-                                           : reconstruction::StripMethod::kRowPairs;
+  ApplySurfaceChoices(o.surface_choices, &params.side);
   params.join = o.join == "shared"     ? session::JoinMode::kShared
                 : o.join == "features" ? session::JoinMode::kFeatures
                                        : session::JoinMode::kAuto;
@@ -201,14 +189,7 @@ void AddReconstructCommand(CLI::App& app) {
                   "or features (thesis 5.2.2 + ICP)")
       ->check(CLI::IsMember({"auto", "shared", "features"}))
       ->capture_default_str();
-  cmd->add_option("--plane-model", opts->plane_model,
-                  "Light planes: perspective (thesis 6.2.2, default) or parallel (6.2.1)")
-      ->check(CLI::IsMember({"perspective", "parallel"}));
-  cmd->add_option("--strips", opts->strips,
-                  "Mesh strips: rows (the samples of the same image row, thesis 5.2.1, default) "
-                  "or stitched (the samples facing each other; docs/reconstruction.md)")
-      ->check(CLI::IsMember({"rows", "stitched"}));
-  cmd->add_flag("--smooth", opts->smooth, "Smooth along each line (thesis eq. 5.32) first");
+  AddSurfaceChoices(cmd, &opts->surface_choices);
   cmd->add_flag("--ascii", opts->ascii, "Write ASCII PLY instead of binary");
   cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
   cmd->add_flag("--json", opts->json, "Print the report as one JSON object instead of the summary");

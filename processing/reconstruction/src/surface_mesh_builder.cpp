@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <stdexcept>
 
 namespace bsls::reconstruction {
@@ -51,10 +52,10 @@ class RowIndex {
 
 // The median of the samples of strips p - kSpacingStrips .. p + kSpacingStrips
 // (`samples` by strip), so that one or two strips lying wholly across a depth
-// jump do not set their own reference; 0 when strip p has none.
-double LocalSpacing(const std::map<int, std::vector<double>>& samples, int p) {
+// jump do not set their own reference; nullopt when strip p has none.
+std::optional<double> LocalSpacing(const std::map<int, std::vector<double>>& samples, int p) {
   const auto own = samples.find(p);
-  if (own == samples.end() || own->second.empty()) return 0.0;
+  if (own == samples.end() || own->second.empty()) return std::nullopt;
   std::vector<double> around;
   for (int k = p - kSpacingStrips; k <= p + kSpacingStrips; ++k)
     if (const auto it = samples.find(k); it != samples.end())
@@ -98,9 +99,9 @@ void PairRows(const StripInput& in, const AddFace& add_face, MeshReport* r) {
     const TriangulatedLine& a = in.lines[la];
     const RowIndex& ra = in.rows[la];
     const RowIndex& rb = in.rows[next->second];
-    const double spacing = LocalSpacing(strip_edges, p);
-    if (!(spacing > 0.0)) continue;
-    const double max_across = in.params.max_across_ratio * spacing;
+    const std::optional<double> spacing = LocalSpacing(strip_edges, p);
+    if (!spacing) continue;
+    const double max_across = in.params.max_across_ratio * *spacing;
     for (std::size_t i = 0; i < a.vertices.size(); ++i) {
       const int row = a.vertices[i].row;
       const int j = rb.Local(row), j1 = rb.Local(row + 1);
@@ -198,7 +199,8 @@ void StitchStrips(const StripInput& in, const AddFace& add_face, MeshReport* r) 
     // (clang before 16 refuses to capture a structured binding).
     const int p = entry.first;
     const Strip& s = entry.second;
-    const double max_across = in.params.max_across_ratio * LocalSpacing(nearest, p);
+    // Every strip here has samples of its own (both lines have vertices).
+    const double max_across = in.params.max_across_ratio * LocalSpacing(nearest, p).value();
     // Edge (a + i, b + j) between the lines: short enough to take part.
     const auto across_ok = [&](int i, int j) {
       const double d = in.Length(s.a + i, s.b + j);
