@@ -7,8 +7,8 @@ void AddSurfaceChoices(CLI::App* cmd, SurfaceChoices* choices) {
                   "Light planes: perspective (thesis 6.2.2, default) or parallel (6.2.1)")
       ->check(CLI::IsMember({"perspective", "parallel"}));
   cmd->add_option("--strips", choices->strips,
-                  "Mesh strips: rows (the samples of the same image row, thesis 5.2.1, default) "
-                  "or stitched (the samples facing each other; docs/reconstruction.md)")
+                  "Mesh strips: stitched (the samples facing each other, default; "
+                  "docs/reconstruction.md) or rows (the samples of the same image row, thesis 5.2.1)")
       ->check(CLI::IsMember({"rows", "stitched"}));
   cmd->add_flag("--smooth", choices->smooth, "Smooth along each line (thesis eq. 5.32) first");
 }
@@ -16,9 +16,9 @@ void AddSurfaceChoices(CLI::App* cmd, SurfaceChoices* choices) {
 void ApplySurfaceChoices(const SurfaceChoices& choices, reconstruction::SidePipelineParams* params) {
   params->planes = choices.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
                                                      : reconstruction::PlaneModelKind::kPerspective;
-  params->reconstruction.mesh.strips = choices.strips == "stitched"
-                                           ? reconstruction::StripMethod::kStitched
-                                           : reconstruction::StripMethod::kRowPairs;
+  params->reconstruction.mesh.strips = choices.strips == "rows"
+                                           ? reconstruction::StripMethod::kRowPairs
+                                           : reconstruction::StripMethod::kStitched;
   params->reconstruction.smooth_lines = choices.smooth;
 }
 
@@ -26,8 +26,8 @@ void ApplySurfaceChoices(const SurfaceChoices& choices, v1::SurfaceOptions* opti
   options->set_plane_model(choices.plane_model == "parallel"
                                ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
                                : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
-  options->set_strips(choices.strips == "stitched" ? v1::SurfaceOptions::STRIP_METHOD_STITCHED
-                                                   : v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS);
+  options->set_strips(choices.strips == "rows" ? v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS
+                                              : v1::SurfaceOptions::STRIP_METHOD_STITCHED);
   options->set_smooth_lines(choices.smooth);
 }
 

@@ -16,7 +16,7 @@ namespace bsls::cli {
 
 struct SurfaceChoices {
   std::string plane_model = "perspective";  // or "parallel"
-  std::string strips = "rows";              // or "stitched"
+  std::string strips = "stitched";          // or "rows"
   bool smooth = false;
 };
 

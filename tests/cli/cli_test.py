@@ -557,27 +557,35 @@ class SurfaceCliTest(unittest.TestCase):
         with open(surface, "rb") as f, open(self.surface, "rb") as g:
             self.assertEqual(f.read(), g.read())
 
-    def test_stitched_strips_here_and_on_the_service(self):
-        """--strips stitched: the same samples, strips that reach further (more faces)."""
+    def test_strip_methods_here_and_on_the_service(self):
+        """Stitched strips by default; --strips rows: the same samples, strips that
+        end sooner (fewer faces), here and on the service alike."""
         rows, stitched = self.path("face_rows.ply"), self.path("face_stitched.ply")
         common = ("process", self.faces["left"], "--side", "left", "--calibration",
                   self.calibration, "--ascii")
-        r = run(*common, "--junctions", self.path("fr.json"), "--surface", rows)
+        r = run(*common, "--junctions", self.path("fs.json"), "--surface", stitched)
         self.assertEqual(r.returncode, EXIT_OK, r.stderr)
-        r = run(*common, "--junctions", self.path("fs.json"), "--surface", stitched,
-                "--strips", "stitched")
+        r = run(*common, "--junctions", self.path("fr.json"), "--surface", rows,
+                "--strips", "rows")
         self.assertEqual(r.returncode, EXIT_OK, r.stderr)
         _, row_vertices, row_faces = read_ascii_ply(rows)
         _, stitched_vertices, stitched_faces = read_ascii_ply(stitched)
         self.assertEqual(len(stitched_vertices), len(row_vertices))
         self.assertGreater(stitched_faces, row_faces)
-        server = self.start_processd()
-        remote = self.path("face_stitched_remote.ply")
-        r = run(*common, "--junctions", self.path("fsr.json"), "--surface", remote,
-                "--strips", "stitched", "--server", server, "-q")
+        explicit = self.path("face_stitched_explicit.ply")
+        r = run(*common, "--junctions", self.path("fe.json"), "--surface", explicit,
+                "--strips", "stitched")
         self.assertEqual(r.returncode, EXIT_OK, r.stderr)
-        with open(remote, "rb") as f, open(stitched, "rb") as g:
+        with open(explicit, "rb") as f, open(stitched, "rb") as g:
             self.assertEqual(f.read(), g.read())
+        server = self.start_processd()
+        for strips, local in (("rows", rows), ("stitched", stitched)):
+            remote = self.path(f"face_{strips}_remote.ply")
+            r = run(*common, "--junctions", self.path(f"f{strips}r.json"), "--surface", remote,
+                    "--strips", strips, "--server", server, "-q")
+            self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+            with open(remote, "rb") as f, open(local, "rb") as g:
+                self.assertEqual(f.read(), g.read(), strips)
         r = run(*common, "--junctions", self.path("fb.json"), "--surface", self.path("b.ply"),
                 "--strips", "diagonal")
         self.assertEqual(r.returncode, EXIT_USAGE)

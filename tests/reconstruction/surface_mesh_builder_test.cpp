@@ -38,9 +38,16 @@ void ExpectFacingCamera(const geometry::SurfaceMesh& mesh) {
   }
 }
 
+// Thesis 5.2.1's row pairs (the default is stitched strips).
+MeshParams RowPairs() {
+  MeshParams params;
+  params.strips = StripMethod::kRowPairs;
+  return params;
+}
+
 TEST(BuildSurfaceMesh, PlaneGivesTwoTrianglesPerQuad) {
   MeshReport report;
-  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, {}, &report);
+  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, RowPairs(), &report);
   std::string why;
   ASSERT_TRUE(mesh.IsValid(&why)) << why;
   EXPECT_EQ(mesh.VertexCount(), 50u);
@@ -58,7 +65,7 @@ TEST(BuildSurfaceMesh, NoTriangleAcrossADepthJump) {
   std::vector<TriangulatedLine> lines = PlaneLines(7, 10);
   for (LineVertex& v : lines[3].vertices) v.position.z() += 50.0;
   MeshReport report;
-  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(lines, kCamera, {}, &report);
+  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(lines, kCamera, RowPairs(), &report);
   for (const Eigen::Vector3i& f : mesh.faces)
     for (int k = 0; k < 3; ++k) EXPECT_NE(mesh.line[f[k]], 3) << "a face uses the raised line";
   EXPECT_EQ(report.triangles, 4 * 9 * 2);  // strips 0-1, 1-2, 4-5 and 5-6 only
@@ -72,7 +79,7 @@ TEST(BuildSurfaceMesh, NoTriangleAcrossAJumpAlongALine) {
     for (LineVertex& v : line.vertices)
       if (v.row >= 5) v.position.z() += 20.0;
   MeshReport report;
-  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(lines, kCamera, {}, &report);
+  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(lines, kCamera, RowPairs(), &report);
   EXPECT_EQ(report.dropped_along, 2);  // one quad per strip
   EXPECT_EQ(report.triangles, 2 * 8 * 2);
   for (const Eigen::Vector3i& f : mesh.faces) {
@@ -88,7 +95,7 @@ TEST(BuildSurfaceMesh, GapLeavesAHole) {
   auto& v = lines[1].vertices;
   v.erase(v.begin() + 4, v.begin() + 6);  // rows 4 and 5
   MeshReport report;
-  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(lines, kCamera, {}, &report);
+  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(lines, kCamera, RowPairs(), &report);
   // Quads on rows 0-1, 1-2, 2-3 and 6-7, 7-8, 8-9 remain.
   EXPECT_EQ(report.triangles, 6 * 2);
   ExpectFacingCamera(mesh);
@@ -131,7 +138,7 @@ MeshParams Stitched() {
 // On upright lines the stitched strips are the row pairs' quads.
 TEST(BuildSurfaceMesh, StitchedUprightLinesGiveTheRowPairsSurface) {
   MeshReport rows, stitched;
-  const geometry::SurfaceMesh a = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, {}, &rows);
+  const geometry::SurfaceMesh a = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, RowPairs(), &rows);
   const geometry::SurfaceMesh b = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, Stitched(), &stitched);
   EXPECT_EQ(stitched.triangles, rows.triangles);
   EXPECT_NEAR(FacesArea(b), FacesArea(a), 1e-9);
@@ -164,7 +171,7 @@ TEST(BuildSurfaceMesh, StitchedStripReachesWhereItsLinesFaceEachOther) {
   const double lean = 60.0 * std::numbers::pi / 180.0;
   std::vector<TriangulatedLine> lines = LeaningLines({0, 0}, 40, -kRowStepMm * std::tan(lean));
   lines[1].vertices.resize(30);
-  const geometry::SurfaceMesh rows = BuildSurfaceMesh(lines, kCamera);
+  const geometry::SurfaceMesh rows = BuildSurfaceMesh(lines, kCamera, RowPairs());
   MeshReport report;
   const geometry::SurfaceMesh stitched = BuildSurfaceMesh(lines, kCamera, Stitched(), &report);
   EXPECT_EQ(LastRowUsed(rows, lines, 0), 29);

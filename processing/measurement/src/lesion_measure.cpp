@@ -12,6 +12,7 @@
 
 #include "hole_fill.h"
 #include "polygon.h"
+#include "stripe_field.h"
 
 namespace bsls::measurement {
 namespace {
@@ -24,9 +25,13 @@ constexpr double kMinRobustSigmaMm = 1e-6;
 constexpr int kQuadricTerms = 6;
 constexpr int kPlaneTerms = 3;
 constexpr int kCubicTerms = 10;
-// The vertex continuing an edge onto the next stripe turns from it by at
-// most acos of this.
-constexpr double kContinuationCos = 0.8;
+// The level cut's lattice (mm) on faces whose deviations come within this
+// fraction of the level of it, at most this many steps per edge; and how
+// far past the region (mm) the stripes that steer the cubic are taken.
+constexpr double kSubdivisionMm = 0.5;
+constexpr double kSubdivisionMargin = 0.5;
+constexpr int kMaxSubdivisions = 64;
+constexpr double kFieldMarginMm = 15.0;
 // The lesion's top: vertices within this fraction of the extreme deviation.
 constexpr double kTopFraction = 0.9;
 // A peak window whose minor/major scatter is below this holds one stripe.
@@ -379,64 +384,62 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   result.peak_position = Eigen::Vector3d(peak_xy.x(), peak_xy.y(), reference_z + sign * peak);
   result.level_mm = params.level_fraction * peak;
 
-  // The mesh joins neighbouring stripes by straight edges (thesis 5.2.1);
-  // a level cut linearly between stripes 5.7 mm apart shrinks a small
-  // lesion's contour (-1 to -3 % of the thesis's cheek cavity's area). On an
-  // edge across stripes the crossing is taken from the Catmull-Rom cubic
-  // through the values at its ends and at the vertices that continue it on
-  // the stripes beyond each end (NaN, i.e. linear, where the mesh has no
-  // stripe labels or no such vertex).
+  // The level cut: between the stripes the deviation follows the cubic of
+  // StripeField, not the mesh's flat triangles (a linear cut between
+  // stripes 5.7 mm apart shrinks the thesis's cheek cavity by 2 to 3 %,
+  // and by a different amount for each way of splitting the strips into
+  // triangles). The faces whose values come near the level are cut on a
+  // lattice of kSubdivisionMm; the others, and meshes without stripe
+  // labels, linearly.
   const std::vector<int> faces_in_box = surface.FacesIn(box);
-  std::vector<std::vector<int>> neighbours;
-  if (mesh.line.size() == mesh.positions.size()) {
-    neighbours.resize(mesh.positions.size());
-    for (int f : faces_in_box)
-      for (int k = 0; k < 3; ++k) {
-        const int a = mesh.faces[f][k], b = mesh.faces[f][(k + 1) % 3];
-        neighbours[a].push_back(b);
-        neighbours[b].push_back(a);
-      }
-  }
-  // The vertex continuing edge b -> a beyond a on the next stripe, or -1.
-  auto beyond = [&](int a, int b) {
-    const int stripe = 2 * mesh.line[a] - mesh.line[b];
-    const Eigen::Vector2d step = mesh.positions[a].head<2>() - mesh.positions[b].head<2>();
-    int best = -1;
-    double best_cos = kContinuationCos;
-    for (int candidate : neighbours[a]) {
-      if (mesh.line[candidate] != stripe) continue;
-      const Eigen::Vector2d next =
-          mesh.positions[candidate].head<2>() - mesh.positions[a].head<2>();
-      const double ratio = next.norm() / std::max(step.norm(), 1e-12);
-      if (ratio < 0.5 || ratio > 2.0) continue;
-      const double c = next.dot(step) / (next.norm() * step.norm());
-      if (c > best_cos) {
-        best_cos = c;
-        best = candidate;
-      }
-    }
-    return best;
+  Eigen::AlignedBox2d field_box = box;
+  field_box.extend(box.min() - Eigen::Vector2d::Constant(kFieldMarginMm));
+  field_box.extend(box.max() + Eigen::Vector2d::Constant(kFieldMarginMm));
+  const internal::StripeField scan_field(mesh, surface.FacesIn(field_box));
+  // The part of `triangle` (counter-clockwise, deviations `values`) above
+  // the level inside the region, in x-y mm^2.
+  auto raised_xy = [&](const Polygon2d& triangle, const std::vector<double>& values) {
+    const Polygon2d raised = internal::ClipByLevel(triangle, values, result.level_mm);
+    if (raised.size() < 3) return 0.0;
+    return std::abs(internal::SignedArea(internal::ClipByConvex(region, raised)));
   };
-  auto cubic_crossing = [&](int a, int b, double level) {
-    constexpr double kLinear = std::numeric_limits<double>::quiet_NaN();
-    if (neighbours.empty() || std::abs(mesh.line[a] - mesh.line[b]) != 1) return kLinear;
-    const int a0 = beyond(a, b), b0 = beyond(b, a);
-    if (a0 < 0 || b0 < 0) return kLinear;
-    const double v0 = sign * deviation(a0), v1 = sign * deviation(a), v2 = sign * deviation(b),
-                 v3 = sign * deviation(b0);
-    if (!std::isfinite(v0 + v1 + v2 + v3) || (v1 >= level) == (v2 >= level)) return kLinear;
-    auto f = [&](double t) {
-      return 0.5 * (2.0 * v1 + (v2 - v0) * t + (2.0 * v0 - 5.0 * v1 + 4.0 * v2 - v3) * t * t +
-                    (3.0 * v1 - v0 - 3.0 * v2 + v3) * t * t * t) -
-             level;
-    };
-    double lo = 0.0, hi = 1.0;  // f(0) = v1 - level and f(1) = v2 - level differ in sign
-    const bool rising = v1 < level;
-    for (int i = 0; i < 40; ++i) {
-      const double mid = 0.5 * (lo + hi);
-      ((f(mid) < 0.0) == rising ? lo : hi) = mid;
-    }
-    return 0.5 * (lo + hi);
+  auto level_cut_xy = [&](const Polygon2d& triangle, const std::vector<double>& values) {
+    const double lo = *std::min_element(values.begin(), values.end());
+    const double hi = *std::max_element(values.begin(), values.end());
+    const double margin = kSubdivisionMargin * std::abs(result.level_mm);
+    if (scan_field.empty() || hi < result.level_mm - margin || lo > result.level_mm + margin)
+      return raised_xy(triangle, values);
+    double longest = 0.0;
+    for (int k = 0; k < 3; ++k) longest = std::max(longest, (triangle[(k + 1) % 3] - triangle[k]).norm());
+    const int steps = std::clamp(static_cast<int>(std::ceil(longest / kSubdivisionMm)), 1, kMaxSubdivisions);
+    // Lattice point (i, j) = t0 + (t1 - t0) i / steps + (t2 - t0) j / steps, row by row.
+    std::vector<Eigen::Vector2d> points;
+    std::vector<double> lattice;
+    for (int i = 0; i <= steps; ++i)
+      for (int j = 0; j <= steps - i; ++j) {
+        const double u = static_cast<double>(i) / steps, v = static_cast<double>(j) / steps;
+        const Eigen::Vector2d p = triangle[0] + (triangle[1] - triangle[0]) * u +
+                                  (triangle[2] - triangle[0]) * v;
+        double value = (1.0 - u - v) * values[0] + u * values[1] + v * values[2];
+        if (const auto z = scan_field.Z(p))
+          if (const auto z_reference = reference.z(p)) value = sign * (*z - *z_reference);
+        points.push_back(p);
+        lattice.push_back(value);
+      }
+    auto at = [&](int i, int j) { return i * (steps + 1) - i * (i - 1) / 2 + j; };
+    double xy = 0.0;
+    for (int i = 0; i < steps; ++i)
+      for (int j = 0; i + j < steps; ++j) {
+        const std::array<int, 3> lower = {at(i, j), at(i + 1, j), at(i, j + 1)};
+        xy += raised_xy({points[lower[0]], points[lower[1]], points[lower[2]]},
+                        {lattice[lower[0]], lattice[lower[1]], lattice[lower[2]]});
+        if (i + j + 1 < steps) {
+          const std::array<int, 3> upper = {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
+          xy += raised_xy({points[upper[0]], points[upper[1]], points[upper[2]]},
+                          {lattice[upper[0]], lattice[upper[1]], lattice[upper[2]]});
+        }
+      }
+    return xy;
   };
 
   // Area at the level, volume over the region.
@@ -471,16 +474,8 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
     volume += piece_xy * (w[0] * values[0] + w[1] * values[1] + w[2] * values[2]);
     for (int k = 0; k < 3; ++k) volume_weight[ids[k]] += piece_xy * w[k];
 
-    std::vector<double> cuts(3);
-    for (int k = 0; k < 3; ++k) cuts[k] = cubic_crossing(ids[k], ids[(k + 1) % 3], result.level_mm);
-    const Polygon2d raised = internal::ClipByLevel(triangle, values, result.level_mm, cuts);
-    if (raised.size() >= 3) {
-      const Polygon2d part = internal::ClipByConvex(region, raised);
-      const double part_xy = std::abs(internal::SignedArea(part));
-      if (part_xy > 0.0)
-        area +=
-            part_xy * std::sqrt(1.0 + reference.gradient(internal::Centroid(part)).squaredNorm());
-    }
+    if (const double part_xy = level_cut_xy(triangle, values); part_xy > 0.0)
+      area += part_xy * std::sqrt(1.0 + reference.gradient(internal::Centroid(piece)).squaredNorm());
     // The level line through this face: its length over the slope of d says
     // how much area a shift of the level moves.
     const double lo = *std::min_element(values.begin(), values.end());
@@ -661,12 +656,19 @@ LesionMeasurement MeasureLesionAgainstBaseline(const SurfaceQuery& surface,
     mean_variance += std::pow(reference.VertexSigma(static_cast<int>(v)), 2);
   mean_variance /= static_cast<double>(std::max<std::size_t>(1, moved.positions.size()));
 
+  // Between its stripes the baseline follows the same cubic as the surface
+  // (StripeField), where it has stripe labels.
+  Eigen::AlignedBox2d field_box = internal::Bounds(region);
+  const double field_margin = params.ring_width_mm + kFieldMarginMm;
+  field_box.extend(field_box.min() - Eigen::Vector2d::Constant(field_margin));
+  field_box.extend(field_box.max() + Eigen::Vector2d::Constant(field_margin));
+  const internal::StripeField baseline_field(moved, reference.FacesIn(field_box));
   ReferenceView view;
   view.kind = ReferenceKind::kBaseline;
   view.z = [&](const Eigen::Vector2d& xy) -> std::optional<double> {
     const auto point = reference.Above(xy);
     if (!point) return std::nullopt;
-    return point->position.z();
+    return baseline_field.Z(xy).value_or(point->position.z());
   };
   view.gradient = [&](const Eigen::Vector2d& xy) -> Eigen::Vector2d {
     const auto point = reference.Above(xy);

@@ -82,22 +82,13 @@ Polygon2d ClipByConvex(const Polygon2d& subject, const Polygon2d& clip) {
 }
 
 Polygon2d ClipByLevel(const Polygon2d& polygon, const std::vector<double>& values, double level) {
-  return ClipByLevel(polygon, values, level,
-                     std::vector<double>(polygon.size(), std::numeric_limits<double>::quiet_NaN()));
-}
-
-Polygon2d ClipByLevel(const Polygon2d& polygon, const std::vector<double>& values, double level,
-                      const std::vector<double>& crossings) {
   Polygon2d output;
   for (std::size_t k = 0, m = polygon.size(); k < m; ++k) {
     const double vp = values[k] - level, vq = values[(k + 1) % m] - level;
     const Eigen::Vector2d& p = polygon[k];
     const Eigen::Vector2d& q = polygon[(k + 1) % m];
     if (vp >= 0.0) output.push_back(p);
-    if ((vp >= 0.0) != (vq >= 0.0)) {
-      const double t = crossings[k] >= 0.0 && crossings[k] <= 1.0 ? crossings[k] : vp / (vp - vq);
-      output.push_back(p + (q - p) * t);
-    }
+    if ((vp >= 0.0) != (vq >= 0.0)) output.push_back(p + (q - p) * (vp / (vp - vq)));
   }
   return output;
 }

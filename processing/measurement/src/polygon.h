@@ -25,11 +25,6 @@ Polygon2d ClipByConvex(const Polygon2d& subject, const Polygon2d& clip);
 // The part of convex `polygon` where the affine function with values
 // `values` at its vertices is >= level (the values are clipped alongside).
 Polygon2d ClipByLevel(const Polygon2d& polygon, const std::vector<double>& values, double level);
-// As above, with the level's crossing on edge k (from vertex k to k + 1) at
-// the fraction `crossings[k]` along it where that is a number in [0, 1]
-// (a curved interpolant's), linear where it is NaN.
-Polygon2d ClipByLevel(const Polygon2d& polygon, const std::vector<double>& values, double level,
-                      const std::vector<double>& crossings);
 // Bounding box.
 Eigen::AlignedBox2d Bounds(const Polygon2d& polygon);
 // Throws MeasurementError "<what>: ..." unless the polygon has >= 3 finite

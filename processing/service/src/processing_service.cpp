@@ -88,9 +88,9 @@ reconstruction::SidePipelineParams SideParams(const v1::DecodeOptions& decode,
                       ? reconstruction::PlaneModelKind::kParallel
                       : reconstruction::PlaneModelKind::kPerspective;
   params.reconstruction.smooth_lines = surface.smooth_lines();
-  params.reconstruction.mesh.strips = surface.strips() == v1::SurfaceOptions::STRIP_METHOD_STITCHED
-                                          ? reconstruction::StripMethod::kStitched
-                                          : reconstruction::StripMethod::kRowPairs;
+  params.reconstruction.mesh.strips = surface.strips() == v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS
+                                          ? reconstruction::StripMethod::kRowPairs
+                                          : reconstruction::StripMethod::kStitched;
   return params;
 }
 

@@ -37,20 +37,20 @@ struct TriangulatedLine {
 
 // How the triangles of a strip between lines p and p + 1 are chosen.
 enum class StripMethod {
-  // Thesis 5.2.1 (the default): the samples of the same image row paired,
-  // quad by quad. Where the lines lean the quads shear, and a strip ends at
-  // the row where the first of its two lines ends.
+  // Thesis 5.2.1: the samples of the same image row paired, quad by quad.
+  // Where the lines lean the quads shear, and a strip ends at the row where
+  // the first of its two lines ends.
   kRowPairs,
   // Each strip stitched (Christiansen and Sederberg 1978): the next triangle
   // takes the next sample of whichever line makes the new edge between the
   // lines shorter, so the triangles join the samples that face each other
-  // and a strip reaches as far as its lines do. Measured against row pairs
-  // in docs/reconstruction.md ("Stitched strips").
+  // and a strip reaches as far as its lines do. The default: measured
+  // against row pairs in docs/reconstruction.md ("Stitched strips").
   kStitched,
 };
 
 struct MeshParams {
-  StripMethod strips = StripMethod::kRowPairs;
+  StripMethod strips = StripMethod::kStitched;
   // A triangle edge between lines p and p + 1 longer than this many times the
   // local spacing spans a depth jump or a shadow: the triangle is dropped.
   // Local spacing: over the strips p-2 .. p+2, the median row-aligned edge
