@@ -87,9 +87,10 @@ void BM_Reconstruct(benchmark::State& state) {
     return;
   }
   const bsls::reconstruction::TriangulationModel model = TrueModel(scene);
-  // Argument 0: strips paired by row (thesis 5.2.1, the default); 1: stitched.
+  // Argument 0: strips paired by row (thesis 5.2.1); 1: stitched (the default).
   bsls::reconstruction::ReconstructionParams params;
-  if (state.range(0) == 1) params.mesh.strips = bsls::reconstruction::StripMethod::kStitched;
+  params.mesh.strips = state.range(0) == 1 ? bsls::reconstruction::StripMethod::kStitched
+                                           : bsls::reconstruction::StripMethod::kRowPairs;
   std::vector<double> ms;
   bsls::reconstruction::ReconstructionReport report;
   for (auto _ : state) {

@@ -14,10 +14,6 @@ constexpr std::string_view kSuffix = ".pgm";
 // The largest file ReadFrameFile accepts: the biggest frame plus a header.
 constexpr std::uint64_t kMaxFileBytes = static_cast<std::uint64_t>(8192) * 8192 + 4096;
 
-Status Prefixed(const Status& status, const std::string& what) {
-  return Status(status.code(), what + ": " + status.message());
-}
-
 }  // namespace
 
 std::string FrameFileName(const CaptureId& id, framestore::Camera camera) {

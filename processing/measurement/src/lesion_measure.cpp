@@ -25,10 +25,11 @@ constexpr double kMinRobustSigmaMm = 1e-6;
 constexpr int kQuadricTerms = 6;
 constexpr int kPlaneTerms = 3;
 constexpr int kCubicTerms = 10;
-// The level cut's lattice (mm) on faces whose deviations come within this
-// fraction of the level of it, at most this many steps per edge; and how
-// far past the region (mm) the stripes that steer the cubic are taken.
-constexpr double kSubdivisionMm = 0.5;
+// The level cut's lattice (mm; 0.5 mm moved the thesis lesions' areas by
+// under 0.05 % and took twice as long) on faces whose deviations come within
+// this fraction of the level of it, at most this many steps per edge; and
+// how far past the region (mm) the stripes that steer the cubic are taken.
+constexpr double kSubdivisionMm = 1.0;
 constexpr double kSubdivisionMargin = 0.5;
 constexpr int kMaxSubdivisions = 64;
 constexpr double kFieldMarginMm = 15.0;
@@ -397,18 +398,19 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   field_box.extend(box.max() + Eigen::Vector2d::Constant(kFieldMarginMm));
   const internal::StripeField scan_field(mesh, surface.FacesIn(field_box));
   // The part of `triangle` (counter-clockwise, deviations `values`) above
-  // the level inside the region, in x-y mm^2.
-  auto raised_xy = [&](const Polygon2d& triangle, const std::vector<double>& values) {
+  // the level inside the region (`whole`: the triangle lies in it), x-y mm^2.
+  auto raised_xy = [&](const Polygon2d& triangle, const std::vector<double>& values, bool whole) {
     const Polygon2d raised = internal::ClipByLevel(triangle, values, result.level_mm);
     if (raised.size() < 3) return 0.0;
-    return std::abs(internal::SignedArea(internal::ClipByConvex(region, raised)));
+    return std::abs(internal::SignedArea(whole ? raised : internal::ClipByConvex(region, raised)));
   };
-  auto level_cut_xy = [&](const Polygon2d& triangle, const std::vector<double>& values) {
+  auto level_cut_xy = [&](const Polygon2d& triangle, const std::vector<double>& values,
+                          bool whole) {
     const double lo = *std::min_element(values.begin(), values.end());
     const double hi = *std::max_element(values.begin(), values.end());
     const double margin = kSubdivisionMargin * std::abs(result.level_mm);
     if (scan_field.empty() || hi < result.level_mm - margin || lo > result.level_mm + margin)
-      return raised_xy(triangle, values);
+      return raised_xy(triangle, values, whole);
     double longest = 0.0;
     for (int k = 0; k < 3; ++k) longest = std::max(longest, (triangle[(k + 1) % 3] - triangle[k]).norm());
     const int steps = std::clamp(static_cast<int>(std::ceil(longest / kSubdivisionMm)), 1, kMaxSubdivisions);
@@ -432,11 +434,11 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
       for (int j = 0; i + j < steps; ++j) {
         const std::array<int, 3> lower = {at(i, j), at(i + 1, j), at(i, j + 1)};
         xy += raised_xy({points[lower[0]], points[lower[1]], points[lower[2]]},
-                        {lattice[lower[0]], lattice[lower[1]], lattice[lower[2]]});
+                        {lattice[lower[0]], lattice[lower[1]], lattice[lower[2]]}, whole);
         if (i + j + 1 < steps) {
           const std::array<int, 3> upper = {at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)};
           xy += raised_xy({points[upper[0]], points[upper[1]], points[upper[2]]},
-                          {lattice[upper[0]], lattice[upper[1]], lattice[upper[2]]});
+                          {lattice[upper[0]], lattice[upper[1]], lattice[upper[2]]}, whole);
         }
       }
     return xy;
@@ -474,7 +476,8 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
     volume += piece_xy * (w[0] * values[0] + w[1] * values[1] + w[2] * values[2]);
     for (int k = 0; k < 3; ++k) volume_weight[ids[k]] += piece_xy * w[k];
 
-    if (const double part_xy = level_cut_xy(triangle, values); part_xy > 0.0)
+    const bool whole = piece_xy >= (1.0 - 1e-9) * std::abs(signed_xy);
+    if (const double part_xy = level_cut_xy(triangle, values, whole); part_xy > 0.0)
       area += part_xy * std::sqrt(1.0 + reference.gradient(internal::Centroid(piece)).squaredNorm());
     // The level line through this face: its length over the slope of d says
     // how much area a shift of the level moves.
