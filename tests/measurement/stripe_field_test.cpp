@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <numbers>
 
@@ -83,11 +83,11 @@ TEST(StripeField, SaysNothingWhereNoNeighbouringStripesBracketThePoint) {
   const Height plane = [](double x, double y) { return 1.0 + 0.1 * x + 0.2 * y; };
   const geometry::SurfaceMesh mesh = Stripes(plane, 6, 0.0, 0.0, 20.0, 0, 3);
   const internal::StripeField field(mesh, AllFaces(mesh));
-  EXPECT_FALSE(field.Z({-1.0, 5.0}).has_value());             // before the first line
-  EXPECT_FALSE(field.Z({5.5 * kPitchMm, 5.0}).has_value());   // after the last
-  EXPECT_FALSE(field.Z({kPitchMm, 25.0}).has_value());        // beyond the lines' ends
-  EXPECT_FALSE(field.Z({3.0 * kPitchMm, 5.0}).has_value());   // line 3 has no edges
-  EXPECT_FALSE(field.Z({2.5 * kPitchMm, 5.0}).has_value());   // lines 2 and 4: labels two apart
+  EXPECT_FALSE(field.Z({-1.0, 5.0}).has_value());            // before the first line
+  EXPECT_FALSE(field.Z({5.5 * kPitchMm, 5.0}).has_value());  // after the last
+  EXPECT_FALSE(field.Z({kPitchMm, 25.0}).has_value());       // beyond the lines' ends
+  EXPECT_FALSE(field.Z({3.0 * kPitchMm, 5.0}).has_value());  // line 3 has no edges
+  EXPECT_FALSE(field.Z({2.5 * kPitchMm, 5.0}).has_value());  // lines 2 and 4: labels two apart
   EXPECT_NEAR(*field.Z({0.5 * kPitchMm, 5.0}), plane(0.5 * kPitchMm, 5.0), 1e-12);
   geometry::SurfaceMesh unlabelled = mesh;
   unlabelled.line.clear();
@@ -120,9 +120,10 @@ TEST(StripeField, TheLevelCutDoesNotDependOnTheTriangles) {
     mesh.line.clear();
     area[0][sheared] = MeasureLesion(SurfaceQuery(mesh), region, {}).area_mm2.value;
   }
-  std::printf("cavity area, true %.1f mm^2 (row pairs / sheared): following the stripes %.1f / "
-              "%.1f, flat triangles %.1f / %.1f\n",
-              truth, area[1][0], area[1][1], area[0][0], area[0][1]);
+  std::printf(
+      "cavity area, true %.1f mm^2 (row pairs / sheared): following the stripes %.1f / "
+      "%.1f, flat triangles %.1f / %.1f\n",
+      truth, area[1][0], area[1][1], area[0][0], area[0][1]);
   EXPECT_NEAR(area[1][0], area[1][1], 0.001 * truth);
   EXPECT_GT(std::abs(area[0][0] - area[0][1]), 0.003 * truth);  // 0.4 % here
   EXPECT_LT(std::abs(area[1][0] / truth - 1.0), 0.03);

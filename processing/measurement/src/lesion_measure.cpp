@@ -184,7 +184,8 @@ ReferenceSurface FitReference(const SurfaceQuery& surface, const Polygon2d& regi
   internal::CheckPolygon(region, "lesion region");
   if (params.reference == ReferenceKind::kBaseline)
     throw MeasurementError(
-        "lesion reference: a baseline is an earlier scan, not a fit (MeasureLesionAgainstBaseline)");
+        "lesion reference: a baseline is an earlier scan, not a fit "
+        "(MeasureLesionAgainstBaseline)");
   const geometry::SurfaceMesh& mesh = surface.mesh();
   const std::vector<int> ring_vertices = RingVertices(surface, region, params.ring_width_mm);
   const int terms = TermsOf(params.reference);
@@ -239,7 +240,7 @@ namespace {
 // reference or a registered baseline scan.
 struct ReferenceView {
   ReferenceKind kind = ReferenceKind::kCubic;
-  std::function<std::optional<double>(const Eigen::Vector2d&)> z;  // nullopt: no surface there
+  std::function<std::optional<double>(const Eigen::Vector2d&)> z;   // nullopt: no surface there
   std::function<Eigen::Vector2d(const Eigen::Vector2d&)> gradient;  // (dz/dx, dz/dy)
   std::function<double(const Eigen::Vector2d&)> sigma;              // 1 sigma of z, mm
   double residual_rms_mm = 0.0;     // of the surface against it outside the region
@@ -268,10 +269,9 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
     }
   }
   if (inside.empty())
-    throw MeasurementError("lesion region: no surface vertex lies inside the polygon" +
-                           std::string(reference.kind == ReferenceKind::kBaseline
-                                           ? " over the baseline"
-                                           : ""));
+    throw MeasurementError(
+        "lesion region: no surface vertex lies inside the polygon" +
+        std::string(reference.kind == ReferenceKind::kBaseline ? " over the baseline" : ""));
   result.region_vertices = static_cast<int>(inside.size());
   auto deviation = [&](int v) {
     if (std::isnan(deviations[v])) {
@@ -412,16 +412,18 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
     if (scan_field.empty() || hi < result.level_mm - margin || lo > result.level_mm + margin)
       return raised_xy(triangle, values, whole);
     double longest = 0.0;
-    for (int k = 0; k < 3; ++k) longest = std::max(longest, (triangle[(k + 1) % 3] - triangle[k]).norm());
-    const int steps = std::clamp(static_cast<int>(std::ceil(longest / kSubdivisionMm)), 1, kMaxSubdivisions);
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (triangle[(k + 1) % 3] - triangle[k]).norm());
+    const int steps =
+        std::clamp(static_cast<int>(std::ceil(longest / kSubdivisionMm)), 1, kMaxSubdivisions);
     // Lattice point (i, j) = t0 + (t1 - t0) i / steps + (t2 - t0) j / steps, row by row.
     std::vector<Eigen::Vector2d> points;
     std::vector<double> lattice;
     for (int i = 0; i <= steps; ++i)
       for (int j = 0; j <= steps - i; ++j) {
         const double u = static_cast<double>(i) / steps, v = static_cast<double>(j) / steps;
-        const Eigen::Vector2d p = triangle[0] + (triangle[1] - triangle[0]) * u +
-                                  (triangle[2] - triangle[0]) * v;
+        const Eigen::Vector2d p =
+            triangle[0] + (triangle[1] - triangle[0]) * u + (triangle[2] - triangle[0]) * v;
         double value = (1.0 - u - v) * values[0] + u * values[1] + v * values[2];
         if (const auto z = scan_field.Z(p))
           if (const auto z_reference = reference.z(p)) value = sign * (*z - *z_reference);
@@ -478,7 +480,8 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
 
     const bool whole = piece_xy >= (1.0 - 1e-9) * std::abs(signed_xy);
     if (const double part_xy = level_cut_xy(triangle, values, whole); part_xy > 0.0)
-      area += part_xy * std::sqrt(1.0 + reference.gradient(internal::Centroid(piece)).squaredNorm());
+      area +=
+          part_xy * std::sqrt(1.0 + reference.gradient(internal::Centroid(piece)).squaredNorm());
     // The level line through this face: its length over the slope of d says
     // how much area a shift of the level moves.
     const double lo = *std::min_element(values.begin(), values.end());
@@ -600,9 +603,8 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   result.filled_share = filled_xy / region_xy;
   result.filled_area_mm2 = {area + plate_area,
                             std::hypot(result.area_mm2.uncertainty, plate_area - membrane_area)};
-  result.filled_volume_mm3 = {
-      volume + plate_volume,
-      std::hypot(result.volume_mm3.uncertainty, plate_volume - membrane_volume)};
+  result.filled_volume_mm3 = {volume + plate_volume, std::hypot(result.volume_mm3.uncertainty,
+                                                                plate_volume - membrane_volume)};
 }
 
 // `region` checked and counter-clockwise.
@@ -612,7 +614,6 @@ Polygon2d OrientedRegion(const Polygon2d& region_in) {
   if (internal::SignedArea(region) < 0.0) std::reverse(region.begin(), region.end());
   return region;
 }
-
 
 }  // namespace
 

@@ -57,8 +57,13 @@ StripeField::StripeField(const geometry::SurfaceMesh& mesh, const std::vector<in
   for (const auto& [a, b] : edges) {
     const Eigen::Vector3d& p = mesh.positions[a];
     const Eigen::Vector3d& q = mesh.positions[b];
-    Segment segment{p.head<2>().dot(across_), p.head<2>().dot(along_), p.z(),
-                    q.head<2>().dot(across_), q.head<2>().dot(along_), q.z(), mesh.line[a]};
+    Segment segment{p.head<2>().dot(across_),
+                    p.head<2>().dot(along_),
+                    p.z(),
+                    q.head<2>().dot(across_),
+                    q.head<2>().dot(along_),
+                    q.z(),
+                    mesh.line[a]};
     if (!std::isfinite(segment.s0 + segment.w0 + segment.z0 + segment.s1 + segment.w1 + segment.z1))
       continue;
     if (segment.w0 == segment.w1) continue;  // runs across: its ends lie on other edges
@@ -123,9 +128,10 @@ std::optional<double> StripeField::Z(const Eigen::Vector2d& xy) const {
   const double m_l = i > 0 && neighbour(i - 1, l.line - step, l.s - crossings[i - 1].s)
                          ? ParabolaSlope(crossings[i - 1], l, r)
                          : secant;
-  const double m_r = i + 2 < crossings.size() && neighbour(i + 2, r.line + step, crossings[i + 2].s - r.s)
-                         ? ParabolaSlope(l, r, crossings[i + 2])
-                         : secant;
+  const double m_r =
+      i + 2 < crossings.size() && neighbour(i + 2, r.line + step, crossings[i + 2].s - r.s)
+          ? ParabolaSlope(l, r, crossings[i + 2])
+          : secant;
   // Cubic Hermite on [l, r].
   const double t = (s - l.s) / h, t2 = t * t, t3 = t2 * t;
   return (2.0 * t3 - 3.0 * t2 + 1.0) * l.z + (t3 - 2.0 * t2 + t) * h * m_l +
