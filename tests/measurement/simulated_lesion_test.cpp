@@ -120,13 +120,13 @@ TEST(SimulatedLesionTest, MeetsTheAcceptanceOnASmoothCheekAtTheRigsSampling) {
 
 // The thesis's cheek cavity (half-depth contour 11.5 mm in radius) is crossed
 // by about four stripes 5.7 mm apart. Cut linearly between stripes, the
-// level's contour runs inside the true one and the area falls short; on
-// edges across stripes the crossing from the cubic through four stripes
-// follows the profile better. Noise-free samples, five placements across
-// the stripes (every 1.14 mm in x): the cubic's area error is smaller at
-// every placement (measured -1.8..+0.3 %, linear -2.6..-0.7 %; a 1-D model
-// of the sampling gives the same, docs/measurement.md). Without stripe
-// labels the cut is linear.
+// level's contour runs inside the true one and the area falls short; cut
+// through the cubic across the stripes (StripeField) it follows the profile
+// better. Noise-free samples, five placements across the stripes (every
+// 1.14 mm in x): the cubic's area error is smaller at every placement
+// (measured -1.5..+0.3 % since 2026-11-27, -1.8..+0.3 % with the earlier
+// per-edge cubic; linear -2.6..-0.7 %). Without stripe labels the cut is
+// linear.
 TEST(SimulatedLesionTest, TheLevelBetweenStripesFollowsTheProfile) {
   const auto cheek = std::make_shared<simulator::BallSurface>(simulator::BallParams{
       .centre_mm = {0.0, 0.0, -60.0}, .radius_mm = 160.0, .cut_below_z_mm = 0.0});
