@@ -87,8 +87,9 @@ StripeField::StripeField(const geometry::SurfaceMesh& mesh, const std::vector<in
   }
 }
 
-// Thesis App. B: cubic interpolation between stripe samples, here across the
-// stripes (the thesis joins them by straight edges, 5.2.1).
+// Ours: the thesis joins neighbouring stripes by straight edges (5.2.1) and
+// interpolates by cubics only along a stripe (App. B); this is a cubic
+// across them.
 std::optional<double> StripeField::Z(const Eigen::Vector2d& xy) const {
   if (segments_.empty()) return std::nullopt;
   const double s = xy.dot(across_), w = xy.dot(along_);
