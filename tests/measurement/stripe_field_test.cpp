@@ -79,6 +79,22 @@ TEST(StripeField, ReproducesAQuadraticAcrossTheStripes) {
   EXPECT_NEAR(*field.Z({2.0 * kPitchMm, 7.25}), quadratic(2.0 * kPitchMm, 7.25), 1e-12);
 }
 
+// A joined face: the left side's lines 3, 2, 1, 0 and the right side's 1,
+// 2, 3 (labels count outwards from the reference line on both sides, and
+// the join keeps the left's line 0): the cubic carries over the seam.
+TEST(StripeField, CarriesTheCubicOverTheReferenceLineOfAJoinedFace) {
+  const Height quadratic = [](double x, double y) { return 0.03 * x * x + 0.02 * x * y + 0.1 * y; };
+  geometry::SurfaceMesh mesh = Stripes(quadratic, 7, -3.0 * kPitchMm, 0.0, 20.0);
+  for (std::int32_t& line : mesh.line) line = std::abs(line - 3);
+  const internal::StripeField field(mesh, AllFaces(mesh));
+  for (double x = -1.5 * kPitchMm; x < 1.5 * kPitchMm; x += 0.9)
+    for (double y = 0.4; y < 20.0; y += 3.1) {
+      const std::optional<double> z = field.Z({x, y});
+      ASSERT_TRUE(z.has_value()) << x << ", " << y;
+      EXPECT_NEAR(*z, quadratic(x, y), 1e-9) << x << ", " << y;
+    }
+}
+
 TEST(StripeField, SaysNothingWhereNoNeighbouringStripesBracketThePoint) {
   const Height plane = [](double x, double y) { return 1.0 + 0.1 * x + 0.2 * y; };
   const geometry::SurfaceMesh mesh = Stripes(plane, 6, 0.0, 0.0, 20.0, 0, 3);

@@ -122,17 +122,20 @@ std::optional<double> StripeField::Z(const Eigen::Vector2d& xy) const {
   const double h = r.s - l.s;
   if (std::abs(step) != 1 || !(h > 0.0)) return std::nullopt;
   const double secant = (r.z - l.z) / h;
+  // The stripe beyond the bracket continues its labels' step; labels count
+  // outwards from the reference line on both sides (contracts section 2),
+  // so on a joined face the stripe beyond line 0 is labelled 1 again.
   auto neighbour = [&](std::size_t k, int line, double gap) {
     return crossings[k].line == line && gap > 0.0 && gap <= kMaxGapRatio * h &&
            h <= kMaxGapRatio * gap;
   };
-  const double m_l = i > 0 && neighbour(i - 1, l.line - step, l.s - crossings[i - 1].s)
+  const double m_l = i > 0 && neighbour(i - 1, std::abs(l.line - step), l.s - crossings[i - 1].s)
                          ? ParabolaSlope(crossings[i - 1], l, r)
                          : secant;
-  const double m_r =
-      i + 2 < crossings.size() && neighbour(i + 2, r.line + step, crossings[i + 2].s - r.s)
-          ? ParabolaSlope(l, r, crossings[i + 2])
-          : secant;
+  const double m_r = i + 2 < crossings.size() &&
+                             neighbour(i + 2, std::abs(r.line + step), crossings[i + 2].s - r.s)
+                         ? ParabolaSlope(l, r, crossings[i + 2])
+                         : secant;
   // Cubic Hermite on [l, r].
   const double t = (s - l.s) / h, t2 = t * t, t3 = t2 * t;
   return (2.0 * t3 - 3.0 * t2 + 1.0) * l.z + (t3 - 2.0 * t2 + t) * h * m_l +
