@@ -107,12 +107,8 @@ std::vector<int> CandidateVertices(const SurfaceQuery& surface, const Eigen::Ali
 // The vertices of `surface` outside `region` within `width_mm` of its boundary.
 std::vector<int> RingVertices(const SurfaceQuery& surface, const Polygon2d& region,
                               double width_mm) {
-  Eigen::AlignedBox2d box = internal::Bounds(region);
-  const Eigen::Vector2d ring(width_mm, width_mm);
-  box.extend(box.min() - ring);
-  box.extend(box.max() + ring);
   std::vector<int> vertices;
-  for (int v : CandidateVertices(surface, box)) {
+  for (int v : CandidateVertices(surface, internal::Grown(internal::Bounds(region), width_mm))) {
     const Eigen::Vector2d xy = surface.mesh().positions[v].head<2>();
     if (!internal::Contains(region, xy) && internal::DistanceToBoundary(region, xy) <= width_mm)
       vertices.push_back(v);
@@ -393,10 +389,8 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
   // lattice of kSubdivisionMm; the others, and meshes without stripe
   // labels, linearly.
   const std::vector<int> faces_in_box = surface.FacesIn(box);
-  Eigen::AlignedBox2d field_box = box;
-  field_box.extend(box.min() - Eigen::Vector2d::Constant(kFieldMarginMm));
-  field_box.extend(box.max() + Eigen::Vector2d::Constant(kFieldMarginMm));
-  const internal::StripeField scan_field(mesh, surface.FacesIn(field_box));
+  const internal::StripeField scan_field(mesh,
+                                         surface.FacesIn(internal::Grown(box, kFieldMarginMm)));
   // The part of `triangle` (counter-clockwise, deviations `values`) above
   // the level inside the region (`whole`: the triangle lies in it), x-y mm^2.
   auto raised_xy = [&](const Polygon2d& triangle, const std::vector<double>& values, bool whole) {
@@ -404,10 +398,9 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
     if (raised.size() < 3) return 0.0;
     return std::abs(internal::SignedArea(whole ? raised : internal::ClipByConvex(region, raised)));
   };
-  auto level_cut_xy = [&](const Polygon2d& triangle, const std::vector<double>& values,
-                          bool whole) {
-    const double lo = *std::min_element(values.begin(), values.end());
-    const double hi = *std::max_element(values.begin(), values.end());
+  // The same for a face whose deviations span [lo, hi].
+  auto level_cut_xy = [&](const Polygon2d& triangle, const std::vector<double>& values, double lo,
+                          double hi, bool whole) {
     const double margin = kSubdivisionMargin * std::abs(result.level_mm);
     if (scan_field.empty() || hi < result.level_mm - margin || lo > result.level_mm + margin)
       return raised_xy(triangle, values, whole);
@@ -478,14 +471,14 @@ void MeasureAgainst(const SurfaceQuery& surface, const Polygon2d& region,
     volume += piece_xy * (w[0] * values[0] + w[1] * values[1] + w[2] * values[2]);
     for (int k = 0; k < 3; ++k) volume_weight[ids[k]] += piece_xy * w[k];
 
+    const double lo = *std::min_element(values.begin(), values.end());
+    const double hi = *std::max_element(values.begin(), values.end());
     const bool whole = piece_xy >= (1.0 - 1e-9) * std::abs(signed_xy);
-    if (const double part_xy = level_cut_xy(triangle, values, whole); part_xy > 0.0)
+    if (const double part_xy = level_cut_xy(triangle, values, lo, hi, whole); part_xy > 0.0)
       area +=
           part_xy * std::sqrt(1.0 + reference.gradient(internal::Centroid(piece)).squaredNorm());
     // The level line through this face: its length over the slope of d says
     // how much area a shift of the level moves.
-    const double lo = *std::min_element(values.begin(), values.end());
-    const double hi = *std::max_element(values.begin(), values.end());
     if (lo < result.level_mm && hi > result.level_mm) {
       std::vector<Eigen::Vector2d> crossings;
       for (int k = 0; k < 3; ++k) {
@@ -662,11 +655,9 @@ LesionMeasurement MeasureLesionAgainstBaseline(const SurfaceQuery& surface,
 
   // Between its stripes the baseline follows the same cubic as the surface
   // (StripeField), where it has stripe labels.
-  Eigen::AlignedBox2d field_box = internal::Bounds(region);
-  const double field_margin = params.ring_width_mm + kFieldMarginMm;
-  field_box.extend(field_box.min() - Eigen::Vector2d::Constant(field_margin));
-  field_box.extend(field_box.max() + Eigen::Vector2d::Constant(field_margin));
-  const internal::StripeField baseline_field(moved, reference.FacesIn(field_box));
+  const internal::StripeField baseline_field(
+      moved, reference.FacesIn(
+                 internal::Grown(internal::Bounds(region), params.ring_width_mm + kFieldMarginMm)));
   ReferenceView view;
   view.kind = ReferenceKind::kBaseline;
   view.z = [&](const Eigen::Vector2d& xy) -> std::optional<double> {

@@ -99,6 +99,13 @@ Eigen::AlignedBox2d Bounds(const Polygon2d& polygon) {
   return box;
 }
 
+Eigen::AlignedBox2d Grown(Eigen::AlignedBox2d box, double margin_mm) {
+  const Eigen::Vector2d margin = Eigen::Vector2d::Constant(margin_mm);
+  box.extend(box.min() - margin);
+  box.extend(box.max() + margin);
+  return box;
+}
+
 void CheckPolygon(const Polygon2d& polygon, const std::string& what) {
   if (polygon.size() < 3)
     throw MeasurementError(what + ": a polygon needs at least 3 vertices, got " +

@@ -27,6 +27,8 @@ Polygon2d ClipByConvex(const Polygon2d& subject, const Polygon2d& clip);
 Polygon2d ClipByLevel(const Polygon2d& polygon, const std::vector<double>& values, double level);
 // Bounding box.
 Eigen::AlignedBox2d Bounds(const Polygon2d& polygon);
+// `box` grown by `margin_mm` on every side.
+Eigen::AlignedBox2d Grown(Eigen::AlignedBox2d box, double margin_mm);
 // Throws MeasurementError "<what>: ..." unless the polygon has >= 3 finite
 // vertices and a non-zero area.
 void CheckPolygon(const Polygon2d& polygon, const std::string& what);
