@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <numeric>
 #include <set>
 #include <stdexcept>
@@ -255,12 +256,23 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
   for (const cv::Point& p : lit) deg[at(p.x, p.y)] = static_cast<uchar>(neighbours(at(p.x, p.y)));
   auto degree = [&](int x, int y) { return deg[at(x, y)]; };
 
-  g.owner_.create(rows, cols, CV_32S);
-  int* const owner_data = g.owner_.ptr<int>(0);  // continuous: freshly allocated
-  static_assert(kNone == -1);                    // every byte 0xFF
-  std::memset(owner_data, 0xFF, g.owner_.total() * sizeof(int));
-  auto owner = [&](int x, int y) -> int& {
-    return owner_data[static_cast<size_t>(y) * static_cast<size_t>(cols) + static_cast<size_t>(x)];
+  // Owners in a buffer laid out like bin (frame -1); the graph keeps its image part.
+  cv::Mat owners(rows + 2, stride, CV_32S);
+  int* const owner_data = owners.ptr<int>(0);  // continuous: freshly allocated
+  static_assert(kNone == -1);                  // every byte 0xFF
+  std::memset(owner_data, 0xFF, owners.total() * sizeof(int));
+  g.owner_ = owners(cv::Rect(1, 1, cols, rows));
+  auto owner = [&](int x, int y) -> int& { return owner_data[at(x, y)]; };
+  auto owner_at = [owner_data](size_t i) -> int& { return owner_data[i]; };
+  // The chain-code neighbours by buffer index, and buffer indices back to pixels.
+  std::array<std::ptrdiff_t, 8> step;
+  for (int c = 0; c < 8; ++c) step[c] = kCodeDy[c] * std::ptrdiff_t{stride} + kCodeDx[c];
+  auto neighbour = [&step](size_t i, int c) {
+    return static_cast<size_t>(static_cast<std::ptrdiff_t>(i) + step[c]);
+  };
+  auto point_of = [stride](size_t i) {
+    return cv::Point(static_cast<int>(i % static_cast<size_t>(stride)) - 1,
+                     static_cast<int>(i / static_cast<size_t>(stride)) - 1);
   };
 
   // Junction clusters: 8-connected groups of pixels with three or more neighbours.
@@ -287,26 +299,47 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
       }
     }
   }
-  // A two-neighbour pixel whose neighbours all belong to one cluster is part of it.
-  for (const cv::Point& p0 : lit) {
-    const int x = p0.x, y = p0.y;
-    if (degree(x, y) != 2 || owner(x, y) != kNone) continue;
-    int cluster = kNone;
-    bool same = true;
-    for (int c = 0; c < 8 && same; ++c) {
-      const int nx = x + kCodeDx[c], ny = y + kCodeDy[c];
-      if (!set(nx, ny)) continue;
-      const int o = owner(nx, ny);
-      if (o < 0 || g.nodes_[o].kind != NodeKind::kJunction)
-        same = false;
-      else if (cluster == kNone)
-        cluster = o;
-      else if (cluster != o)
-        same = false;
-    }
-    if (same && cluster != kNone) {
-      owner(x, y) = cluster;
-      g.nodes_[cluster].pixels.push_back({x, y});
+  // A two-neighbour pixel whose neighbours all belong to one cluster is part
+  // of it. Pixels are taken in raster order, each seeing the pixels joined
+  // before it; only those next to a cluster pixel, or to a pixel joined
+  // before them, can join, so those alone are visited (a min-heap of buffer
+  // indices keeps the raster order).
+  {
+    std::vector<size_t> heap;
+    auto offer = [&](size_t i) {  // a neighbour that might join
+      if (deg[i] == 2 && owner_at(i) == kNone) {
+        heap.push_back(i);
+        std::push_heap(heap.begin(), heap.end(), std::greater<>());
+      }
+    };
+    for (const SkeletonNode& node : g.nodes_)
+      for (const cv::Point& p : node.pixels)
+        for (int c = 0; c < 8; ++c) offer(neighbour(at(p.x, p.y), c));
+    size_t last = 0;  // the index taken last (0 lies in the frame)
+    while (!heap.empty()) {
+      std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+      const size_t i = heap.back();
+      heap.pop_back();
+      if (i == last) continue;  // offered twice
+      last = i;
+      if (owner_at(i) != kNone) continue;
+      int cluster = kNone;
+      bool same = true;
+      for (int c = 0; c < 8 && same; ++c) {
+        if (!bin[neighbour(i, c)]) continue;
+        const int o = owner_at(neighbour(i, c));
+        if (o < 0 || g.nodes_[o].kind != NodeKind::kJunction)
+          same = false;
+        else if (cluster == kNone)
+          cluster = o;
+        else if (cluster != o)
+          same = false;
+      }
+      if (!same || cluster == kNone) continue;
+      owner_at(i) = cluster;
+      g.nodes_[cluster].pixels.push_back(point_of(i));
+      for (int c = 0; c < 8; ++c)
+        if (neighbour(i, c) > i) offer(neighbour(i, c));  // only pixels after it see it
     }
   }
   // Thesis 5.1.4.8: where two lines run a few pixels apart, the short segment
@@ -349,44 +382,48 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
 
   // Chains between nodes.
   std::set<std::pair<int, int>> direct_links;
+  // Pixels are carried as (buffer index, point); a step moves both.
   auto trace_from = [&](int node, cv::Point start, cv::Point first) {
     SkeletonEdge edge;
     edge.from = node;
     const int id = static_cast<int>(g.edges_.size());
-    cv::Point prev = start, cur = first;
+    const size_t start_i = at(start.x, start.y);
+    size_t prev = start_i, cur = at(first.x, first.y);
+    cv::Point cur_p = first;
     while (true) {
-      const int o = owner(cur.x, cur.y);
+      const int o = owner_at(cur);
       if (o >= 0) {
         edge.to = o;
         break;
       }
-      owner(cur.x, cur.y) = EncodeEdge(id);
-      edge.pixels.push_back(cur);
-      cv::Point next(-1, -1);
+      owner_at(cur) = EncodeEdge(id);
+      edge.pixels.push_back(cur_p);
+      int next_c = -1;
       // Prefer stepping onto a node pixel (other than the one we came from at
       // the very start) so chains stop at their junction.
       for (int c = 0; c < 8; ++c) {
-        const int nx = cur.x + kCodeDx[c], ny = cur.y + kCodeDy[c];
-        if (!set(nx, ny) || cv::Point(nx, ny) == prev) continue;
-        const int o2 = owner(nx, ny);
+        const size_t q = neighbour(cur, c);
+        if (!bin[q] || q == prev) continue;
+        const int o2 = owner_at(q);
         if (o2 >= 0) {
-          if (edge.pixels.size() == 1 && o2 == node && cv::Point(nx, ny) != start) continue;
-          next = {nx, ny};
+          if (edge.pixels.size() == 1 && o2 == node && q != start_i) continue;
+          next_c = c;
           break;
         }
-        if (o2 == kNone) next = {nx, ny};
+        if (o2 == kNone) next_c = c;
       }
-      if (next.x < 0) {
+      if (next_c < 0) {
         // Dead end inside a chain (cannot happen on a thin skeleton): close at an end node.
         const int end = new_node(NodeKind::kEnd);
         edge.pixels.pop_back();
-        g.nodes_[end].pixels.push_back(cur);
-        owner(cur.x, cur.y) = end;
+        g.nodes_[end].pixels.push_back(cur_p);
+        owner_at(cur) = end;
         edge.to = end;
         break;
       }
       prev = cur;
-      cur = next;
+      cur = neighbour(cur, next_c);
+      cur_p += cv::Point(kCodeDx[next_c], kCodeDy[next_c]);
     }
     g.edges_.push_back(std::move(edge));
   };
