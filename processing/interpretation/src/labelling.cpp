@@ -51,6 +51,53 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// Positioned samples bucketed by the cells of a square grid `cell` wide.
+class SampleGrid {
+ public:
+  using Sample = std::pair<cv::Point2d, double>;
+
+  SampleGrid(const std::vector<Sample>& samples, double cell) : samples_(samples), cell_(cell) {
+    if (samples.empty()) return;
+    cv::Point lo = CellOf(samples.front().first), hi = lo;
+    for (const Sample& s : samples) {
+      const cv::Point c = CellOf(s.first);
+      lo = {std::min(lo.x, c.x), std::min(lo.y, c.y)};
+      hi = {std::max(hi.x, c.x), std::max(hi.y, c.y)};
+    }
+    origin_ = lo;
+    size_ = {hi.x - lo.x + 1, hi.y - lo.y + 1};
+    cells_.resize(static_cast<size_t>(size_.area()));
+    for (size_t i = 0; i < samples.size(); ++i) {
+      const cv::Point c = CellOf(samples[i].first) - origin_;
+      cells_[static_cast<size_t>(c.y * size_.width + c.x)].push_back(i);
+    }
+  }
+
+  // Calls visit(sample) for every sample within `cell` of `at` in x and in y
+  // (and some farther ones).
+  template <typename Visit>
+  void ForEachNear(cv::Point2d at, Visit visit) const {
+    if (cells_.empty() || !std::isfinite(at.x) || !std::isfinite(at.y)) return;
+    const cv::Point c = CellOf(at) - origin_;
+    for (int y = std::max(c.y - 1, 0); y <= std::min(c.y + 1, size_.height - 1); ++y)
+      for (int x = std::max(c.x - 1, 0); x <= std::min(c.x + 1, size_.width - 1); ++x)
+        for (size_t i : cells_[static_cast<size_t>(y * size_.width + x)]) visit(samples_[i]);
+  }
+
+ private:
+  cv::Point CellOf(cv::Point2d p) const {
+    // Clamped far beyond any image, so that the cast is defined.
+    return {static_cast<int>(std::floor(std::clamp(p.x / cell_, -1e6, 1e6))),
+            static_cast<int>(std::floor(std::clamp(p.y / cell_, -1e6, 1e6)))};
+  }
+
+  const std::vector<Sample>& samples_;
+  double cell_;
+  cv::Point origin_;
+  cv::Size size_;
+  std::vector<std::vector<size_t>> cells_;
+};
+
 struct VerticalLink {
   int a = -1, b = -1;  // a above b
   int first = -1;      // half-edge leaving a downwards
@@ -184,13 +231,18 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     all_spacing.push_back(s);
   }
   const double global_spacing = Median(all_spacing);
+  // The samples by cell of a grid spacing_radius wide, so that a query reads
+  // the 3 x 3 cells around its own only: the same samples as a scan of all
+  // (in another order, which the median does not see).
+  const SampleGrid grid(spacing_samples, params.spacing_radius);
+  std::vector<double> near;
   auto local_spacing = [&](cv::Point2d at) {
-    std::vector<double> near;
+    near.clear();
     const double r2 = params.spacing_radius * params.spacing_radius;
-    for (const auto& [pos, s] : spacing_samples) {
-      const cv::Point2d d = pos - at;
-      if (d.x * d.x + d.y * d.y <= r2) near.push_back(s);
-    }
+    grid.ForEachNear(at, [&](const std::pair<cv::Point2d, double>& sample) {
+      const cv::Point2d d = sample.first - at;
+      if (d.x * d.x + d.y * d.y <= r2) near.push_back(sample.second);
+    });
     return near.size() >= 3 ? Median(near) : global_spacing;
   };
 
