@@ -152,6 +152,7 @@ class RowValues {
 std::vector<std::pair<double, double>> RowsNear(const RowValues& rows, double centre, int radius,
                                                 double exclude) {
   std::vector<std::pair<double, double>> out;
+  out.reserve(static_cast<size_t>(2 * radius + 2));  // one allocation, not one per doubling
   const int from = std::max(rows.First(), cvFloor(centre) - radius);
   for (int y = from; y < rows.End() && y <= centre + radius; ++y)
     if (rows.Has(y) && std::abs(y - centre) > exclude) out.push_back({y - centre, rows.At(y)});
