@@ -1,5 +1,7 @@
 #include "bsls/extraction/feature_extraction.h"
 
+#include <future>
+
 #include "input_checks.h"
 #include "neighbourhood.h"
 #include "skeleton_in_place.h"
@@ -34,10 +36,23 @@ ExtractionResult ExtractFeatures(const cv::Mat& grey, const ExtractionParams& pa
   if (params.method == ExtractionMethod::kModern) {
     // The skeleton stages one after the other on one padded buffer.
     result.mask = DetectStripes(grey, params.stripe);
+    // The re-centring reads the grey image smoothed, which the skeleton does
+    // not change: where a second core is free, it is smoothed there while
+    // this one thins (the same image either way).
+    std::future<cv::Mat> smoothing;
+    if (params.recentre && cv::getNumThreads() > 1)
+      smoothing = std::async(std::launch::async, [&grey, &params] {
+        return internal::RecentreSmoothing(grey, params.recentre_params, false);
+      });
     internal::PaddedBinary skeleton(result.mask);
     internal::ZhangSuenThinInPlace(&skeleton, params.zhang_suen);
     internal::MakeOnePixelWideInPlace(&skeleton, params.t_junctions);
-    if (params.recentre) internal::RecentreOnRidgeInPlace(&skeleton, grey, params.recentre_params);
+    if (params.recentre) {
+      const cv::Mat smoothed = smoothing.valid()
+                                   ? smoothing.get()
+                                   : internal::RecentreSmoothing(grey, params.recentre_params, true);
+      internal::RecentreOnRidgeInPlace(&skeleton, smoothed, params.recentre_params);
+    }
     internal::PruneSpursInPlace(&skeleton, params.spurs);
     internal::RemoveSmallComponentsInPlace(&skeleton, params.min_component_pixels);
     internal::MakeOnePixelWideInPlace(&skeleton, params.t_junctions);

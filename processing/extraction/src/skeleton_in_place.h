@@ -20,8 +20,15 @@ void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params);
 // MakeOnePixelWide (thinning.h) on *img.
 void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions);
 
-// RecentreOnRidge (thinning.h) on *img; grey is CV_8UC1 of the image's size.
-void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& grey, const RecentreParams& params);
+// The grey image (CV_8UC1) smoothed as RecentreOnRidge reads it, CV_32FC1 in a
+// buffer laid out like a PaddedBinary of its size (the frame unused): band by
+// band on OpenCV's thread pool, or all on the calling thread (the same values).
+cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel);
+
+// RecentreOnRidge (thinning.h) on *img, reading `smoothed`: RecentreSmoothing
+// of the grey image, of the image's size.
+void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
+                            const RecentreParams& params);
 
 // PruneSpurs (pruning.h) on *img.
 void PruneSpursInPlace(PaddedBinary* img, const SpurPruneParams& params);

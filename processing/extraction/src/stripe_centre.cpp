@@ -105,6 +105,9 @@ class SmoothedDerivatives {
         ratio_step_(std::exp(-2.0 * a_)),
         g_(static_cast<size_t>(2 * support_ + 2)) {}
 
+  // The profile indices that At(x) reads: lround(x) -+ Support() (clamped).
+  int Support() const { return support_; }
+
   // First (d1) and second (d2) derivative at x.
   void At(double x, double* d1, double* d2) {
     const int n = static_cast<int>(p_.size());
@@ -186,9 +189,16 @@ int ProfileReach(const StripeCentreParams& p) {
          static_cast<int>(std::ceil(4.0 * max_sigma)) + 2;
 }
 
-// MeasureStripeProfile (stripe_centre.h) without the parameter check.
+// MeasureStripeProfile (stripe_centre.h) without the parameter check, on a
+// profile whose elements may be filled in lazily: need(i0, i1) must make
+// elements i0 .. i1 (within 0 .. n - 1) hold their values; it is called
+// before any of them is read.
+template <typename Need>
 std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile, double approximate,
-                                                const StripeCentreParams& params);
+                                                const StripeCentreParams& params, Need need);
+
+// A profile that is all there.
+constexpr auto kWhole = [](int, int) {};
 
 // The profile across the stripes of image row (row_major) or column `along`
 // at positions lo .. hi of the other coordinate into `profile` (hi - lo + 1
@@ -235,28 +245,71 @@ std::optional<double> MeasureAcross(const cv::Mat& image, bool row_major, int al
   const int hi = std::min(across_size - 1, centre + reach);
   Scratch buffer(static_cast<size_t>(hi - lo + 1));
   const std::span<double> profile = buffer.span();
-  ProfileAcross<Pixel>(image, row_major, along, lo, hi, params, profile);
-  const auto m = MeasureProfile(profile, approximate - lo, params);
+  // Only the part of the profile the measurement reads is taken from the
+  // image (each element is the same on its own as in the whole profile): a
+  // narrow stripe reads well under half of the reach that the widest needs.
+  int have_from = 0, have_to = -1;  // the elements taken so far
+  auto take = [&](int from, int to) {  // elements from .. to, none taken yet
+    if (from <= to)
+      ProfileAcross<Pixel>(image, row_major, along, lo + from, lo + to, params,
+                           profile.subspan(static_cast<size_t>(from),
+                                           static_cast<size_t>(to - from + 1)));
+  };
+  auto need = [&](int from, int to) {
+    from = std::max(from, 0);
+    to = std::min(to, hi - lo);
+    if (from > to) return;
+    if (have_from > have_to) {
+      take(from, to);
+      have_from = from, have_to = to;
+      return;
+    }
+    // Grown to one run, so that the taken elements stay contiguous.
+    if (from < have_from) take(from, have_from - 1), have_from = from;
+    if (to > have_to) take(have_to + 1, to), have_to = to;
+  };
+  const auto m = MeasureProfile(std::span<const double>(profile), approximate - lo, params, need);
   if (!m) return std::nullopt;
   return m->centre + lo;
 }
 
+template <typename Need>
 std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile, double approximate,
-                                                const StripeCentreParams& params) {
+                                                const StripeCentreParams& params, Need need) {
   const int n = static_cast<int>(profile.size());
   if (n < 3 || !(approximate >= 0.0 && approximate <= n - 1)) return std::nullopt;
 
   // Peak of the 1 px smoothed profile inside the search range; the steps
-  // below read it only within climb + reach of that range.
+  // below read it only within climb + reach of that range, and each only
+  // where it has been smoothed (`smooth`, which grows one run of positions).
   const int a = std::max(0, static_cast<int>(std::floor(approximate)) - params.search_radius);
   const int b = std::min(n - 1, static_cast<int>(std::ceil(approximate)) + params.search_radius);
   const int climb = static_cast<int>(std::ceil(0.5 * params.max_width));
   const int reach = climb + 6;
+  const int first = std::max(0, a - climb - reach), last = std::min(n - 1, b + climb + reach);
   Scratch smoothed(profile.size());
-  SmoothedAtPixels(profile, std::max(0, a - climb - reach), std::min(n - 1, b + climb + reach),
-                   smoothed.span());
+  int have_from = 0, have_to = -1;  // the positions smoothed so far
+  auto smooth_run = [&](int from, int to) {  // positions none of which is smoothed yet
+    if (from > to) return;
+    need(from - kUnitSupport, to + kUnitSupport);
+    SmoothedAtPixels(profile, from, to, smoothed.span());
+  };
+  auto smooth = [&](int from, int to) {
+    from = std::max(from, first);
+    to = std::min(to, last);
+    if (from > to) return;
+    if (have_from > have_to) {
+      smooth_run(from, to);
+      have_from = from, have_to = to;
+      return;
+    }
+    if (from < have_from) smooth_run(from, have_from - 1), have_from = from;
+    if (to > have_to) smooth_run(have_to + 1, to), have_to = to;
+  };
   const double* s = smoothed.data();
   auto at = [s](int i) { return s[i]; };
+  // The search range, and the climb from it with the test of its top.
+  smooth(a - climb - 1, b + climb + 1);
   int peak = a;
   for (int i = a; i <= b; ++i)
     if (at(i) > at(peak)) peak = i;
@@ -269,6 +322,7 @@ std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile,
     return std::nullopt;
 
   // Grounds: lowest values before the profile rises again (a neighbour) or the reach ends.
+  smooth(peak - reach, peak + reach);
   auto ground = [&](int step, int* where) {
     double deepest = at(peak);  // lowest value within the reach
     for (int k = 1; k <= reach; ++k) {
@@ -317,13 +371,18 @@ std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile,
   sigma = std::min(sigma, std::max(params.min_sigma, clear / params.clearance));
 
   // Newton's method on the first derivative of the smoothed profile.
-  SmoothedDerivatives smooth(profile, sigma);
+  SmoothedDerivatives derivatives(profile, sigma);
   const double reach_from_peak = std::max(2.0, 0.5 * width + 1.0);  // flat tops
   double x = peak;
   double d1 = 0.0, d2 = 0.0;
   bool converged = false;
+  auto derivatives_at = [&](double at_x) {
+    const int middle = static_cast<int>(std::lround(at_x));
+    need(middle - derivatives.Support(), middle + derivatives.Support());
+    derivatives.At(at_x, &d1, &d2);
+  };
   for (int iteration = 0; iteration < 30; ++iteration) {
-    smooth.At(x, &d1, &d2);
+    derivatives_at(x);
     if (!(d2 < 0.0)) return std::nullopt;  // not a maximum
     const double step = std::clamp(d1 / d2, -0.5, 0.5);
     x -= step;
@@ -334,7 +393,7 @@ std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile,
     }
   }
   if (!converged) return std::nullopt;
-  smooth.At(x, &d1, &d2);
+  derivatives_at(x);
   if (!(d2 < 0.0)) return std::nullopt;
   if (std::abs(x - approximate) > params.search_radius + 0.5) return std::nullopt;
   return StripeMeasurement{x, width, contrast, sigma};
@@ -533,7 +592,7 @@ std::optional<StripeMeasurement> MeasureStripeProfile(std::span<const double> pr
                                                       double approximate,
                                                       const StripeCentreParams& params) {
   RequireValid(params, "MeasureStripeProfile");
-  return MeasureProfile(profile, approximate, params);
+  return MeasureProfile(profile, approximate, params, kWhole);
 }
 
 std::optional<double> StripeCentreInRow(const cv::Mat& image, int y, double approximate_x,

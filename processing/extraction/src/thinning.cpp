@@ -18,6 +18,7 @@ namespace {
 
 using internal::CodeTable;
 using internal::GaussianBandsInto;
+using internal::GaussianInto;
 using internal::MakeCodeTable;
 using internal::Neighbours;
 using internal::PaddedBinary;
@@ -448,7 +449,7 @@ cv::Mat RecentreOnRidge(const cv::Mat& skeleton, const cv::Mat& grey,
   if (grey.size() != skeleton.size())
     throw std::invalid_argument("RecentreOnRidge: skeleton and grey image differ in size");
   PaddedBinary img(skeleton);
-  internal::RecentreOnRidgeInPlace(&img, grey, params);
+  internal::RecentreOnRidgeInPlace(&img, internal::RecentreSmoothing(grey, params, true), params);
   return img.ToMat();
 }
 
@@ -494,10 +495,24 @@ void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions) {
   }
 }
 
+cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel) {
+  cv::Mat smoothed(grey.rows + 2, grey.cols + 2, CV_32F);
+  cv::Mat inner = smoothed(cv::Rect(1, 1, grey.cols, grey.rows));
+  const int half = static_cast<int>(std::ceil(3.0 * params.sigma));
+  if (in_parallel)
+    GaussianBandsInto(grey, params.sigma, half, &inner);
+  else
+    GaussianInto(grey, params.sigma, half, &inner);  // the same values (bands.h)
+  return smoothed;
+}
+
 // The passes of RecentreOnRidge on the padded buffer, pixels addressed by
 // buffer index (no division per look-up).
-void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& grey, const RecentreParams& params) {
+void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
+                            const RecentreParams& params) {
   const int rows = img->Rows(), cols = img->Cols();
+  CV_Assert(smoothed.type() == CV_32F && smoothed.rows == rows + 2 && smoothed.cols == cols + 2 &&
+            smoothed.isContinuous());
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(img->Stride());
   // The 8 neighbours in the order dy = -1 .. 1, dx = -1 .. 1: steps and buffer offsets.
   constexpr int kDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
@@ -505,12 +520,6 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& grey, const Recent
   std::ptrdiff_t around[8];
   for (int k = 0; k < 8; ++k) around[k] = kDy[k] * stride + kDx[k];
   auto set = [img](std::ptrdiff_t i) { return img->data[static_cast<size_t>(i)] != 0; };
-  // The smoothed grey image in a buffer laid out like img's (frame unused).
-  cv::Mat smoothed(rows + 2, cols + 2, CV_32F);
-  {
-    cv::Mat inner = smoothed(cv::Rect(1, 1, cols, rows));
-    GaussianBandsInto(grey, params.sigma, static_cast<int>(std::ceil(3.0 * params.sigma)), &inner);
-  }
   const float* f = smoothed.ptr<float>(0);
   const float min_gain = static_cast<float>(params.min_gain);
   // Near junctions the grey ridge bends towards the branches: keep clear.
