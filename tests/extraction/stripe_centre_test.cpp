@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 #include <random>
@@ -75,6 +76,52 @@ TEST(StripeCentre, ColumnVersionMeasuresHorizontalStripesAsWell) {
     EXPECT_LE(a.rms, kRmsTarget) << "width " << width;
     EXPECT_GE(a.found, kMinFoundFraction) << "width " << width;
   }
+}
+
+// StripeCentreInRow / InColumn take from the image only the part of the
+// profile their measurement reads; their answers are those of
+// MeasureStripeProfile on the whole profile (averaged over 2 along_radius + 1
+// rows with binomial weights), to the last bit: narrow and wide stripes, the
+// approximate position off by up to 3 px, stripes near the image's edge.
+TEST(StripeCentre, ImageMeasurementEqualsTheWholeProfiles) {
+  StripeCentreParams params;
+  const int reach = params.search_radius + 7 + 6 + 23 + 2;  // the widest stripe's reach
+  int compared = 0;
+  for (double width : {1.0, 3.0, 6.0, 10.0, 13.0}) {
+    for (double x0 : {3.2, 28.3, 60.4}) {  // near the left edge, inside, near the right edge
+      const cv::Mat image = testing::RenderSlantedStripe({64, 40}, x0, kSlope, width, kPsf,
+                                                         kBackground, kContrast, kNoise, 5);
+      std::mt19937 rng(static_cast<std::uint32_t>(width * 100 + x0));
+      std::uniform_real_distribution<double> offset(-3.0, 3.0);
+      for (int y = 0; y < image.rows; ++y) {
+        const double guess = std::clamp(x0 + kSlope * y + offset(rng), 0.0, 63.0);
+        // The whole profile around the guess, as the image function would take it.
+        const int centre = static_cast<int>(std::lround(guess));
+        const int lo = std::max(0, centre - reach), hi = std::min(image.cols - 1, centre + reach);
+        std::vector<double> profile(static_cast<size_t>(hi - lo + 1), 0.0);
+        const double weights[3] = {0.25, 0.5, 0.25};
+        double total = 0.0;
+        for (int a = std::max(0, y - 1); a <= std::min(image.rows - 1, y + 1); ++a) {
+          const double w = weights[a - y + 1];
+          total += w;
+          for (int x = lo; x <= hi; ++x) profile[x - lo] += w * image.at<uchar>(a, x);
+        }
+        if (total != 1.0)
+          for (double& v : profile) v /= total;
+        const auto whole = MeasureStripeProfile(profile, guess - lo, params);
+        const auto in_row = StripeCentreInRow(image, y, guess, params);
+        const cv::Mat transposed = image.t();
+        const auto in_column = StripeCentreInColumn(transposed, y, guess, params);
+        ASSERT_EQ(whole.has_value(), in_row.has_value()) << width << " " << x0 << " " << y;
+        ASSERT_EQ(in_row.has_value(), in_column.has_value());
+        if (!whole) continue;
+        EXPECT_EQ(whole->centre + lo, *in_row) << width << " " << x0 << " " << y;
+        EXPECT_EQ(*in_row, *in_column);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 300);
 }
 
 TEST(StripeCentre, NoPixelLockingWithoutNoise) {

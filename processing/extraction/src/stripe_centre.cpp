@@ -154,6 +154,33 @@ class SmoothedDerivatives {
   Scratch g_;          // Gaussian at the pixel edges
 };
 
+// Positions lowest .. highest filled in on demand as one growing run:
+// Cover(from, to, fill) calls fill(a, b) for each stretch a .. b of from ..
+// to (clamped to the limits) not filled yet, and any gap between it and the
+// run, so that every position is filled once and the run stays contiguous.
+class CoveredRun {
+ public:
+  CoveredRun(int lowest, int highest) : lowest_(lowest), highest_(highest) {}
+
+  template <typename Fill>
+  void Cover(int from, int to, Fill fill) {
+    from = std::max(from, lowest_);
+    to = std::min(to, highest_);
+    if (from > to) return;
+    if (from_ > to_) {
+      fill(from, to);
+      from_ = from, to_ = to;
+      return;
+    }
+    if (from < from_) fill(from, from_ - 1), from_ = from;
+    if (to > to_) fill(to_ + 1, to), to_ = to;
+  }
+
+ private:
+  int lowest_, highest_;
+  int from_ = 0, to_ = -1;  // the run filled so far (empty)
+};
+
 // Binomial weights C(2r, k) / 4^r, k = 0 .. 2r (r <= 4).
 std::array<double, 9> BinomialWeights(int radius) {
   std::array<double, 9> w{};
@@ -248,25 +275,12 @@ std::optional<double> MeasureAcross(const cv::Mat& image, bool row_major, int al
   // Only the part of the profile the measurement reads is taken from the
   // image (each element is the same on its own as in the whole profile): a
   // narrow stripe reads well under half of the reach that the widest needs.
-  int have_from = 0, have_to = -1;  // the elements taken so far
-  auto take = [&](int from, int to) {  // elements from .. to, none taken yet
-    if (from <= to)
-      ProfileAcross<Pixel>(image, row_major, along, lo + from, lo + to, params,
-                           profile.subspan(static_cast<size_t>(from),
-                                           static_cast<size_t>(to - from + 1)));
-  };
+  CoveredRun taken(0, hi - lo);
   auto need = [&](int from, int to) {
-    from = std::max(from, 0);
-    to = std::min(to, hi - lo);
-    if (from > to) return;
-    if (have_from > have_to) {
-      take(from, to);
-      have_from = from, have_to = to;
-      return;
-    }
-    // Grown to one run, so that the taken elements stay contiguous.
-    if (from < have_from) take(from, have_from - 1), have_from = from;
-    if (to > have_to) take(have_to + 1, to), have_to = to;
+    taken.Cover(from, to, [&](int i0, int i1) {
+      ProfileAcross<Pixel>(image, row_major, along, lo + i0, lo + i1, params,
+                           profile.subspan(static_cast<size_t>(i0), static_cast<size_t>(i1 - i0 + 1)));
+    });
   };
   const auto m = MeasureProfile(std::span<const double>(profile), approximate - lo, params, need);
   if (!m) return std::nullopt;
@@ -281,30 +295,19 @@ std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile,
 
   // Peak of the 1 px smoothed profile inside the search range; the steps
   // below read it only within climb + reach of that range, and each only
-  // where it has been smoothed (`smooth`, which grows one run of positions).
+  // where it has been smoothed (`smooth`).
   const int a = std::max(0, static_cast<int>(std::floor(approximate)) - params.search_radius);
   const int b = std::min(n - 1, static_cast<int>(std::ceil(approximate)) + params.search_radius);
   const int climb = static_cast<int>(std::ceil(0.5 * params.max_width));
   const int reach = climb + 6;
   const int first = std::max(0, a - climb - reach), last = std::min(n - 1, b + climb + reach);
   Scratch smoothed(profile.size());
-  int have_from = 0, have_to = -1;  // the positions smoothed so far
-  auto smooth_run = [&](int from, int to) {  // positions none of which is smoothed yet
-    if (from > to) return;
-    need(from - kUnitSupport, to + kUnitSupport);
-    SmoothedAtPixels(profile, from, to, smoothed.span());
-  };
+  CoveredRun smoothed_run(first, last);
   auto smooth = [&](int from, int to) {
-    from = std::max(from, first);
-    to = std::min(to, last);
-    if (from > to) return;
-    if (have_from > have_to) {
-      smooth_run(from, to);
-      have_from = from, have_to = to;
-      return;
-    }
-    if (from < have_from) smooth_run(from, have_from - 1), have_from = from;
-    if (to > have_to) smooth_run(have_to + 1, to), have_to = to;
+    smoothed_run.Cover(from, to, [&](int i0, int i1) {
+      need(i0 - kUnitSupport, i1 + kUnitSupport);
+      SmoothedAtPixels(profile, i0, i1, smoothed.span());
+    });
   };
   const double* s = smoothed.data();
   auto at = [s](int i) { return s[i]; };
