@@ -8,6 +8,7 @@
 #include <cstring>
 #include <functional>
 #include <numeric>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -48,6 +49,11 @@ int CrossingNumber(cv::Point p, IsSet is_set) {
 template <typename IsSet>
 bool SplitH(const std::vector<cv::Point>& cluster, IsSet is_set, std::vector<cv::Point>* branch_out,
             std::vector<cv::Point>* a, std::vector<cv::Point>* b) {
+  // Groups whose centres lie 3 px or more apart in x need a cluster at least
+  // that wide: most clusters (one T) are narrower and are not looked into.
+  const auto [left, right] = std::minmax_element(
+      cluster.begin(), cluster.end(), [](const cv::Point& p, const cv::Point& q) { return p.x < q.x; });
+  if (cluster.empty() || right->x - left->x < 3) return false;
   std::vector<cv::Point>& branch = *branch_out;
   branch.clear();
   for (const cv::Point& p : cluster)
@@ -204,7 +210,7 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
   std::vector<uchar> bin(static_cast<size_t>(stride) * static_cast<size_t>(rows + 2), 0);
   {
     cv::Mat inner = cv::Mat(rows + 2, stride, CV_8UC1, bin.data())(cv::Rect(1, 1, cols, rows));
-    cv::min(skeleton, 1, inner);
+    cv::threshold(skeleton, inner, 0, 1, cv::THRESH_BINARY);  // 0 / 1
   }
   auto at = [stride](int x, int y) {
     return static_cast<size_t>(y + 1) * static_cast<size_t>(stride) + static_cast<size_t>(x + 1);
