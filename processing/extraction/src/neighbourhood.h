@@ -107,6 +107,7 @@ class PaddedBinary {
   // Buffer indices of the set pixels, in raster order.
   std::vector<size_t> SetIndices() const {
     std::vector<size_t> out;
+    out.reserve(count_hint_);  // stages delete pixels: the last count is a good bound
     const std::uint8_t* d = data.data();
     const size_t begin = stride_, end = data.size() - stride_;  // the image's rows
     size_t i = begin;
@@ -132,6 +133,7 @@ class PaddedBinary {
     }
     for (; i < end; ++i)
       if (d[i]) out.push_back(i);
+    count_hint_ = out.size();
     return out;  // the border is always 0, so only image pixels are listed
   }
 
@@ -160,6 +162,7 @@ class PaddedBinary {
   int rows_;
   int cols_;
   size_t stride_;
+  mutable size_t count_hint_ = 0;  // set pixels at the last SetIndices
 
  public:
   std::vector<std::uint8_t> data;  // 0 / 1, (rows + 2) x (cols + 2)
