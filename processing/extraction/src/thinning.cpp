@@ -566,7 +566,9 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
         const int dx = sign * sx, dy = sign * sy;  // p -> q
         if (x + dx < 0 || y + dy < 0 || x + dx >= cols || y + dy >= rows) continue;
         const std::ptrdiff_t q = p + dy * stride + dx;
-        if (set(q)) continue;
+        // Not brighter enough (the usual case on a centred skeleton): no
+        // need to look at its neighbourhood.
+        if (set(q) || !(f[q] >= best_value)) continue;
         bool ok = true;
         for (int k : nb) ok = ok && std::abs(kDx[k] - dx) <= 1 && std::abs(kDy[k] - dy) <= 1;
         for (std::ptrdiff_t o : around) {
@@ -574,7 +576,7 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
           if (!ok) break;
           if (r != p && r != p + around[nb[0]] && r != p + around[nb[1]] && set(r)) ok = false;
         }
-        if (ok && f[q] >= best_value) {
+        if (ok) {
           best = q;
           best_value = f[q];
         }
