@@ -105,13 +105,13 @@ class SmoothedDerivatives {
         ratio_step_(std::exp(-2.0 * a_)),
         g_(static_cast<size_t>(2 * support_ + 2)) {}
 
-  // The profile indices that At(x) reads: lround(x) -+ Support() (clamped).
+  // The profile indices that At(x, middle) reads: middle -+ Support() (clamped).
   int Support() const { return support_; }
 
-  // First (d1) and second (d2) derivative at x.
-  void At(double x, double* d1, double* d2) {
+  // First (d1) and second (d2) derivative at x; middle is std::lround(x).
+  void At(double x, int middle, double* d1, double* d2) {
     const int n = static_cast<int>(p_.size());
-    const int first = static_cast<int>(std::lround(x)) - support_;
+    const int first = middle - support_;
     const int edges = 2 * support_ + 2;
     // g_[m] = G(h_m), h_m = x - first + 1/2 - m: the edge between pixels
     // first + m - 1 and first + m.
@@ -235,7 +235,13 @@ template <typename Pixel>
 void ProfileAcross(const cv::Mat& image, bool row_major, int along, int lo, int hi,
                    const StripeCentreParams& params, std::span<double> profile) {
   const int along_size = row_major ? image.rows : image.cols;
-  const std::array<double, 9> weights = BinomialWeights(params.along_radius);
+  // The weights of each radius (0 .. 4, StripeCentreParams::IsValid), made once.
+  static const std::array<std::array<double, 9>, 5> kWeights = [] {
+    std::array<std::array<double, 9>, 5> w{};
+    for (int r = 0; r < 5; ++r) w[static_cast<size_t>(r)] = BinomialWeights(r);
+    return w;
+  }();
+  const std::array<double, 9>& weights = kWeights[static_cast<size_t>(params.along_radius)];
   const int first = std::max(0, along - params.along_radius);
   const int last = std::min(along_size - 1, along + params.along_radius);
   double total = 0.0;  // < 1 where the rows (columns) run out at the border
@@ -382,7 +388,7 @@ std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile,
   auto derivatives_at = [&](double at_x) {
     const int middle = static_cast<int>(std::lround(at_x));
     need(middle - derivatives.Support(), middle + derivatives.Support());
-    derivatives.At(at_x, &d1, &d2);
+    derivatives.At(at_x, middle, &d1, &d2);
   };
   for (int iteration = 0; iteration < 30; ++iteration) {
     derivatives_at(x);
