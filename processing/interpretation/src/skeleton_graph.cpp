@@ -222,8 +222,13 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     const uchar* down = &bin[i + static_cast<size_t>(stride)];
     return up[-1] + up[0] + up[1] + here[-1] + here[1] + down[-1] + down[0] + down[1];
   };
-  // Only the set pixels are visited from here on (a skeleton is sparse).
-  std::vector<cv::Point> lit;
+  // Only the set pixels are visited from here on (a skeleton is sparse),
+  // each with its buffer index.
+  struct Lit {
+    size_t i;
+    cv::Point p;
+  };
+  std::vector<Lit> lit;
   for (int y = 0; y < rows; ++y) {
     const uchar* row = &bin[at(0, y)];
     int x = 0;
@@ -240,27 +245,27 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
       std::memcpy(&word, row + x, 8);
       static_assert(std::endian::native == std::endian::little);
       while (word) {  // pixel x + k is bit 8k
-        lit.emplace_back(x + std::countr_zero(word) / 8, y);
+        const int px = x + std::countr_zero(word) / 8;
+        lit.push_back({at(px, y), {px, y}});
         word &= word - 1;
       }
     }
     for (; x < cols; ++x)
-      if (row[x]) lit.emplace_back(x, y);
+      if (row[x]) lit.push_back({at(x, y), {x, y}});
   }
   // Corner pixels of 4-connected steps (an L of three pixels) make their
   // neighbours look like junctions; the skeleton stays 8-connected without them.
-  for (const cv::Point& p : lit) {
-    const size_t i = at(p.x, p.y);
+  for (const Lit& l : lit) {
+    const size_t i = l.i;
     if (neighbours(i) != 2) continue;
     const bool horizontal = bin[i - 1] || bin[i + 1];
     const bool vertical =
         bin[i - static_cast<size_t>(stride)] || bin[i + static_cast<size_t>(stride)];
     if (horizontal && vertical) bin[i] = 0;
   }
-  std::erase_if(lit, [&](const cv::Point& p) { return !set(p.x, p.y); });
+  std::erase_if(lit, [&](const Lit& l) { return !bin[l.i]; });
   std::vector<uchar> deg(bin.size(), 0);
-  for (const cv::Point& p : lit) deg[at(p.x, p.y)] = static_cast<uchar>(neighbours(at(p.x, p.y)));
-  auto degree = [&](int x, int y) { return deg[at(x, y)]; };
+  for (const Lit& l : lit) deg[l.i] = static_cast<uchar>(neighbours(l.i));
 
   // Owners in a buffer laid out like bin (frame -1); the graph keeps its image part.
   cv::Mat owners(rows + 2, stride, CV_32S);
@@ -286,22 +291,22 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     g.nodes_.push_back(SkeletonNode{kind, {}, {}, {}});
     return static_cast<int>(g.nodes_.size()) - 1;
   };
-  for (const cv::Point& p0 : lit) {
-    const int x = p0.x, y = p0.y;
-    if (degree(x, y) < 3 || owner(x, y) != kNone) continue;
+  std::vector<Lit> stack;
+  for (const Lit& l0 : lit) {
+    if (deg[l0.i] < 3 || owner_at(l0.i) != kNone) continue;
     const int id = new_node(NodeKind::kJunction);
-    std::vector<cv::Point> stack{{x, y}};
-    owner(x, y) = id;
+    stack.assign(1, l0);
+    owner_at(l0.i) = id;
     while (!stack.empty()) {
-      const cv::Point p = stack.back();
+      const Lit l = stack.back();
       stack.pop_back();
-      g.nodes_[id].pixels.push_back(p);
+      g.nodes_[id].pixels.push_back(l.p);
       for (int c = 0; c < 8; ++c) {
-        const int nx = p.x + kCodeDx[c], ny = p.y + kCodeDy[c];
-        if (degree(nx, ny) < 3) continue;  // also outside the image
-        if (owner(nx, ny) != kNone) continue;
-        owner(nx, ny) = id;
-        stack.push_back({nx, ny});
+        const size_t q = neighbour(l.i, c);
+        if (deg[q] < 3) continue;  // also in the frame
+        if (owner_at(q) != kNone) continue;
+        owner_at(q) = id;
+        stack.push_back({q, l.p + CodeStep(c)});
       }
     }
   }
@@ -379,11 +384,11 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
   }
 
   // Line ends.
-  for (const cv::Point& p : lit)
-    if (degree(p.x, p.y) == 1 && owner(p.x, p.y) == kNone) {
+  for (const Lit& l : lit)
+    if (deg[l.i] == 1 && owner_at(l.i) == kNone) {
       const int id = new_node(NodeKind::kEnd);
-      g.nodes_[id].pixels.push_back(p);
-      owner(p.x, p.y) = id;
+      g.nodes_[id].pixels.push_back(l.p);
+      owner_at(l.i) = id;
     }
 
   // Chains between nodes.
@@ -437,12 +442,13 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     // By index: tracing may add nodes (moving nodes_), never pixels of node n.
     for (size_t k = 0; k < g.nodes_[n].pixels.size(); ++k) {
       const cv::Point p = g.nodes_[n].pixels[k];
+      const size_t i = at(p.x, p.y);
       for (int c = 0; c < 8; ++c) {
-        const int nx = p.x + kCodeDx[c], ny = p.y + kCodeDy[c];
-        if (!set(nx, ny)) continue;
-        const int o = owner(nx, ny);
+        const size_t q = neighbour(i, c);
+        if (!bin[q]) continue;
+        const int o = owner_at(q);
         if (o == kNone) {
-          trace_from(n, p, {nx, ny});
+          trace_from(n, p, p + CodeStep(c));
         } else if (o >= 0 && o != n) {
           const auto key = std::minmax(n, o);
           if (direct_links.insert(key).second) {
@@ -456,16 +462,15 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     }
   }
   // Closed chains without any node get an anchor.
-  for (const cv::Point& p0 : lit) {
-    const int x = p0.x, y = p0.y;
-    if (owner(x, y) != kNone || degree(x, y) == 0) continue;
+  for (const Lit& l : lit) {
+    if (owner_at(l.i) != kNone || deg[l.i] == 0) continue;
     const int id = new_node(NodeKind::kAnchor);
-    g.nodes_[id].pixels.push_back({x, y});
-    owner(x, y) = id;
+    g.nodes_[id].pixels.push_back(l.p);
+    owner_at(l.i) = id;
     for (int c = 0; c < 8; ++c) {
-      const int nx = x + kCodeDx[c], ny = y + kCodeDy[c];
-      if (set(nx, ny) && owner(nx, ny) == kNone) {
-        trace_from(id, {x, y}, {nx, ny});
+      const size_t q = neighbour(l.i, c);
+      if (bin[q] && owner_at(q) == kNone) {
+        trace_from(id, l.p, l.p + CodeStep(c));
         break;
       }
     }
