@@ -133,12 +133,18 @@ class SmoothedDerivatives {
     }
     // G'(h) = -h / sigma^2 G(h) = -2 a h G(h).
     double s1 = 0.0, s2 = 0.0;
-    for (int m = 0; m <= 2 * support_; ++m) {
-      const double pj = p_[static_cast<size_t>(std::clamp(first + m, 0, n - 1))];
+    auto add = [&](int m, double pj) {
       const double g0 = g[m], g1 = g[m + 1];
       const double h = h0 - m;
       s1 += pj * (g0 - g1);
       s2 += pj * (h * g0 - (h - 1.0) * g1);
+    };
+    if (first >= 0 && first + 2 * support_ <= n - 1) {  // the usual case: no end replicated
+      const double* p = p_.data() + first;
+      for (int m = 0; m <= 2 * support_; ++m) add(m, p[m]);
+    } else {
+      for (int m = 0; m <= 2 * support_; ++m)
+        add(m, p_[static_cast<size_t>(std::clamp(first + m, 0, n - 1))]);
     }
     *d1 = s1;
     *d2 = -2.0 * a_ * s2;
