@@ -4,6 +4,8 @@
 #include <bit>
 #include <cmath>
 #include <cstdlib>
+#include <iterator>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <optional>
 #include <vector>
@@ -496,7 +498,13 @@ void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions) {
 }
 
 cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel) {
+  // The frame holds -infinity: nothing beyond the image is ever brighter.
   cv::Mat smoothed(grey.rows + 2, grey.cols + 2, CV_32F);
+  const float never = -std::numeric_limits<float>::infinity();
+  smoothed.row(0).setTo(never);
+  smoothed.row(grey.rows + 1).setTo(never);
+  smoothed.col(0).setTo(never);
+  smoothed.col(grey.cols + 1).setTo(never);
   cv::Mat inner = smoothed(cv::Rect(1, 1, grey.cols, grey.rows));
   const int half = static_cast<int>(std::ceil(3.0 * params.sigma));
   if (in_parallel)
@@ -524,9 +532,10 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
   const float min_gain = static_cast<float>(params.min_gain);
   // Near junctions the grey ridge bends towards the branches: keep clear.
   std::vector<std::uint8_t> near_junction(img->data.size(), 0);
+  std::vector<size_t> pixels = img->SetIndices();  // at the start of each pass
   {
     const int c = params.junction_clearance;
-    for (size_t i : img->SetIndices()) {
+    for (size_t i : pixels) {
       if (std::popcount(img->CodeOf(i)) < 3) continue;
       const int x = img->X(i), y = img->Y(i);
       for (int yy = std::max(0, y - c); yy <= std::min(rows - 1, y + c); ++yy)
@@ -535,10 +544,10 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
     }
   }
   std::vector<std::uint8_t> moved(img->data.size(), 0);
+  std::vector<size_t> targets, kept;  // of a pass: the pixels moved to, those still set
   for (int pass = 0; pass < params.passes; ++pass) {
-    const std::vector<size_t> pixels = img->SetIndices();
-    std::fill(moved.begin(), moved.end(), 0);
-    bool any = false;
+    for (size_t t : targets) moved[t] = 0;
+    targets.clear();
     for (size_t pu : pixels) {
       const std::ptrdiff_t p = static_cast<std::ptrdiff_t>(pu);
       if (!set(p) || moved[pu] || near_junction[pu]) continue;
@@ -558,16 +567,15 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
       } else {
         continue;  // a corner
       }
-      const int x = img->X(pu), y = img->Y(pu);
       const float here = f[pu];
       std::ptrdiff_t best = -1;
       float best_value = here + min_gain;
       for (int sign : {-1, 1}) {
         const int dx = sign * sx, dy = sign * sy;  // p -> q
-        if (x + dx < 0 || y + dy < 0 || x + dx >= cols || y + dy >= rows) continue;
         const std::ptrdiff_t q = p + dy * stride + dx;
-        // Not brighter enough (the usual case on a centred skeleton): no
-        // need to look at its neighbourhood.
+        // Not brighter enough (the usual case on a centred skeleton, and
+        // always in the frame beyond the image): no need to look at its
+        // neighbourhood.
         if (set(q) || !(f[q] >= best_value)) continue;
         bool ok = true;
         for (int k : nb) ok = ok && std::abs(kDx[k] - dx) <= 1 && std::abs(kDy[k] - dy) <= 1;
@@ -585,9 +593,19 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
       img->data[pu] = 0;
       img->data[static_cast<size_t>(best)] = 1;
       moved[static_cast<size_t>(best)] = 1;
-      any = true;
+      targets.push_back(static_cast<size_t>(best));
     }
-    if (!any) break;
+    if (targets.empty()) break;
+    // The next pass's pixels in raster order, as SetIndices would list them:
+    // those still set, and those moved to (a pixel moved to is skipped for
+    // the rest of its pass, so it stays set).
+    kept.clear();
+    for (size_t pu : pixels)
+      if (img->data[pu]) kept.push_back(pu);
+    std::sort(targets.begin(), targets.end());
+    pixels.clear();
+    std::set_union(kept.begin(), kept.end(), targets.begin(), targets.end(),
+                   std::back_inserter(pixels));
   }
 }
 
