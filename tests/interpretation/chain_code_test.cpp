@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdlib>
+
 #include "bsls/interpretation/line_fill.h"
 
 namespace bsls::interpretation {
@@ -13,6 +16,14 @@ TEST(ChainCode, CodesRunAnticlockwiseFromPlusX) {
   EXPECT_EQ(DirectionCode(-1, 0), 4);
   EXPECT_EQ(DirectionCode(0, 1), 6);
   EXPECT_EQ(DirectionCode(2, 0), -1);
+  // Every unit step has its code, and nothing else has one.
+  for (int c = 0; c < 8; ++c)
+    EXPECT_EQ(DirectionCode(CodeStep(c).x, CodeStep(c).y), c) << c;
+  for (int dy = -3; dy <= 3; ++dy)
+    for (int dx = -3; dx <= 3; ++dx)
+      if (std::max(std::abs(dx), std::abs(dy)) != 1) {
+        EXPECT_EQ(DirectionCode(dx, dy), -1) << dx << " " << dy;
+      }
 }
 
 TEST(ChainCode, DifferenceCodeFollowsEquation54) {

@@ -1,6 +1,7 @@
 #include "bsls/interpretation/chain_code.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -18,9 +19,14 @@ std::string_view ToString(EndDirection ed) {
 }
 
 int DirectionCode(int dx, int dy) {
-  for (int c = 0; c < 8; ++c)
-    if (kCodeDx[c] == dx && kCodeDy[c] == dy) return c;
-  return -1;
+  // The codes by (dy + 1) * 3 + dx + 1 (rows up, level, down), from kCodeDx / kCodeDy.
+  static constexpr std::array<int, 9> kByStep = [] {
+    std::array<int, 9> t{-1, -1, -1, -1, -1, -1, -1, -1, -1};
+    for (int c = 0; c < 8; ++c) t[static_cast<size_t>((kCodeDy[c] + 1) * 3 + kCodeDx[c] + 1)] = c;
+    return t;
+  }();
+  if (dx < -1 || dx > 1 || dy < -1 || dy > 1) return -1;
+  return kByStep[static_cast<size_t>((dy + 1) * 3 + dx + 1)];
 }
 
 double LeanFromVerticalDeg(cv::Point2d d) {
