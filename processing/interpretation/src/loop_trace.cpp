@@ -34,19 +34,32 @@ LoopRecord TraceLoop(const JunctionNetwork& network, const std::vector<int>& fac
   LoopRecord r;
   r.walk = face;
   r.area2 = g.SignedArea2(face);
-  std::map<int, int> visits;
-  std::vector<cv::Point> pixels;
+  std::vector<int> visited;  // the junctions met so far (a walk meets a handful)
+  // DCS over the walk's pixels, step by step; steps that are not unit moves
+  // (node centres of clusters) are skipped.
+  std::vector<int> codes;
+  bool started = false;
+  cv::Point last;
+  auto walk_to = [&](const cv::Point& q) {
+    if (started) {
+      const cv::Point d = q - last;
+      const int c = DirectionCode(d.x, d.y);
+      if (c >= 0) codes.push_back(InverseCode(c));
+    }
+    started = true;
+    last = q;
+  };
   for (int i = 0; i < static_cast<int>(face.size()); ++i) {
     const int h = face[i];
     const std::vector<cv::Point>& chain = g.edges()[SkeletonGraph::EdgeOf(h)].pixels;
     if (h & 1)  // walked backwards
-      pixels.insert(pixels.end(), chain.rbegin(), chain.rend());
+      for (auto it = chain.rbegin(); it != chain.rend(); ++it) walk_to(*it);
     else
-      pixels.insert(pixels.end(), chain.begin(), chain.end());
+      for (const cv::Point& q : chain) walk_to(q);
     const int node = g.Target(h);
     const SkeletonNode& n = g.nodes()[node];
     const NodeRole& role = network.role(node);
-    pixels.push_back(cv::Point(cvRound(role.centre.x), cvRound(role.centre.y)));
+    walk_to(cv::Point(cvRound(role.centre.x), cvRound(role.centre.y)));
     if (n.kind == NodeKind::kEnd) {
       LoopEvent e;
       e.is_end = true;
@@ -66,17 +79,12 @@ LoopRecord TraceLoop(const JunctionNetwork& network, const std::vector<int>& fac
       e.walk_index = i;
       r.events.push_back(e);
       ++r.n_t;
-      if (visits[node]++ > 0) ++r.repeated;
+      if (std::find(visited.begin(), visited.end(), node) != visited.end())
+        ++r.repeated;
+      else
+        visited.push_back(node);
       if (!IsPatternJunction(e.attribute)) ++r.crossings;
     }
-  }
-  // DCS over the walk's pixels; steps that are not unit moves (node centres of
-  // clusters) are skipped.
-  std::vector<int> codes;
-  for (size_t i = 0; i + 1 < pixels.size(); ++i) {
-    const cv::Point d = pixels[i + 1] - pixels[i];
-    const int c = DirectionCode(d.x, d.y);
-    if (c >= 0) codes.push_back(InverseCode(c));
   }
   r.dcs = DifferenceCodes(codes);
   ClassifyLoop(r);
