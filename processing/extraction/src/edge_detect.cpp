@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <cstdint>
-#include <cstring>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
@@ -263,29 +261,19 @@ cv::Mat KeepComponentsTouching(const cv::Mat& weak, const cv::Mat& strong) {
   const std::ptrdiff_t s = static_cast<std::ptrdiff_t>(img.Stride());
   const std::ptrdiff_t offsets[8] = {-s - 1, -s, -s + 1, -1, 1, s - 1, s, s + 1};
   std::vector<size_t> stack;
-  for (int y = 0; y < strong.rows; ++y) {
-    const unsigned char* sr = strong.ptr<unsigned char>(y);
-    for (int x = 0; x < strong.cols; ++x) {
-      if (x + 8 <= strong.cols) {  // strong pixels are few: skip eight at a time
-        std::uint64_t word;
-        std::memcpy(&word, sr + x, 8);
-        if (!word) {
-          x += 7;  // and 1 by the loop
-          continue;
-        }
-      }
-      if (!sr[x] || img.data[img.Index(x, y)] != 1) continue;
-      stack.assign(1, img.Index(x, y));
-      img.data[stack.back()] = 2;
-      while (!stack.empty()) {
-        const size_t i = stack.back();
-        stack.pop_back();
-        for (std::ptrdiff_t o : offsets) {
-          const size_t q = static_cast<size_t>(static_cast<std::ptrdiff_t>(i) + o);
-          if (img.data[q] != 1) continue;
-          img.data[q] = 2;
-          stack.push_back(q);
-        }
+  // The strong pixels in raster order, by index into a buffer laid out like img's.
+  for (size_t start : PaddedBinary(strong).SetIndices()) {
+    if (img.data[start] != 1) continue;
+    stack.assign(1, start);
+    img.data[start] = 2;
+    while (!stack.empty()) {
+      const size_t i = stack.back();
+      stack.pop_back();
+      for (std::ptrdiff_t o : offsets) {
+        const size_t q = static_cast<size_t>(static_cast<std::ptrdiff_t>(i) + o);
+        if (img.data[q] != 1) continue;
+        img.data[q] = 2;
+        stack.push_back(q);
       }
     }
   }
