@@ -21,7 +21,7 @@ void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params);
 void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions);
 
 // The grey image (CV_8UC1) smoothed as RecentreOnRidge reads it, CV_32FC1 in a
-// buffer laid out like a PaddedBinary of its size (the frame unused): band by
+// buffer laid out like a PaddedBinary of its size, its frame -infinity: band by
 // band on OpenCV's thread pool, or all on the calling thread (the same values).
 cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel);
 
