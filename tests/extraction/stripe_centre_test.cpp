@@ -91,6 +91,7 @@ TEST(StripeCentre, ImageMeasurementEqualsTheWholeProfiles) {
     for (double x0 : {3.2, 28.3, 60.4}) {  // near the left edge, inside, near the right edge
       const cv::Mat image = testing::RenderSlantedStripe({64, 40}, x0, kSlope, width, kPsf,
                                                          kBackground, kContrast, kNoise, 5);
+      const cv::Mat transposed = image.t();
       std::mt19937 rng(static_cast<std::uint32_t>(width * 100 + x0));
       std::uniform_real_distribution<double> offset(-3.0, 3.0);
       for (int y = 0; y < image.rows; ++y) {
@@ -110,7 +111,6 @@ TEST(StripeCentre, ImageMeasurementEqualsTheWholeProfiles) {
           for (double& v : profile) v /= total;
         const auto whole = MeasureStripeProfile(profile, guess - lo, params);
         const auto in_row = StripeCentreInRow(image, y, guess, params);
-        const cv::Mat transposed = image.t();
         const auto in_column = StripeCentreInColumn(transposed, y, guess, params);
         ASSERT_EQ(whole.has_value(), in_row.has_value()) << width << " " << x0 << " " << y;
         ASSERT_EQ(in_row.has_value(), in_column.has_value());
