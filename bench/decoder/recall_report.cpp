@@ -48,6 +48,7 @@ struct Options {
   bool quiet = false;
   bool extra = false;
   std::string crops;  // folder for the crops of missed junctions; empty: none
+  bsls::decoder::DecodeChain chain = bsls::decoder::DecodeParams{}.chain;
 };
 
 struct Totals {
@@ -135,7 +136,9 @@ void Report(SurfaceKind kind, Side side, std::uint32_t seed, const Options& o, T
   const bsls::simulator::Frame frame =
       bsls::simulator::Render(bsls::simulator::ThesisScene(side, kind, options), params);
   const auto t0 = std::chrono::steady_clock::now();
-  const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame.image, side);
+  bsls::decoder::DecodeParams decode;
+  decode.chain = o.chain;
+  const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame.image, side, decode);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const std::string name = std::string(bsls::simulator::ToString(kind)) + " " +
@@ -218,8 +221,14 @@ int main(int argc, char** argv) {
       o.extra = true;
     } else if (a == "--crops" && i + 1 < argc) {
       o.crops = argv[++i];
+    } else if (a == "--chain" && i + 1 < argc && (std::string(argv[i + 1]) == "tracks" ||
+                                                  std::string(argv[i + 1]) == "skeleton")) {
+      o.chain = std::string(argv[++i]) == "tracks" ? bsls::decoder::DecodeChain::kTracks
+                                                   : bsls::decoder::DecodeChain::kSkeleton;
     } else {
-      std::fprintf(stderr, "usage: %s [--seeds N] [--size PX] [--quiet] [--extra] [--crops DIR]\n",
+      std::fprintf(stderr,
+                   "usage: %s [--seeds N] [--size PX] [--quiet] [--extra] [--crops DIR] "
+                   "[--chain tracks|skeleton]\n",
                    argv[0]);
       return 2;
     }

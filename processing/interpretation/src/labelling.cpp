@@ -39,10 +39,7 @@ JunctionKind KindOf(const JunctionNetwork& net, int node) {
 
 // The kind a junction at (p, v) must have; v is relative but keeps its parity.
 bool KindFits(const pattern::PatternSpec& spec, int p, int v, JunctionKind kind) {
-  if (p < 0 || p >= spec.lines) return false;
-  const bool direct_row = ((v - p) % 2) == 0;
-  if (kind == JunctionKind::kDirect) return direct_row && p + 1 < spec.lines;
-  return !direct_row && p >= 1;
+  return pattern::JunctionOnRowParity(spec, p, v) == kind;
 }
 
 double Median(std::vector<double> v) {

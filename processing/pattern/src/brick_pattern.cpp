@@ -43,7 +43,12 @@ double UFromS(Side side, double s) { return side == Side::kLeft ? -s : s; }
 double SFromU(Side side, double u) { return side == Side::kLeft ? -u : u; }
 
 std::optional<JunctionKind> JunctionAt(const PatternSpec& spec, int p, int v) {
-  if (p < 0 || p >= spec.lines || v < -spec.rows || v > spec.rows) return std::nullopt;
+  if (v < -spec.rows || v > spec.rows) return std::nullopt;
+  return JunctionOnRowParity(spec, p, v);
+}
+
+std::optional<JunctionKind> JunctionOnRowParity(const PatternSpec& spec, int p, int v) {
+  if (p < 0 || p >= spec.lines) return std::nullopt;
   // Segment (p, p+1) lies on rows v = p (mod 2): direct on p, corresponding on p+1.
   const bool direct_row = IsEven(v - p);
   if (direct_row) {

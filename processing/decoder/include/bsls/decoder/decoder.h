@@ -35,13 +35,47 @@
 #include "bsls/extraction/feature_extraction.h"
 #include "bsls/extraction/stripe_centre.h"
 #include "bsls/extraction/stripe_pitch.h"
+#include "bsls/extraction/ridge_points.h"
 #include "bsls/interpretation/interpreter.h"
+#include "bsls/interpretation/ridge_tracks.h"
+#include "bsls/interpretation/track_labelling.h"
 #include "bsls/pattern/brick_pattern.h"
 
 namespace bsls::decoder {
 
+// Which chain of stages turns the frame into labelled junctions.
+enum class DecodeChain {
+  // Feature extraction to a one-pixel skeleton (thesis chapter 4) and its
+  // interpretation as a pixel graph (chapter 5): boundary and loop tracing,
+  // repair, labelling.
+  kSkeleton,
+  // Ridge points along rows and columns linked into line and segment tracks,
+  // junctions where a segment's end meets a line, labels spread through them
+  // (docs/decoding.md, "The track chain").
+  kTracks,
+};
+
+// The track chain's own stages (DecodeChain::kTracks).
+struct TrackChainParams {
+  double smoothing_sigma = 1.0;  // px, Gaussian applied before the ridge points, > 0
+  extraction::RidgeParams ridge;
+  interpretation::TrackParams tracks;
+  interpretation::TrackLabellingParams labelling;
+  // Rows each side of a line centre whose centres judge it (an outlier beyond
+  // max_centre_residual is dropped) and refill the rows skipped beside a
+  // junction, >= 1.
+  int centre_fit_rows = 5;
+  // Columns of a segment measured next to its junction to place it, >= 2.
+  int segment_columns = 10;
+
+  // True when every part is usable; otherwise says which and why.
+  bool IsValid(std::string* error) const;
+};
+
 struct DecodeParams {
   pattern::PatternSpec spec;
+  DecodeChain chain = DecodeChain::kSkeleton;
+  TrackChainParams track_chain;
   extraction::ExtractionParams extraction;
   interpretation::InterpretationParams interpretation;
   // Pixel lengths below and in `centre` are for the working resolution (see

@@ -85,6 +85,15 @@ std::optional<double> StripeCentreInRow(const cv::Mat& image, int y, double appr
 std::optional<double> StripeCentreInColumn(const cv::Mat& image, int x, double approximate_y,
                                            const StripeCentreParams& params = {});
 
+// Sub-pixel x of a (roughly vertical) stripe crossing row y within 2 px of
+// x = approximate_x, by a cheaper measure than StripeCentreInRow for the
+// track chain (docs/decoding.md, "The track chain"): rows y-1, y, y+1
+// weighted 1-2-1, smoothed by a 5-tap binomial (sigma 1 px), and the zero of
+// its first difference at the brightest smoothed pixel, interpolated
+// linearly. Nullopt within 9 px of the image's left or right edge or where
+// that pixel is no peak.
+std::optional<double> RidgeCentreInRow(const cv::Mat& image, int y, double approximate_x);
+
 // Sub-pixel x of (roughly vertical) stripes crossing row y close together,
 // near approximate_x (ascending): one pixel-integrated Gaussian per stripe
 // on a linear ground, fitted jointly (Levenberg-Marquardt) over the stripes

@@ -65,6 +65,9 @@ double SFromU(Side side, double u);
 // The kind of the junction at (p, v), or nullopt when the pattern has none
 // there (outside the pattern, or line 0 on an odd row).
 std::optional<JunctionKind> JunctionAt(const PatternSpec& spec, int p, int v);
+// The same for a row v known only up to an even offset (a relative label,
+// contracts section 2): only v's parity is used, not its range.
+std::optional<JunctionKind> JunctionOnRowParity(const PatternSpec& spec, int p, int v);
 
 // Every junction of the brick pattern, ordered by p then v.
 std::vector<SlideJunction> AllJunctions(const PatternSpec& spec);

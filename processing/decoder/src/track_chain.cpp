@@ -1,0 +1,222 @@
+#include "track_chain.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "bsls/extraction/stripe_centre.h"
+#include "curve_fit.h"
+
+namespace bsls::decoder::internal {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MsSince(Clock::time_point t) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+}
+
+// The sub-pixel centres of one line track, by row (NaN where none).
+struct TrackCentres {
+  int first_row = 0;
+  std::vector<double> measured;  // centres measured and kept
+  std::vector<double> output;    // measured, or refilled between measured ones
+
+  double Measured(int y) const {
+    const int i = y - first_row;
+    return i >= 0 && i < static_cast<int>(measured.size()) ? measured[i] : NAN;
+  }
+};
+
+// (t = row - y, centre) samples of the measured centres within `reach` rows of y.
+Samples MeasuredNear(const TrackCentres& c, int y, int reach, bool skip_own) {
+  Samples s;
+  for (int r = y - reach; r <= y + reach; ++r) {
+    if (skip_own && r == y) continue;
+    const double x = c.Measured(r);
+    if (!std::isnan(x)) s.emplace_back(r - y, x);
+  }
+  return s;
+}
+
+// The centres of line track `t`: measured in each row clear of the track's
+// junctions, outliers against their neighbours' fit dropped, and the rows
+// beside junctions refilled from the centres on both sides.
+TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwork& net, int t,
+                          const DecodeParams& params) {
+  const auto& pts = net.lines[t].points;
+  const auto& rp = net.rows.points;
+  TrackCentres c;
+  c.first_row = rp[pts.front()].y;
+  const int n = static_cast<int>(pts.size());
+  c.measured.assign(n, NAN);
+  const int clearance = params.junction_clearance;
+  std::vector<char> beside_junction(n, 0);
+  for (int j : net.junctions_on_line[t]) {
+    const int jy = static_cast<int>(std::lround(net.junctions[j].position.y));
+    for (int y = jy - clearance; y <= jy + clearance; ++y)
+      if (y - c.first_row >= 0 && y - c.first_row < n) beside_junction[y - c.first_row] = 1;
+  }
+  for (int i = 0; i < n; ++i) {
+    if (beside_junction[i]) continue;
+    const extraction::RidgePoint& p = rp[pts[i]];
+    if (auto x = extraction::RidgeCentreInRow(grey, p.y, p.x)) c.measured[i] = *x;
+  }
+  // Outliers: a centre further than max_centre_residual from its neighbours' fit.
+  const int reach = params.track_chain.centre_fit_rows;
+  std::vector<int> drop;
+  for (int i = 0; i < n; ++i) {
+    if (std::isnan(c.measured[i])) continue;
+    const Samples near = MeasuredNear(c, c.first_row + i, reach, true);
+    if (near.size() < 3) continue;
+    if (auto fit = FitAtZero(near); fit && std::abs(*fit - c.measured[i]) > params.max_centre_residual)
+      drop.push_back(i);
+  }
+  for (int i : drop) c.measured[i] = NAN;
+  // Refill: rows without a centre, from measured centres on both sides.
+  c.output = c.measured;
+  for (int i = 0; i < n; ++i) {
+    if (!std::isnan(c.output[i])) continue;
+    const Samples near = MeasuredNear(c, c.first_row + i, reach + clearance, false);
+    const bool above = std::any_of(near.begin(), near.end(), [](const auto& s) { return s.first < 0; });
+    const bool below = std::any_of(near.begin(), near.end(), [](const auto& s) { return s.first > 0; });
+    if (!above || !below) continue;
+    if (auto fit = FitAtZero(near)) c.output[i] = *fit;
+  }
+  return c;
+}
+
+// Where junction j lies: the segment's centres near the line fitted as a
+// straight line y(x) and met with the line's centres fitted as x(y).
+cv::Point2d PlaceJunction(const cv::Mat& grey_t, const interpretation::TrackNetwork& net, int j,
+                          const TrackCentres& line, const DecodeParams& params) {
+  const interpretation::TrackJunction& junction = net.junctions[j];
+  cv::Point2d at = junction.position;
+  const int fit_rows = params.junction_fit_rows;
+  auto line_x = [&](double y) -> std::optional<double> {
+    const int row = static_cast<int>(std::lround(y));
+    Samples near = MeasuredNear(line, row, fit_rows, false);
+    for (auto& s : near) s.first -= y - row;  // t relative to y itself
+    if (near.size() < 2) return std::nullopt;
+    return FitAtZero(near);
+  };
+  if (auto x = line_x(at.y)) at.x = *x;
+  // The segment's columns nearest the line, clear of its light.
+  const auto& seg = net.segments[junction.segment].points;
+  const auto& cp = net.columns.points;  // x: image row, y: image column
+  Samples columns;
+  const int clearance = params.junction_clearance;
+  auto take = [&](int k) {
+    const extraction::RidgePoint& p = cp[k];
+    if (std::abs(p.y - at.x) <= clearance) return;
+    if (auto y = extraction::RidgeCentreInRow(grey_t, p.y, p.x))
+      columns.emplace_back(p.y - at.x, *y);
+  };
+  const int want = params.track_chain.segment_columns;
+  if (junction.segment_left) {
+    for (int i = static_cast<int>(seg.size()) - 1; i >= 0 && static_cast<int>(columns.size()) < want; --i)
+      take(seg[i]);
+  } else {
+    for (size_t i = 0; i < seg.size() && static_cast<int>(columns.size()) < want; ++i) take(seg[i]);
+  }
+  double a, b;
+  if (!FitLine(columns, &a, &b)) return at;
+  at.y = a;
+  if (auto x = line_x(at.y)) {
+    // Once more at the line's x there.
+    at.y = a + b * (*x - at.x);
+    at.x = *x;
+  }
+  return at;
+}
+
+}  // namespace
+
+void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
+                    DecodeResult* result) {
+  const TrackChainParams& tp = params.track_chain;
+  auto t = Clock::now();
+  cv::Mat smoothed, smoothed_t, grey_t;
+  cv::GaussianBlur(grey, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
+                   cv::BORDER_REPLICATE);
+  cv::transpose(smoothed, smoothed_t);
+  cv::transpose(grey, grey_t);
+  extraction::RidgePoints rows = extraction::FindRidgePoints(smoothed, tp.ridge);
+  extraction::RidgePoints columns = extraction::FindRidgePoints(smoothed_t, tp.ridge);
+  result->times.extraction_ms = MsSince(t);
+
+  t = Clock::now();
+  const interpretation::TrackNetwork net =
+      interpretation::BuildTrackNetwork(std::move(rows), std::move(columns), side, tp.tracks);
+  const interpretation::TrackLabels labels =
+      interpretation::LabelTracks(net, side, params.spec, tp.labelling);
+  result->times.interpretation_ms = MsSince(t);
+  result->label_conflicts = labels.conflicts;
+  if (!labels.ok) {
+    result->error = labels.error;
+    return;
+  }
+
+  t = Clock::now();
+  // Centres of every labelled line track, in parallel.
+  std::vector<int> labelled;
+  for (size_t i = 0; i < net.lines.size(); ++i)
+    if (labels.line_p[i] >= 0) labelled.push_back(static_cast<int>(i));
+  std::vector<TrackCentres> centres(net.lines.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(labelled.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i)
+      centres[labelled[i]] = MeasureTrack(grey, net, labelled[i], params);
+  });
+
+  // Junctions: one per label; where two claim one, the one on a track of
+  // its own p (then the first) keeps it.
+  const int q_offset = params.q_offset.value_or(0);
+  std::map<std::pair<int, int>, int> by_label;
+  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j) {
+    if (labels.p[j] == interpretation::kUnlabelled) continue;
+    const auto key = std::make_pair(labels.p[j], labels.v[j]);
+    const auto [it, fresh] = by_label.emplace(key, j);
+    if (fresh) continue;
+    ++result->label_conflicts;
+    const bool mine = labels.line_p[net.junctions[j].line] == labels.p[j];
+    const bool theirs = labels.line_p[net.junctions[it->second].line] == labels.p[it->second];
+    if (mine && !theirs) it->second = j;
+  }
+  std::vector<int> placed;
+  for (const auto& [key, j] : by_label) placed.push_back(j);
+  result->junctions.resize(placed.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(placed.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const int j = placed[i];
+      DecodedJunction& d = result->junctions[i];
+      d.p = labels.p[j];
+      d.q = labels.v[j] + q_offset;
+      d.kind = net.junctions[j].kind;
+      d.position = PlaceJunction(grey_t, net, j, centres[net.junctions[j].line], params);
+    }
+  });
+
+  // Lines: the centres of all tracks of one p, one per row.
+  std::map<int, std::map<int, double>> by_line;
+  for (int i : labelled) {
+    const TrackCentres& c = centres[i];
+    auto& rows_of_line = by_line[labels.line_p[i]];
+    for (size_t k = 0; k < c.output.size(); ++k)
+      if (!std::isnan(c.output[k])) rows_of_line.emplace(c.first_row + static_cast<int>(k), c.output[k]);
+  }
+  for (const auto& [p, rows_of_line] : by_line) {
+    DecodedLine line;
+    line.p = p;
+    for (const auto& [y, x] : rows_of_line) line.points.emplace_back(x, y);
+    if (!line.points.empty()) result->lines.push_back(std::move(line));
+  }
+  result->times.subpixel_ms = MsSince(t);
+  result->ok = true;
+}
+
+}  // namespace bsls::decoder::internal

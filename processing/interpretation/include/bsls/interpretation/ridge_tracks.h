@@ -1,0 +1,84 @@
+// The track network: ridge points (extraction/ridge_points.h) linked into
+// the pattern's vertical lines and horizontal segments, and the T-junctions
+// where a segment's end meets a line (thesis 5.1.4: direct when the segment
+// leaves towards p + 1, corresponding when it comes from p - 1).
+//
+// Not the thesis's skeleton tracing (5.2): the lines come as tracks of one
+// ridge point per row, the segments as tracks of one per column, so a
+// junction is read off where a segment track ends beside a line track
+// instead of being classified from a pixel graph. Where the light of a line
+// and a segment overlaps, both tracks usually run on through the junction;
+// where it does not, a segment's end stops a few pixels short of its line.
+// Either way the end lies within `end_reach` of the line.
+//
+// Image coordinates: x right, y down, pixels.
+//
+// Thread-safety: pure functions of their arguments.
+#ifndef BSLS_INTERPRETATION_RIDGE_TRACKS_H_
+#define BSLS_INTERPRETATION_RIDGE_TRACKS_H_
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "bsls/extraction/ridge_points.h"
+#include "bsls/pattern/brick_pattern.h"
+
+namespace bsls::interpretation {
+
+struct TrackParams {
+  // px: a ridge point links to the nearest point of the next row within
+  // this (the steepest line followed: about 50 degrees from the vertical), > 0.
+  double max_step = 1.2;
+  int min_track = 4;    // points: shorter tracks are noise, >= 1
+  int min_segment = 3;  // points of a segment track that make junctions, >= 1
+  // px: a segment's end meets a line whose ridge point lies this close to
+  // it in the end's row (or the rows either side), > 0.
+  double end_reach = 6.0;
+
+  // True when the values are usable; otherwise says why.
+  bool IsValid(std::string* error) const;
+};
+
+// Ridge points linked from row to row: indices into RidgePoints::points,
+// one per row, in increasing row order.
+struct Track {
+  std::vector<int> points;
+};
+
+struct TrackJunction {
+  int line = -1;     // the vertical line's track
+  int segment = -1;  // the segment's track
+  bool segment_left = false;  // the segment lies to the left of the line in the image
+  pattern::JunctionKind kind = pattern::JunctionKind::kDirect;
+  cv::Point2d position;  // the line's ridge point in the row where the segment's end meets it
+};
+
+struct TrackNetwork {
+  extraction::RidgePoints rows;     // ridge points along the rows: the lines' crossings
+  // Ridge points along the columns, found on the transposed image: a point's
+  // x is an image row, its y an image column.
+  extraction::RidgePoints columns;
+  std::vector<Track> lines;     // tracks through `rows`
+  std::vector<Track> segments;  // tracks through `columns`
+  std::vector<int> line_of_point;  // for each point of `rows`: its line track, or -1
+  std::vector<TrackJunction> junctions;
+  std::vector<std::vector<int>> junctions_on_line;  // per line track: its junctions by increasing y
+};
+
+// Links ridge points from row to row into tracks: each point to the nearest
+// point of the next row within max_step, each point taken at most once (by
+// the nearer claimant); tracks shorter than min_track are dropped.
+// `track_of_point` (optional) receives each point's track or -1.
+std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const TrackParams& params,
+                              std::vector<int>* track_of_point = nullptr);
+
+// Links both sets of ridge points and finds the junctions of the brick
+// slide of `side`. Throws std::invalid_argument for invalid params.
+TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePoints columns,
+                               pattern::Side side, const TrackParams& params = {});
+
+}  // namespace bsls::interpretation
+
+#endif  // BSLS_INTERPRETATION_RIDGE_TRACKS_H_

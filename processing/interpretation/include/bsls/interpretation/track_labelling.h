@@ -1,0 +1,76 @@
+// Labelling of thesis 5.1.4.9 on the track network (ridge_tracks.h): line 0
+// is found (5.2.1), its junctions are numbered along it, and labels spread
+// from them along lines (v changes by one row per junction, the kinds
+// alternating) and across segments (p changes by one, v stays).
+//
+// Line 0 is the lit line on the unlit side of the pattern: the "moving
+// column" of 5.2.1 swept in from that side stops on it in each row, so a
+// line track that is outermost in most of its rows and carries direct
+// junctions only (its segments all leave towards p = 1) is part of line 0.
+// A break in a line or a lost segment does not stop the labels: every
+// junction is reached through its brick's other junctions, which is what
+// the thesis's repairs (5.1.4.3-5.1.4.8) restore the paths for.
+//
+// A label must agree with the junction's kind (a direct junction on line p
+// lies on a row v = p mod 2); a junction whose neighbours mostly disagree
+// with it is dropped rather than guessed. v is relative: line 0's junction
+// nearest the image's centre row gets v = 0 (thesis point O).
+//
+// Image coordinates: x right, y down.
+//
+// Thread-safety: pure function of its arguments.
+#ifndef BSLS_INTERPRETATION_TRACK_LABELLING_H_
+#define BSLS_INTERPRETATION_TRACK_LABELLING_H_
+
+#include <climits>
+#include <string>
+#include <vector>
+
+#include "bsls/interpretation/ridge_tracks.h"
+#include "bsls/pattern/brick_pattern.h"
+
+namespace bsls::interpretation {
+
+struct TrackLabellingParams {
+  // A line track is part of line 0 when it is the outermost on the unlit
+  // side in at least this fraction of its rows, (0, 1],
+  double reference_share = 0.5;
+  // carries at least this many direct junctions, >= 1,
+  int min_reference_junctions = 2;
+  // and at most this fraction of corresponding ones, [0, 1].
+  double max_inner_fraction = 0.2;
+  // A step along a line between junctions must fit a whole number of rows
+  // (odd when their kinds alternate, even otherwise) to within this fraction
+  // of a row, (0, 0.5]; at most max_rows rows, >= 1.
+  double max_row_miss = 0.45;
+  int max_rows = 8;
+  // Spacing samples a line track needs to judge its steps by its own row
+  // spacing instead of the frame's, >= 1.
+  int min_own_spacings = 3;
+
+  // True when the values are usable; otherwise says why.
+  bool IsValid(std::string* error) const;
+};
+
+constexpr int kUnlabelled = INT_MIN;
+
+struct TrackLabels {
+  bool ok = false;
+  std::string error;     // why nothing could be labelled (ok == false)
+  std::vector<int> p;    // per junction of the network: its line, or kUnlabelled
+  std::vector<int> v;    // per junction: its slide row (relative), or kUnlabelled
+  std::vector<int> line_p;  // per line track: the p most of its labelled junctions carry, or -1
+  std::vector<int> reference;  // the line tracks taken for line 0
+  int conflicts = 0;     // labels dropped because their neighbours disagreed
+};
+
+// Labels the junctions and line tracks of `network` for the brick slide of
+// `side`. Fails (ok == false, with the reason) when no line 0 carrying
+// enough direct junctions is found. Throws std::invalid_argument for invalid
+// params.
+TrackLabels LabelTracks(const TrackNetwork& network, pattern::Side side,
+                        const pattern::PatternSpec& spec, const TrackLabellingParams& params = {});
+
+}  // namespace bsls::interpretation
+
+#endif  // BSLS_INTERPRETATION_TRACK_LABELLING_H_

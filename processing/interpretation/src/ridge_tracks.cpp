@@ -1,0 +1,129 @@
+#include "bsls/interpretation/ridge_tracks.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace bsls::interpretation {
+
+bool TrackParams::IsValid(std::string* error) const {
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!(max_step > 0)) return fail("max_step must be positive");
+  if (min_track < 1) return fail("min_track must be at least 1");
+  if (min_segment < 1) return fail("min_segment must be at least 1");
+  if (!(end_reach > 0)) return fail("end_reach must be positive");
+  return true;
+}
+
+std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const TrackParams& params,
+                              std::vector<int>* track_of_point) {
+  const auto& pts = points.points;
+  const int n = static_cast<int>(pts.size());
+  std::vector<int> next(n, -1), prev(n, -1);
+  const int rows = static_cast<int>(points.row_start.size()) - 1;
+  const float reach = static_cast<float>(params.max_step);
+  for (int y = 0; y + 1 < rows; ++y) {
+    const int below_end = points.row_start[y + 2];
+    int j = points.row_start[y + 1];  // both rows run left to right
+    for (int i = points.row_start[y]; i < points.row_start[y + 1]; ++i) {
+      const float x = pts[i].x;
+      while (j < below_end && pts[j].x < x - reach) ++j;
+      int best = -1;
+      float best_d = reach;
+      for (int k = j; k < below_end && pts[k].x <= x + reach; ++k) {
+        const float d = std::abs(pts[k].x - x);
+        if (best < 0 || d < best_d) {
+          best = k;
+          best_d = d;
+        }
+      }
+      if (best < 0) continue;
+      if (prev[best] >= 0) {
+        // Claimed already: the nearer claimant keeps it.
+        if (std::abs(pts[prev[best]].x - pts[best].x) <= best_d) continue;
+        next[prev[best]] = -1;
+      }
+      prev[best] = i;
+      next[i] = best;
+    }
+  }
+  std::vector<Track> tracks;
+  if (track_of_point) track_of_point->assign(n, -1);
+  for (int i = 0; i < n; ++i) {
+    if (prev[i] >= 0) continue;
+    Track t;
+    for (int k = i; k >= 0; k = next[k]) t.points.push_back(k);
+    if (static_cast<int>(t.points.size()) < params.min_track) continue;
+    if (track_of_point)
+      for (int k : t.points) (*track_of_point)[k] = static_cast<int>(tracks.size());
+    tracks.push_back(std::move(t));
+  }
+  return tracks;
+}
+
+TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePoints columns,
+                               pattern::Side side, const TrackParams& params) {
+  std::string why;
+  if (!params.IsValid(&why)) throw std::invalid_argument("BuildTrackNetwork: " + why);
+  TrackNetwork net;
+  net.rows = std::move(rows);
+  net.columns = std::move(columns);
+  net.lines = LinkTracks(net.rows, params, &net.line_of_point);
+  net.segments = LinkTracks(net.columns, params);
+
+  // The line point of row y within [lo, hi] nearest to `at`, or -1.
+  auto line_point = [&](int y, double lo, double hi, double at) {
+    int best = -1;
+    const auto row = net.rows.Row(y);
+    for (size_t k = 0; k < row.size(); ++k) {
+      const int i = net.rows.row_start[y] + static_cast<int>(k);
+      if (net.line_of_point[i] < 0 || row[k].x < lo || row[k].x > hi) continue;
+      if (best < 0 || std::abs(row[k].x - at) < std::abs(net.rows.points[best].x - at)) best = i;
+    }
+    return best;
+  };
+  const int towards_p = pattern::ImageDirectionOfIncreasingP(side);
+  const auto& cp = net.columns.points;  // x: image row, y: image column
+  for (int s = 0; s < static_cast<int>(net.segments.size()); ++s) {
+    const std::vector<int>& t = net.segments[s].points;
+    if (static_cast<int>(t.size()) < params.min_segment) continue;
+    // The segment's middle column: each end looks for its line on its own
+    // half, so that a short segment's two ends find their two lines.
+    const double middle = 0.5 * (cp[t.front()].y + cp[t.back()].y);
+    for (const bool left_end : {true, false}) {
+      const extraction::RidgePoint& end = cp[left_end ? t.front() : t.back()];
+      const double ex = end.y, ey = end.x;
+      const double lo = left_end ? ex - params.end_reach : std::max(ex - params.end_reach, middle);
+      const double hi = left_end ? std::min(ex + params.end_reach, middle) : ex + params.end_reach;
+      int hit = -1;
+      for (const int dy : {0, -1, 1}) {
+        hit = line_point(static_cast<int>(std::lround(ey)) + dy, lo, hi, ex);
+        if (hit >= 0) break;
+      }
+      if (hit < 0) continue;
+      TrackJunction j;
+      j.line = net.line_of_point[hit];
+      j.segment = s;
+      // The left end meets the line on its left: the segment lies to its right.
+      j.segment_left = !left_end;
+      const int segment_direction = j.segment_left ? -1 : +1;
+      j.kind = segment_direction == towards_p ? pattern::JunctionKind::kDirect
+                                              : pattern::JunctionKind::kCorresponding;
+      j.position = {net.rows.points[hit].x, static_cast<double>(net.rows.points[hit].y)};
+      net.junctions.push_back(j);
+    }
+  }
+  net.junctions_on_line.assign(net.lines.size(), {});
+  for (int i = 0; i < static_cast<int>(net.junctions.size()); ++i)
+    net.junctions_on_line[net.junctions[i].line].push_back(i);
+  for (auto& on_line : net.junctions_on_line)
+    std::sort(on_line.begin(), on_line.end(), [&](int a, int b) {
+      return net.junctions[a].position.y < net.junctions[b].position.y;
+    });
+  return net;
+}
+
+}  // namespace bsls::interpretation

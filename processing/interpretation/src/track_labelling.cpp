@@ -1,0 +1,248 @@
+#include "bsls/interpretation/track_labelling.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <queue>
+#include <stdexcept>
+#include <tuple>
+
+namespace bsls::interpretation {
+namespace {
+
+using pattern::JunctionKind;
+
+struct Link {
+  int to = -1;
+  int dp = 0;
+  int dv = 0;
+  double weight = 1.0;
+};
+
+constexpr double kOneRow = 1.0;      // a step of one or two rows along a line, or a segment
+constexpr double kPerLongRow = 10.0;  // per row of a longer step: over a gap, only when no
+                                      // path of single steps reaches the junction
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// The row spacing along a line: the dy of a step between junctions of
+// alternating kinds, half of one between junctions of the same kind.
+double RowSpacing(const TrackJunction& a, const TrackJunction& b) {
+  const double dy = b.position.y - a.position.y;
+  return a.kind != b.kind ? dy : dy / 2.0;
+}
+
+// Thesis 5.2.1: the line tracks the moving column from the unlit side stops
+// on in most of their rows, carrying direct junctions only.
+std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
+                                 const TrackLabellingParams& params) {
+  const int towards_p = pattern::ImageDirectionOfIncreasingP(side);
+  std::vector<int> outermost(net.lines.size(), 0);
+  const int rows = static_cast<int>(net.rows.row_start.size()) - 1;
+  for (int y = 0; y < rows; ++y) {
+    int best = -1;
+    for (int i = net.rows.row_start[y]; i < net.rows.row_start[y + 1]; ++i) {
+      if (net.line_of_point[i] < 0) continue;
+      // The unlit side lies opposite to increasing p.
+      if (best < 0 || (net.rows.points[i].x - net.rows.points[best].x) * towards_p < 0) best = i;
+    }
+    if (best >= 0) ++outermost[net.line_of_point[best]];
+  }
+  std::vector<int> reference;
+  for (int t = 0; t < static_cast<int>(net.lines.size()); ++t) {
+    if (outermost[t] < params.reference_share * static_cast<double>(net.lines[t].points.size()))
+      continue;
+    int direct = 0, corresponding = 0;
+    for (int j : net.junctions_on_line[t])
+      ++(net.junctions[j].kind == JunctionKind::kDirect ? direct : corresponding);
+    if (direct < params.min_reference_junctions ||
+        corresponding > params.max_inner_fraction * (direct + corresponding))
+      continue;
+    reference.push_back(t);
+  }
+  return reference;
+}
+
+}  // namespace
+
+bool TrackLabellingParams::IsValid(std::string* error) const {
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (!(reference_share > 0 && reference_share <= 1))
+    return fail("reference_share must lie in (0, 1]");
+  if (min_reference_junctions < 1) return fail("min_reference_junctions must be at least 1");
+  if (!(max_inner_fraction >= 0 && max_inner_fraction <= 1))
+    return fail("max_inner_fraction must lie in [0, 1]");
+  if (!(max_row_miss > 0 && max_row_miss <= 0.5)) return fail("max_row_miss must lie in (0, 0.5]");
+  if (max_rows < 1) return fail("max_rows must be at least 1");
+  if (min_own_spacings < 1) return fail("min_own_spacings must be at least 1");
+  return true;
+}
+
+// Thesis 5.1.4.9: labelling, on the track network.
+TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
+                        const pattern::PatternSpec& spec, const TrackLabellingParams& params) {
+  std::string invalid;
+  if (!params.IsValid(&invalid)) throw std::invalid_argument("LabelTracks: " + invalid);
+  const int n = static_cast<int>(net.junctions.size());
+  TrackLabels out;
+  out.p.assign(n, kUnlabelled);
+  out.v.assign(n, kUnlabelled);
+  out.line_p.assign(net.lines.size(), -1);
+
+  // Row spacing: each line's own where it has enough steps, else the frame's.
+  std::vector<double> all_spacing;
+  std::vector<double> own_spacing(net.lines.size(), 0.0);
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    const std::vector<int>& on = net.junctions_on_line[t];
+    std::vector<double> samples;
+    for (size_t i = 1; i < on.size(); ++i)
+      samples.push_back(RowSpacing(net.junctions[on[i - 1]], net.junctions[on[i]]));
+    all_spacing.insert(all_spacing.end(), samples.begin(), samples.end());
+    if (static_cast<int>(samples.size()) >= params.min_own_spacings)
+      own_spacing[t] = Median(samples);
+  }
+  const double frame_spacing = Median(all_spacing);
+
+  // Links along lines: consecutive junctions of a track, a whole number of rows apart.
+  std::vector<std::vector<Link>> adj(n);
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    const std::vector<int>& on = net.junctions_on_line[t];
+    const double s = own_spacing[t] > 0 ? own_spacing[t] : frame_spacing;
+    if (!(s > 0)) continue;
+    for (size_t i = 1; i < on.size(); ++i) {
+      const TrackJunction& a = net.junctions[on[i - 1]];
+      const TrackJunction& b = net.junctions[on[i]];
+      const double dy = b.position.y - a.position.y;
+      const int first = a.kind != b.kind ? 1 : 2;
+      int rows = first;
+      double miss = std::numeric_limits<double>::infinity();
+      for (int r = first; r <= params.max_rows; r += 2)
+        if (std::abs(dy - r * s) < miss) {
+          miss = std::abs(dy - r * s);
+          rows = r;
+        }
+      // A step that fits no whole number of rows of its parity joins a false
+      // junction (a segment's end on the wrong line): no link.
+      if (miss > params.max_row_miss * s) continue;
+      const double w = rows <= 2 ? kOneRow : kPerLongRow * rows;
+      adj[on[i - 1]].push_back({on[i], 0, rows, w});
+      adj[on[i]].push_back({on[i - 1], 0, -rows, w});
+    }
+  }
+  // Links across segments: a segment with a direct junction at one end and
+  // a corresponding one at the other joins lines p and p + 1.
+  std::map<int, std::pair<int, int>> ends;  // segment -> (direct, corresponding)
+  for (int j = 0; j < n; ++j) {
+    auto& e = ends.try_emplace(net.junctions[j].segment, -1, -1).first->second;
+    (net.junctions[j].kind == JunctionKind::kDirect ? e.first : e.second) = j;
+  }
+  for (const auto& [segment, e] : ends) {
+    if (e.first < 0 || e.second < 0) continue;
+    adj[e.first].push_back({e.second, +1, 0, kOneRow});
+    adj[e.second].push_back({e.first, -1, 0, kOneRow});
+  }
+
+  // Seeds: line 0's direct junctions in order down the image, two rows per
+  // step of their spacing.
+  out.reference = ReferenceTracks(net, side, params);
+  std::vector<int> seeds;
+  for (int t : out.reference)
+    for (int j : net.junctions_on_line[t])
+      if (net.junctions[j].kind == JunctionKind::kDirect) seeds.push_back(j);
+  if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
+    out.error = out.reference.empty()
+                    ? "no reference line (line 0) found"
+                    : "line 0 carries " + std::to_string(seeds.size()) + " junctions";
+    return out;
+  }
+  std::sort(seeds.begin(), seeds.end(), [&](int a, int b) {
+    return net.junctions[a].position.y < net.junctions[b].position.y;
+  });
+  std::vector<int> seed_v{0};
+  for (size_t i = 1; i < seeds.size(); ++i) {
+    const double gap = net.junctions[seeds[i]].position.y - net.junctions[seeds[i - 1]].position.y;
+    const double s = own_spacing[net.junctions[seeds[i]].line] > 0
+                         ? own_spacing[net.junctions[seeds[i]].line]
+                         : frame_spacing;
+    seed_v.push_back(seed_v.back() + 2 * std::max(1, static_cast<int>(std::lround(gap / (2 * s)))));
+  }
+
+  // Propagation, cheapest paths first (Dijkstra over the link weights).
+  std::vector<double> cost(n, std::numeric_limits<double>::infinity());
+  std::vector<char> done(n, 0);
+  using Item = std::tuple<double, int, int, int>;  // cost, junction, p, v
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    cost[seeds[i]] = 0;
+    queue.push({0.0, seeds[i], 0, seed_v[i]});
+  }
+  while (!queue.empty()) {
+    const auto [c, j, p, v] = queue.top();
+    queue.pop();
+    if (done[j]) continue;
+    done[j] = 1;
+    out.p[j] = p;
+    out.v[j] = v;
+    for (const Link& l : adj[j]) {
+      if (done[l.to]) continue;
+      const int np = p + l.dp, nv = v + l.dv;
+      if (pattern::JunctionOnRowParity(spec, np, nv) != net.junctions[l.to].kind) continue;
+      if (c + l.weight < cost[l.to]) {
+        cost[l.to] = c + l.weight;
+        queue.push({c + l.weight, l.to, np, nv});
+      }
+    }
+  }
+
+  // A label most of whose neighbours disagree is dropped, not guessed.
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int> drop;
+    for (int j = 0; j < n; ++j) {
+      if (out.p[j] == kUnlabelled) continue;
+      int agree = 0, disagree = 0;
+      for (const Link& l : adj[j]) {
+        if (out.p[l.to] == kUnlabelled) continue;
+        const bool same = out.p[l.to] == out.p[j] + l.dp && out.v[l.to] == out.v[j] + l.dv;
+        ++(same ? agree : disagree);
+      }
+      if (disagree >= 2 && disagree > agree) drop.push_back(j);
+    }
+    for (int j : drop) out.p[j] = out.v[j] = kUnlabelled;
+    out.conflicts += static_cast<int>(drop.size());
+  }
+
+  // Thesis point O: line 0's junction nearest the centre row is v = 0.
+  const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
+  int origin_v = 0;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int s : seeds)
+    if (out.p[s] == 0 && std::abs(net.junctions[s].position.y - centre_row) < nearest) {
+      nearest = std::abs(net.junctions[s].position.y - centre_row);
+      origin_v = out.v[s];
+    }
+  for (int j = 0; j < n; ++j)
+    if (out.v[j] != kUnlabelled) out.v[j] -= origin_v;
+
+  // Each line track takes the p most of its labelled junctions carry.
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    std::map<int, int> votes;
+    for (int j : net.junctions_on_line[t])
+      if (out.p[j] != kUnlabelled) ++votes[out.p[j]];
+    if (votes.empty()) continue;
+    out.line_p[t] = std::max_element(votes.begin(), votes.end(), [](const auto& a, const auto& b) {
+                      return a.second < b.second;
+                    })->first;
+  }
+  out.ok = true;
+  return out;
+}
+
+}  // namespace bsls::interpretation
