@@ -9,6 +9,8 @@
 // stages use cv::parallel_for_); BM_DecodeSingleThread sets
 // cv::setNumThreads(1) for both the baseline and the decode, so its ratio
 // compares single-threaded code with single-threaded OpenCV.
+// BM_DecodeTracks and BM_DecodeTracksSingleThread are the same for the
+// track chain (DecodeChain::kTracks).
 // BM_DecodeNothingAhead is BM_Decode with DecodeParams::measure_ahead off:
 // the sub-pixel centres measured after the interpretation instead of on the
 // second thread during it (counter ahead: centres measured ahead).
@@ -116,6 +118,18 @@ void BM_DecodeNothingAhead(benchmark::State& state) {
   DecodeWithThreads(state, 0, params);
 }
 
+void BM_DecodeTracks(benchmark::State& state) {
+  bsls::decoder::DecodeParams params;
+  params.chain = bsls::decoder::DecodeChain::kTracks;
+  DecodeWithThreads(state, 0, params);
+}
+
+void BM_DecodeTracksSingleThread(benchmark::State& state) {
+  bsls::decoder::DecodeParams params;
+  params.chain = bsls::decoder::DecodeChain::kTracks;
+  DecodeWithThreads(state, 1, params);
+}
+
 }  // namespace
 
 BENCHMARK(BM_GaussianBlurCanny)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
@@ -123,6 +137,8 @@ BENCHMARK(BM_Decode)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_DecodeNothingAhead)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_Decode)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_DecodeSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_DecodeTracks)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_DecodeTracksSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_DecodeSingleThread)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
 
 BENCHMARK_MAIN();

@@ -6,7 +6,7 @@
 namespace bsls::decoder::internal {
 
 // Least-squares line x = a + b t through (t, x) samples; false with < 2 samples.
-bool FitLine(const Samples& s, double* a, double* b) {
+bool FitLine(std::span<const Sample> s, double* a, double* b) {
   if (s.size() < 2) return false;
   double st = 0, sx = 0, stt = 0, stx = 0;
   for (const auto& [t, x] : s) {
@@ -27,7 +27,7 @@ bool FitLine(const Samples& s, double* a, double* b) {
 // there are fewer than five or they do not fix a parabola. The normal
 // equations are solved by Cholesky's method (as cv::solve's DECOMP_CHOLESKY),
 // written out for 3 x 3.
-bool FitParabola(const Samples& s, cv::Vec3d* c) {
+bool FitParabola(std::span<const Sample> s, cv::Vec3d* c) {
   if (s.size() < 5) return false;
   double m[5] = {0, 0, 0, 0, 0};  // sums of t^0 .. t^4
   double r[3] = {0, 0, 0};        // sums of x, t x, t^2 x
@@ -67,7 +67,7 @@ bool FitParabola(const Samples& s, cv::Vec3d* c) {
 
 // The value at t = 0 of a parabola through (t, x) samples (a line when there
 // are fewer than five), or nullopt.
-std::optional<double> FitAtZero(const Samples& s) {
+std::optional<double> FitAtZero(std::span<const Sample> s) {
   cv::Vec3d c;
   if (FitParabola(s, &c)) return c[0];
   double a, b;

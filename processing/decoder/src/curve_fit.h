@@ -7,6 +7,7 @@
 #define BSLS_DECODER_SRC_CURVE_FIT_H_
 
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -14,19 +15,20 @@
 
 namespace bsls::decoder::internal {
 
-using Samples = std::vector<std::pair<double, double>>;
+using Sample = std::pair<double, double>;
+using Samples = std::vector<Sample>;
 
 // Least-squares line x = a + b t through the samples; false with fewer than
 // two or all at one t.
-bool FitLine(const Samples& s, double* a, double* b);
+bool FitLine(std::span<const Sample> s, double* a, double* b);
 
 // Least-squares x = c0 + c1 t + c2 t^2 through the samples; false when
 // there are fewer than five or they do not fix a parabola.
-bool FitParabola(const Samples& s, cv::Vec3d* c);
+bool FitParabola(std::span<const Sample> s, cv::Vec3d* c);
 
 // The value at t = 0 of a parabola through the samples (a line when there
 // are fewer than five), or nullopt.
-std::optional<double> FitAtZero(const Samples& s);
+std::optional<double> FitAtZero(std::span<const Sample> s);
 
 }  // namespace bsls::decoder::internal
 

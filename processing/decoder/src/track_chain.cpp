@@ -33,15 +33,15 @@ struct TrackCentres {
   }
 };
 
-// (t = row - y, centre) samples of the measured centres within `reach` rows of y.
-Samples MeasuredNear(const TrackCentres& c, int y, int reach, bool skip_own) {
-  Samples s;
+// The (t = row - y, centre) samples of the measured centres within `reach`
+// rows of y, into `s` (reused by the caller, so that it is allocated once).
+void MeasuredNear(const TrackCentres& c, int y, int reach, bool skip_own, Samples* s) {
+  s->clear();
   for (int r = y - reach; r <= y + reach; ++r) {
     if (skip_own && r == y) continue;
     const double x = c.Measured(r);
-    if (!std::isnan(x)) s.emplace_back(r - y, x);
+    if (!std::isnan(x)) s->emplace_back(r - y, x);
   }
-  return s;
 }
 
 // The centres of line track `t`: measured in each row clear of the track's
@@ -70,9 +70,10 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
   // Outliers: a centre further than max_centre_residual from its neighbours' fit.
   const int reach = params.track_chain.centre_fit_rows;
   std::vector<int> drop;
+  Samples near;
   for (int i = 0; i < n; ++i) {
     if (std::isnan(c.measured[i])) continue;
-    const Samples near = MeasuredNear(c, c.first_row + i, reach, true);
+    MeasuredNear(c, c.first_row + i, reach, true, &near);
     if (near.size() < 3) continue;
     if (auto fit = FitAtZero(near); fit && std::abs(*fit - c.measured[i]) > params.max_centre_residual)
       drop.push_back(i);
@@ -82,7 +83,7 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
   c.output = c.measured;
   for (int i = 0; i < n; ++i) {
     if (!std::isnan(c.output[i])) continue;
-    const Samples near = MeasuredNear(c, c.first_row + i, reach + clearance, false);
+    MeasuredNear(c, c.first_row + i, reach + clearance, false, &near);
     const bool above = std::any_of(near.begin(), near.end(), [](const auto& s) { return s.first < 0; });
     const bool below = std::any_of(near.begin(), near.end(), [](const auto& s) { return s.first > 0; });
     if (!above || !below) continue;
@@ -98,9 +99,10 @@ cv::Point2d PlaceJunction(const cv::Mat& grey_t, const interpretation::TrackNetw
   const interpretation::TrackJunction& junction = net.junctions[j];
   cv::Point2d at = junction.position;
   const int fit_rows = params.junction_fit_rows;
+  Samples near;
   auto line_x = [&](double y) -> std::optional<double> {
     const int row = static_cast<int>(std::lround(y));
-    Samples near = MeasuredNear(line, row, fit_rows, false);
+    MeasuredNear(line, row, fit_rows, false, &near);
     for (auto& s : near) s.first -= y - row;  // t relative to y itself
     if (near.size() < 2) return std::nullopt;
     return FitAtZero(near);

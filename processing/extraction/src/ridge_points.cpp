@@ -1,9 +1,11 @@
 #include "bsls/extraction/ridge_points.h"
 
 #include <algorithm>
+#include <bit>
 #include <stdexcept>
 
-#include <opencv2/imgproc.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/core/hal/intrin.hpp>
 
 namespace bsls::extraction {
 
@@ -22,66 +24,120 @@ std::span<const RidgePoint> RidgePoints::Row(int y) const {
   return {points.data() + row_start[y], points.data() + row_start[y + 1]};
 }
 
+namespace {
+
+constexpr int kBandRows = 32;  // rows per parallel task
+
+// The ridge points of one row `s` (cols pixels, read from s[-w] to
+// s[cols - 1 + w + 16]: the caller pads it by replication), appended to
+// `out` from left to right. `candidates` is scratch.
+void RowRidgePoints(const uchar* s, int cols, int y, const RidgeParams& params,
+                    std::vector<int>* candidates, std::vector<RidgePoint>* out) {
+  const int w = params.half_window;
+  const int t = params.min_prominence;
+  // The smaller fall within w to each side of x (the pixel's own grey level
+  // minus the darkest one there).
+  auto fall_left = [&](int x) {
+    int lo = s[x];
+    for (int k = 1; k <= w; ++k) lo = std::min<int>(lo, s[x - k]);
+    return s[x] - lo;
+  };
+  auto fall_right = [&](int x) {
+    int lo = s[x];
+    for (int k = 1; k <= w; ++k) lo = std::min<int>(lo, s[x + k]);
+    return s[x] - lo;
+  };
+  // Candidates: pixels no darker than their neighbours that fall by t on
+  // both sides (every pixel of a peak's plateau does where the plateau is
+  // shorter than about w minus the stripe's edge).
+  candidates->clear();
+  int x = 0;
+#if CV_SIMD128
+  const cv::v_uint8x16 vt = cv::v_setall_u8(static_cast<uchar>(t));
+  for (; x + 16 <= cols; x += 16) {
+    const cv::v_uint8x16 v = cv::v_load(s + x);
+    const cv::v_uint8x16 peak = (v >= cv::v_load(s + x - 1)) & (v >= cv::v_load(s + x + 1));
+    if (!cv::v_check_any(peak)) continue;
+    cv::v_uint8x16 left = v, right = v;
+    for (int k = 1; k <= w; ++k) {
+      left = cv::v_min(left, cv::v_load(s + x - k));
+      right = cv::v_min(right, cv::v_load(s + x + k));
+    }
+    const cv::v_uint8x16 fall = cv::v_min(v - left, v - right);  // saturating
+    unsigned mask = static_cast<unsigned>(cv::v_signmask(peak & (fall >= vt)));
+    while (mask) {
+      candidates->push_back(x + std::countr_zero(mask));
+      mask &= mask - 1;
+    }
+  }
+#endif
+  for (; x < cols; ++x)
+    if (s[x] >= s[x - 1] && s[x] >= s[x + 1] && std::min(fall_left(x), fall_right(x)) >= t)
+      candidates->push_back(x);
+
+  const std::vector<int>& at = *candidates;
+  for (size_t i = 0; i < at.size();) {
+    // A run of candidates of one grey level: one peak or plateau.
+    const int first = at[i];
+    int end = first;
+    size_t j = i + 1;
+    while (j < at.size() && at[j] == end + 1 && s[at[j]] == s[first]) {
+      ++end;
+      ++j;
+    }
+    i = j;
+    const int v = s[first];
+    if (first == 0 || end == cols - 1 || s[first - 1] >= v || s[end + 1] >= v) continue;
+    const int prominence = std::min(fall_left(first), fall_right(end));
+    if (prominence < t) continue;
+    float c;
+    if (end > first) {
+      c = 0.5f * static_cast<float>(first + end);
+    } else {
+      const float l = s[first - 1], r = s[first + 1];
+      c = static_cast<float>(first) + 0.5f * (l - r) / (l - 2.0f * static_cast<float>(v) + r);
+    }
+    out->push_back({c, y, prominence});
+  }
+}
+
+}  // namespace
+
 RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) {
   if (smoothed.empty() || smoothed.type() != CV_8UC1)
     throw std::invalid_argument("FindRidgePoints: image must be a non-empty CV_8UC1 image");
   std::string why;
   if (!params.IsValid(&why)) throw std::invalid_argument("FindRidgePoints: " + why);
 
-  // The darkest pixel within half_window to the left and to the right of
-  // each pixel, and the brightest of its two neighbours and itself.
-  const int w = params.half_window;
-  const cv::Mat window = cv::Mat::ones(1, w + 1, CV_8U);
-  cv::Mat left_min, right_min, peak, fall_left, fall_right, fall, candidates;
-  cv::erode(smoothed, left_min, window, cv::Point(w, 0), 1, cv::BORDER_REPLICATE);
-  cv::erode(smoothed, right_min, window, cv::Point(0, 0), 1, cv::BORDER_REPLICATE);
-  cv::dilate(smoothed, peak, cv::Mat::ones(1, 3, CV_8U), cv::Point(1, 0), 1,
-             cv::BORDER_REPLICATE);
-  cv::subtract(smoothed, left_min, fall_left);
-  cv::subtract(smoothed, right_min, fall_right);
-  // Candidates: pixels no darker than their neighbours that fall far enough
-  // on at least one side (every pixel of a peak's plateau shorter than about
-  // half_window minus the stripe's edge does).
-  cv::max(fall_left, fall_right, fall);
-  cv::compare(smoothed, peak, candidates, cv::CMP_GE);
-  cv::Mat strong;
-  cv::compare(fall, params.min_prominence, strong, cv::CMP_GE);
-  cv::bitwise_and(candidates, strong, candidates);
-  std::vector<cv::Point> at;
-  cv::findNonZero(candidates, at);
-
+  // Rows are independent: bands of them in parallel (cv::parallel_for_),
+  // each row copied into a buffer padded by replication.
+  const int bands = (smoothed.rows + kBandRows - 1) / kBandRows;
+  const int w = params.half_window, cols = smoothed.cols;
+  constexpr int kVector = 16;  // the vector loop reads up to this far past a row's last pixel
+  std::vector<std::vector<RidgePoint>> found(bands);
+  cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& r) {
+    std::vector<uchar> padded(static_cast<size_t>(cols + 2 * w + kVector));
+    std::vector<int> candidates;
+    for (int b = r.start; b < r.end; ++b) {
+      const int y1 = std::min((b + 1) * kBandRows, smoothed.rows);
+      for (int y = b * kBandRows; y < y1; ++y) {
+        const uchar* row = smoothed.ptr<uchar>(y);
+        std::fill(padded.begin(), padded.begin() + w, row[0]);
+        std::copy(row, row + cols, padded.begin() + w);
+        std::fill(padded.begin() + w + cols, padded.end(), row[cols - 1]);
+        RowRidgePoints(padded.data() + w, cols, y, params, &candidates, &found[b]);
+      }
+    }
+  });
   RidgePoints out;
-  out.points.reserve(at.size());
+  size_t total = 0;
+  for (const auto& f : found) total += f.size();
+  out.points.reserve(total);
+  for (const auto& f : found) out.points.insert(out.points.end(), f.begin(), f.end());
   out.row_start.assign(static_cast<size_t>(smoothed.rows) + 1, 0);
   int row = 0;
-  const int last = smoothed.cols - 1;
-  for (size_t i = 0; i < at.size();) {
-    const int y = at[i].y;
-    while (row <= y) out.row_start[row++] = static_cast<int>(out.points.size());
-    const uchar* s = smoothed.ptr<uchar>(y);
-    // A run of candidates of one grey level in one row: one peak or plateau.
-    const int first = at[i].x;
-    int end = first;
-    size_t j = i + 1;
-    while (j < at.size() && at[j].y == y && at[j].x == end + 1 && s[at[j].x] == s[first]) {
-      end = at[j].x;
-      ++j;
-    }
-    i = j;
-    const int v = s[first];
-    if (first == 0 || end == last || s[first - 1] >= v || s[end + 1] >= v) continue;
-    const int prominence =
-        std::min(fall_left.ptr<uchar>(y)[first], fall_right.ptr<uchar>(y)[end]);
-    if (prominence < params.min_prominence) continue;
-    float x;
-    if (end > first) {
-      x = 0.5f * static_cast<float>(first + end);
-    } else {
-      const float l = s[first - 1], r = s[first + 1];
-      x = static_cast<float>(first) + 0.5f * (l - r) / (l - 2.0f * static_cast<float>(v) + r);
-    }
-    out.points.push_back({x, y, prominence});
-  }
+  for (size_t i = 0; i < out.points.size(); ++i)
+    while (row <= out.points[i].y) out.row_start[row++] = static_cast<int>(i);
   while (row <= smoothed.rows) out.row_start[row++] = static_cast<int>(out.points.size());
   return out;
 }

@@ -647,12 +647,15 @@ std::vector<std::optional<double>> StripeCentresInRow(const cv::Mat& image, int 
 }
 
 std::optional<double> RidgeCentreInRow(const cv::Mat& image, int y, double approximate_x) {
-  constexpr int kReach = 9;  // px each side read from the image
+  // The smoothed profile is wanted at the guess +-2 px (where the peak is
+  // sought) and one pixel beyond; each smoothed value reads 2 px each side.
+  constexpr int kPeak = 2, kReach = kPeak + 3;
+  constexpr int kEdge = 9;  // px from the image's edges where nothing is measured
   if (image.empty() || image.type() != CV_8UC1 || y < 0 || y >= image.rows ||
       !std::isfinite(approximate_x))
     return std::nullopt;
   const int x0 = static_cast<int>(std::lround(approximate_x));
-  if (x0 - kReach < 0 || x0 + kReach >= image.cols) return std::nullopt;
+  if (x0 - kEdge < 0 || x0 + kEdge >= image.cols) return std::nullopt;
   const uchar* above = image.ptr<uchar>(std::max(y - 1, 0)) + x0 - kReach;
   const uchar* row = image.ptr<uchar>(y) + x0 - kReach;
   const uchar* below = image.ptr<uchar>(std::min(y + 1, image.rows - 1)) + x0 - kReach;
@@ -664,9 +667,8 @@ std::optional<double> RidgeCentreInRow(const cv::Mat& image, int y, double appro
     smooth[k] = profile[k - 2] + 4 * profile[k - 1] + 6 * profile[k] + 4 * profile[k + 1] +
                 profile[k + 2];
   int peak = kReach;
-  for (int k = kReach - 2; k <= kReach + 2; ++k)
+  for (int k = kReach - kPeak; k <= kReach + kPeak; ++k)
     if (smooth[k] > smooth[peak]) peak = k;
-  if (peak <= 3 || peak >= kSize - 4) return std::nullopt;
   // Differences at peak - 1/2 and peak + 1/2: rising, then falling.
   const double rise = smooth[peak] - smooth[peak - 1], fall = smooth[peak + 1] - smooth[peak];
   if (rise < 0 || fall > 0 || rise == fall) return std::nullopt;
