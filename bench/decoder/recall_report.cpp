@@ -138,6 +138,7 @@ void Report(SurfaceKind kind, Side side, std::uint32_t seed, const Options& o, T
   const auto t0 = std::chrono::steady_clock::now();
   bsls::decoder::DecodeParams decode;
   decode.chain = o.chain;
+  if (const char* v = std::getenv("BSLS_TRACK_STEP")) decode.track_chain.tracks.max_step = std::atof(v);
   const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame.image, side, decode);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -126,12 +126,42 @@ cv::Point2d PlaceJunction(const cv::Mat& grey_t, const interpretation::TrackNetw
   } else {
     for (size_t i = 0; i < seg.size() && static_cast<int>(columns.size()) < want; ++i) take(seg[i]);
   }
-  double a, b;
+  double a, b;  // the segment: y = a + b (x - x_ref)
   if (!FitLine(columns, &a, &b)) return at;
+  const double x_ref = at.x;
+  // Where the line folds at the junction (its slope above and below differs
+  // by more than fold_slope_change: the side of the nose, the lips), no one
+  // curve fits both branches: the junction is where the segment's line
+  // crosses the track itself.
+  MeasuredNear(line, static_cast<int>(std::lround(at.y)), fit_rows, false, &near);
+  Samples above, below;
+  for (const Sample& s : near) (s.first < 0 ? above : below).push_back(s);
+  double a_above, b_above, a_below, b_below;
+  const bool fold = FitLine(above, &a_above, &b_above) && FitLine(below, &a_below, &b_below) &&
+                    std::abs(b_above - b_below) > params.fold_slope_change;
+  if (fold) {
+    const auto& pts = net.lines[junction.line].points;
+    const auto& rp = net.rows.points;
+    auto off = [&](int k) { return rp[pts[k]].y - (a + b * (rp[pts[k]].x - x_ref)); };
+    std::optional<cv::Point2d> crossing;
+    double nearest = fit_rows + 1.0;
+    for (size_t k = 0; k + 1 < pts.size(); ++k) {
+      const double d0 = off(static_cast<int>(k)), d1 = off(static_cast<int>(k) + 1);
+      if ((d0 > 0) == (d1 > 0) && d0 != 0) continue;
+      const double f = d0 / (d0 - d1);
+      const double x = rp[pts[k]].x + f * (rp[pts[k + 1]].x - rp[pts[k]].x);
+      const cv::Point2d c(x, a + b * (x - x_ref));
+      if (std::abs(c.y - a) < nearest) {
+        nearest = std::abs(c.y - a);
+        crossing = c;
+      }
+    }
+    if (crossing) return *crossing;
+  }
   at.y = a;
   if (auto x = line_x(at.y)) {
     // Once more at the line's x there.
-    at.y = a + b * (*x - at.x);
+    at.y = a + b * (*x - x_ref);
     at.x = *x;
   }
   return at;
@@ -159,6 +189,18 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       interpretation::LabelTracks(net, side, params.spec, tp.labelling);
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
+  // The tracks' ridge points, as the skeleton chain's repaired skeleton.
+  result->skeleton = cv::Mat::zeros(grey.size(), CV_8UC1);
+  for (const interpretation::Track& track : net.lines)
+    for (int k : track.points) {
+      const extraction::RidgePoint& p = net.rows.points[k];
+      result->skeleton.at<uchar>(p.y, static_cast<int>(std::lround(p.x))) = 255;
+    }
+  for (const interpretation::Track& track : net.segments)
+    for (int k : track.points) {
+      const extraction::RidgePoint& p = net.columns.points[k];  // x: row, y: column
+      result->skeleton.at<uchar>(static_cast<int>(std::lround(p.x)), p.y) = 255;
+    }
   if (!labels.ok) {
     result->error = labels.error;
     return;

@@ -30,31 +30,44 @@ constexpr int kBandRows = 32;  // rows per parallel task
 
 // The ridge points of one row `s` (cols pixels, read from s[-w] to
 // s[cols - 1 + w + 16]: the caller pads it by replication), appended to
-// `out` from left to right. `candidates` is scratch.
+// `out` from left to right. `candidates` is scratch. Within w of the row's
+// ends only the inner fall is judged.
 void RowRidgePoints(const uchar* s, int cols, int y, const RidgeParams& params,
                     std::vector<int>* candidates, std::vector<RidgePoint>* out) {
   const int w = params.half_window;
   const int t = params.min_prominence;
   // The smaller fall within w to each side of x (the pixel's own grey level
   // minus the darkest one there).
+  // The fall within w to each side of x: the pixel's own grey level minus
+  // the darkest one there. Where the window is cut by the row's end, that
+  // side is not judged (a stripe at the image's edge shows one flank only).
+  constexpr int kUnjudged = 255;
   auto fall_left = [&](int x) {
+    if (x < w) return kUnjudged;
     int lo = s[x];
     for (int k = 1; k <= w; ++k) lo = std::min<int>(lo, s[x - k]);
     return s[x] - lo;
   };
   auto fall_right = [&](int x) {
+    if (x + w > cols - 1) return kUnjudged;
     int lo = s[x];
     for (int k = 1; k <= w; ++k) lo = std::min<int>(lo, s[x + k]);
     return s[x] - lo;
+  };
+  auto candidate = [&](int x) {
+    return s[x] >= s[x - 1] && s[x] >= s[x + 1] && std::min(fall_left(x), fall_right(x)) >= t;
   };
   // Candidates: pixels no darker than their neighbours that fall by t on
   // both sides (every pixel of a peak's plateau does where the plateau is
   // shorter than about w minus the stripe's edge).
   candidates->clear();
   int x = 0;
+  for (; x < std::min(w, cols); ++x)
+    if (candidate(x)) candidates->push_back(x);
+  const int inner_end = cols - w;  // from here the right window is cut
 #if CV_SIMD128
   const cv::v_uint8x16 vt = cv::v_setall_u8(static_cast<uchar>(t));
-  for (; x + 16 <= cols; x += 16) {
+  for (; x + 16 <= inner_end; x += 16) {
     const cv::v_uint8x16 v = cv::v_load(s + x);
     const cv::v_uint8x16 peak = (v >= cv::v_load(s + x - 1)) & (v >= cv::v_load(s + x + 1));
     if (!cv::v_check_any(peak)) continue;
@@ -72,8 +85,7 @@ void RowRidgePoints(const uchar* s, int cols, int y, const RidgeParams& params,
   }
 #endif
   for (; x < cols; ++x)
-    if (s[x] >= s[x - 1] && s[x] >= s[x + 1] && std::min(fall_left(x), fall_right(x)) >= t)
-      candidates->push_back(x);
+    if (candidate(x)) candidates->push_back(x);
 
   const std::vector<int>& at = *candidates;
   for (size_t i = 0; i < at.size();) {
@@ -87,11 +99,16 @@ void RowRidgePoints(const uchar* s, int cols, int y, const RidgeParams& params,
     }
     i = j;
     const int v = s[first];
-    if (first == 0 || end == cols - 1 || s[first - 1] >= v || s[end + 1] >= v) continue;
+    // A peak at the row's end (a stripe cut by the image's edge) is taken
+    // at that pixel.
+    const bool at_edge = first == 0 || end == cols - 1;
+    if ((first > 0 && s[first - 1] >= v) || (end < cols - 1 && s[end + 1] >= v)) continue;
     const int prominence = std::min(fall_left(first), fall_right(end));
-    if (prominence < t) continue;
+    if (prominence < t || (at_edge && prominence == kUnjudged)) continue;
     float c;
-    if (end > first) {
+    if (at_edge) {
+      c = static_cast<float>(first == 0 ? first : end);
+    } else if (end > first) {
       c = 0.5f * static_cast<float>(first + end);
     } else {
       const float l = s[first - 1], r = s[first + 1];

@@ -151,7 +151,10 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   }
 
   // Seeds: line 0's direct junctions in order down the image, two rows per
-  // step of their spacing.
+  // step of their spacing. Only the one nearest the centre row starts free;
+  // each other starts at the cost of a long step from it, so that it keeps
+  // the row counted from the spacing only where no path through the links
+  // reaches it (a gap in line 0 that no neighbour bridges).
   out.reference = ReferenceTracks(net, side, params);
   std::vector<int> seeds;
   for (int t : out.reference)
@@ -175,14 +178,24 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     seed_v.push_back(seed_v.back() + 2 * std::max(1, static_cast<int>(std::lround(gap / (2 * s)))));
   }
 
+  const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
+  size_t centre_seed = 0;
+  for (size_t i = 1; i < seeds.size(); ++i)
+    if (std::abs(net.junctions[seeds[i]].position.y - centre_row) <
+        std::abs(net.junctions[seeds[centre_seed]].position.y - centre_row))
+      centre_seed = i;
+  std::vector<double> seed_cost(seeds.size());
+  for (size_t i = 0; i < seeds.size(); ++i)
+    seed_cost[i] = kPerLongRow * std::abs(seed_v[i] - seed_v[centre_seed]);
+
   // Propagation, cheapest paths first (Dijkstra over the link weights).
   std::vector<double> cost(n, std::numeric_limits<double>::infinity());
   std::vector<char> done(n, 0);
   using Item = std::tuple<double, int, int, int>;  // cost, junction, p, v
   std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
   for (size_t i = 0; i < seeds.size(); ++i) {
-    cost[seeds[i]] = 0;
-    queue.push({0.0, seeds[i], 0, seed_v[i]});
+    cost[seeds[i]] = seed_cost[i];
+    queue.push({seed_cost[i], seeds[i], 0, seed_v[i]});
   }
   while (!queue.empty()) {
     const auto [c, j, p, v] = queue.top();
@@ -220,7 +233,6 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   }
 
   // Thesis point O: line 0's junction nearest the centre row is v = 0.
-  const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
   int origin_v = 0;
   double nearest = std::numeric_limits<double>::infinity();
   for (int s : seeds)

@@ -180,7 +180,9 @@ struct DecodeResult {
   int repairs = 0;
   int label_conflicts = 0;
   std::map<interpretation::LoopClass, int> loop_classes;
-  cv::Mat skeleton;  // the repaired skeleton, CV_8UC1 0/255, frame size (redrawn when binned)
+  // The repaired skeleton, CV_8UC1 0/255, frame size (redrawn when binned);
+  // for the track chain, the ridge points of its line and segment tracks.
+  cv::Mat skeleton;
 };
 
 // Decodes a CV_8UC1 frame of the brick slide of `side`. A blank or saturated
