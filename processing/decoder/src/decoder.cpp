@@ -634,6 +634,7 @@ bool TrackChainParams::IsValid(std::string* error) const {
   };
   if (!(smoothing_sigma > 0 && smoothing_sigma <= 10))
     return fail("track_chain.smoothing_sigma must lie in (0, 10]");
+  if (!(max_centre_shift > 0)) return fail("track_chain.max_centre_shift must be positive");
   if (centre_fit_rows < 1 || centre_fit_rows > 50)
     return fail("track_chain.centre_fit_rows must lie in 1..50");
   if (segment_columns < 2) return fail("track_chain.segment_columns must be at least 2");

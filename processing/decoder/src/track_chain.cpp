@@ -45,8 +45,8 @@ void MeasuredNear(const TrackCentres& c, int y, int reach, bool skip_own, Sample
 }
 
 // The centres of line track `t`: measured in each row clear of the track's
-// junctions, outliers against their neighbours' fit dropped, and the rows
-// beside junctions refilled from the centres on both sides.
+// junctions, those far from their ridge points dropped, and the rows beside
+// junctions refilled from the centres on both sides.
 TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwork& net, int t,
                           const DecodeParams& params) {
   const auto& pts = net.lines[t].points;
@@ -65,20 +65,13 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
   for (int i = 0; i < n; ++i) {
     if (beside_junction[i]) continue;
     const extraction::RidgePoint& p = rp[pts[i]];
-    if (auto x = extraction::RidgeCentreInRow(grey, p.y, p.x)) c.measured[i] = *x;
+    // A centre far from its ridge point took another stripe's light (a
+    // neighbour crowding in, a segment nearby): dropped.
+    const auto x = extraction::RidgeCentreInRow(grey, p.y, p.x);
+    if (x && std::abs(*x - p.x) <= params.track_chain.max_centre_shift) c.measured[i] = *x;
   }
-  // Outliers: a centre further than max_centre_residual from its neighbours' fit.
   const int reach = params.track_chain.centre_fit_rows;
-  std::vector<int> drop;
   Samples near;
-  for (int i = 0; i < n; ++i) {
-    if (std::isnan(c.measured[i])) continue;
-    MeasuredNear(c, c.first_row + i, reach, true, &near);
-    if (near.size() < 3) continue;
-    if (auto fit = FitAtZero(near); fit && std::abs(*fit - c.measured[i]) > params.max_centre_residual)
-      drop.push_back(i);
-  }
-  for (int i : drop) c.measured[i] = NAN;
   // Refill: rows without a centre, from measured centres on both sides.
   c.output = c.measured;
   for (int i = 0; i < n; ++i) {
@@ -94,7 +87,7 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
 
 // Where junction j lies: the segment's centres near the line fitted as a
 // straight line y(x) and met with the line's centres fitted as x(y).
-cv::Point2d PlaceJunction(const cv::Mat& grey_t, const interpretation::TrackNetwork& net, int j,
+cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwork& net, int j,
                           const TrackCentres& line, const DecodeParams& params) {
   const interpretation::TrackJunction& junction = net.junctions[j];
   cv::Point2d at = junction.position;
@@ -116,7 +109,7 @@ cv::Point2d PlaceJunction(const cv::Mat& grey_t, const interpretation::TrackNetw
   auto take = [&](int k) {
     const extraction::RidgePoint& p = cp[k];
     if (std::abs(p.y - at.x) <= clearance) return;
-    if (auto y = extraction::RidgeCentreInRow(grey_t, p.y, p.x))
+    if (auto y = extraction::RidgeCentreInColumn(grey, p.y, p.x))
       columns.emplace_back(p.y - at.x, *y);
   };
   const int want = params.track_chain.segment_columns;
@@ -130,26 +123,39 @@ cv::Point2d PlaceJunction(const cv::Mat& grey_t, const interpretation::TrackNetw
   if (!FitLine(columns, &a, &b)) return at;
   const double x_ref = at.x;
   // Where the line folds at the junction (its slope above and below differs
-  // by more than fold_slope_change: the side of the nose, the lips), no one
-  // curve fits both branches: the junction is where the segment's line
-  // crosses the track itself.
+  // by more than fold_slope_change: the side of the nose, the lips) no one
+  // curve fits both branches, and where it has centres on one side only (it
+  // turns too steep for the track beyond) none reaches the junction: there
+  // the junction is where the segment's line crosses the track itself.
   MeasuredNear(line, static_cast<int>(std::lround(at.y)), fit_rows, false, &near);
   Samples above, below;
   for (const Sample& s : near) (s.first < 0 ? above : below).push_back(s);
   double a_above, b_above, a_below, b_below;
-  const bool fold = FitLine(above, &a_above, &b_above) && FitLine(below, &a_below, &b_below) &&
-                    std::abs(b_above - b_below) > params.fold_slope_change;
-  if (fold) {
-    const auto& pts = net.lines[junction.line].points;
-    const auto& rp = net.rows.points;
-    auto off = [&](int k) { return rp[pts[k]].y - (a + b * (rp[pts[k]].x - x_ref)); };
+  const bool both_sides =
+      FitLine(above, &a_above, &b_above) && FitLine(below, &a_below, &b_below);
+  if (!both_sides || std::abs(b_above - b_below) > params.fold_slope_change) {
+    // The track's ridge points, with those of the tracks continuing it
+    // across a gap above and below (joined by a chord).
+    std::vector<cv::Point2d> path;
+    auto add = [&](int track, bool tail) {
+      const auto& pts = net.lines[track].points;
+      const size_t count = std::min(pts.size(), static_cast<size_t>(fit_rows + 1));
+      const size_t from = tail ? pts.size() - count : 0, to = tail ? pts.size() : count;
+      for (size_t k = from; k < to; ++k)
+        path.emplace_back(net.rows.points[pts[k]].x, net.rows.points[pts[k]].y);
+    };
+    if (net.line_above[junction.line] >= 0) add(net.line_above[junction.line], true);
+    for (int k : net.lines[junction.line].points)
+      path.emplace_back(net.rows.points[k].x, net.rows.points[k].y);
+    if (net.line_below[junction.line] >= 0) add(net.line_below[junction.line], false);
+    auto off = [&](const cv::Point2d& q) { return q.y - (a + b * (q.x - x_ref)); };
     std::optional<cv::Point2d> crossing;
     double nearest = fit_rows + 1.0;
-    for (size_t k = 0; k + 1 < pts.size(); ++k) {
-      const double d0 = off(static_cast<int>(k)), d1 = off(static_cast<int>(k) + 1);
+    for (size_t k = 0; k + 1 < path.size(); ++k) {
+      const double d0 = off(path[k]), d1 = off(path[k + 1]);
       if ((d0 > 0) == (d1 > 0) && d0 != 0) continue;
       const double f = d0 / (d0 - d1);
-      const double x = rp[pts[k]].x + f * (rp[pts[k + 1]].x - rp[pts[k]].x);
+      const double x = path[k].x + f * (path[k + 1].x - path[k].x);
       const cv::Point2d c(x, a + b * (x - x_ref));
       if (std::abs(c.y - a) < nearest) {
         nearest = std::abs(c.y - a);
@@ -173,13 +179,11 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
                     DecodeResult* result) {
   const TrackChainParams& tp = params.track_chain;
   auto t = Clock::now();
-  cv::Mat smoothed, smoothed_t, grey_t;
+  cv::Mat smoothed;
   cv::GaussianBlur(grey, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
                    cv::BORDER_REPLICATE);
-  cv::transpose(smoothed, smoothed_t);
-  cv::transpose(grey, grey_t);
   extraction::RidgePoints rows = extraction::FindRidgePoints(smoothed, tp.ridge);
-  extraction::RidgePoints columns = extraction::FindRidgePoints(smoothed_t, tp.ridge);
+  extraction::RidgePoints columns = extraction::FindColumnRidgePoints(smoothed, tp.ridge);
   result->times.extraction_ms = MsSince(t);
 
   t = Clock::now();
@@ -241,7 +245,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       d.p = labels.p[j];
       d.q = labels.v[j] + q_offset;
       d.kind = net.junctions[j].kind;
-      d.position = PlaceJunction(grey_t, net, j, centres[net.junctions[j].line], params);
+      d.position = PlaceJunction(grey, net, j, centres[net.junctions[j].line], params);
     }
   });
 

@@ -57,10 +57,21 @@ cv::Mat BinFrame(const cv::Mat& grey, int n) {
 }
 
 GreyHistogram::GreyHistogram(const cv::Mat& grey) : total_(static_cast<double>(grey.total())) {
+  // Four tallies taken in turn, so that runs of one level (the dark ground)
+  // do not wait on one counter; summed at the end.
+  int tally[4][256] = {};
   for (int y = 0; y < grey.rows; ++y) {
     const uchar* row = grey.ptr<uchar>(y);
-    for (int x = 0; x < grey.cols; ++x) ++count_[row[x]];
+    int x = 0;
+    for (; x + 4 <= grey.cols; x += 4) {
+      ++tally[0][row[x]];
+      ++tally[1][row[x + 1]];
+      ++tally[2][row[x + 2]];
+      ++tally[3][row[x + 3]];
+    }
+    for (; x < grey.cols; ++x) ++tally[0][row[x]];
   }
+  for (int i = 0; i < 256; ++i) count_[i] = tally[0][i] + tally[1][i] + tally[2][i] + tally[3][i];
 }
 
 int GreyHistogram::Percentile(double fraction) const {

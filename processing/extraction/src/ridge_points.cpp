@@ -26,84 +26,71 @@ std::span<const RidgePoint> RidgePoints::Row(int y) const {
 
 namespace {
 
-constexpr int kBandRows = 32;  // rows per parallel task
+constexpr int kBandRows = 32;    // rows per parallel task
+constexpr int kVector = 16;      // pixels per vector step
+constexpr int kUnjudged = 255;   // the fall of a side cut by the image's edge
 
-// The ridge points of one row `s` (cols pixels, read from s[-w] to
-// s[cols - 1 + w + 16]: the caller pads it by replication), appended to
-// `out` from left to right. `candidates` is scratch. Within w of the row's
-// ends only the inner fall is judged.
-void RowRidgePoints(const uchar* s, int cols, int y, const RidgeParams& params,
-                    std::vector<int>* candidates, std::vector<RidgePoint>* out) {
-  const int w = params.half_window;
-  const int t = params.min_prominence;
-  // The smaller fall within w to each side of x (the pixel's own grey level
-  // minus the darkest one there).
-  // The fall within w to each side of x: the pixel's own grey level minus
-  // the darkest one there. Where the window is cut by the row's end, that
-  // side is not judged (a stripe at the image's edge shows one flank only).
-  constexpr int kUnjudged = 255;
-  auto fall_left = [&](int x) {
-    if (x < w) return kUnjudged;
-    int lo = s[x];
-    for (int k = 1; k <= w; ++k) lo = std::min<int>(lo, s[x - k]);
-    return s[x] - lo;
-  };
-  auto fall_right = [&](int x) {
-    if (x + w > cols - 1) return kUnjudged;
-    int lo = s[x];
-    for (int k = 1; k <= w; ++k) lo = std::min<int>(lo, s[x + k]);
-    return s[x] - lo;
-  };
-  auto candidate = [&](int x) {
-    return s[x] >= s[x - 1] && s[x] >= s[x + 1] && std::min(fall_left(x), fall_right(x)) >= t;
-  };
-  // Candidates: pixels no darker than their neighbours that fall by t on
-  // both sides (every pixel of a peak's plateau does where the plateau is
-  // shorter than about w minus the stripe's edge).
-  candidates->clear();
-  int x = 0;
-  for (; x < std::min(w, cols); ++x)
-    if (candidate(x)) candidates->push_back(x);
-  const int inner_end = cols - w;  // from here the right window is cut
-#if CV_SIMD128
-  const cv::v_uint8x16 vt = cv::v_setall_u8(static_cast<uchar>(t));
-  for (; x + 16 <= inner_end; x += 16) {
-    const cv::v_uint8x16 v = cv::v_load(s + x);
-    const cv::v_uint8x16 peak = (v >= cv::v_load(s + x - 1)) & (v >= cv::v_load(s + x + 1));
-    if (!cv::v_check_any(peak)) continue;
-    cv::v_uint8x16 left = v, right = v;
-    for (int k = 1; k <= w; ++k) {
-      left = cv::v_min(left, cv::v_load(s + x - k));
-      right = cv::v_min(right, cv::v_load(s + x + k));
-    }
-    const cv::v_uint8x16 fall = cv::v_min(v - left, v - right);  // saturating
-    unsigned mask = static_cast<unsigned>(cv::v_signmask(peak & (fall >= vt)));
-    while (mask) {
-      candidates->push_back(x + std::countr_zero(mask));
-      mask &= mask - 1;
-    }
-  }
-#endif
-  for (; x < cols; ++x)
-    if (candidate(x)) candidates->push_back(x);
+// One row or column of the smoothed image as a profile: value(i) for
+// i in 0 .. n-1, replicated beyond.
+struct Profile {
+  const uchar* data;
+  std::ptrdiff_t step;  // bytes between consecutive pixels
+  int n;
 
-  const std::vector<int>& at = *candidates;
+  int operator()(int i) const { return data[std::clamp(i, 0, n - 1) * step]; }
+  // Pixel i, which must lie in 0 .. n-1.
+  int At(int i) const { return data[i * step]; }
+};
+
+// The fall within w to one side of i (dir = -1 before, +1 after): the
+// pixel's own grey level minus the darkest one there. Where the window is
+// cut by the profile's end, that side is not judged (a stripe at the image's
+// edge shows one flank only).
+int Fall(const Profile& s, int i, int dir, int w) {
+  if (i + dir * w < 0 || i + dir * w > s.n - 1) return kUnjudged;
+  const uchar* p = s.data + i * s.step;
+  const std::ptrdiff_t d = dir * s.step;
+  int lo = p[0];
+  for (int k = 1; k <= w; ++k) lo = std::min<int>(lo, p[k * d]);
+  return p[0] - lo;
+}
+
+// A candidate pixel: no darker than its neighbours, falling by t on both
+// sides (every pixel of a peak's plateau does where the plateau is shorter
+// than about w minus the stripe's edge), with its two falls.
+struct Candidate {
+  int at;
+  uchar before, after;
+};
+
+// Appends pixel i of `s` to `out` when it is a candidate.
+void AddIfCandidate(const Profile& s, int i, int w, int t, std::vector<Candidate>* out) {
+  if (s(i) < s(i - 1) || s(i) < s(i + 1)) return;
+  const int before = Fall(s, i, -1, w), after = Fall(s, i, +1, w);
+  if (std::min(before, after) >= t)
+    out->push_back({i, static_cast<uchar>(before), static_cast<uchar>(after)});
+}
+
+// The ridge points of profile `s` (row or column `line` of the image) from
+// its candidates in increasing order, appended to `out`: each run of
+// candidates of one grey level is one peak or plateau.
+void ProfileRidgePoints(const Profile& s, int line, const std::vector<Candidate>& at, int t,
+                        std::vector<RidgePoint>* out) {
   for (size_t i = 0; i < at.size();) {
-    // A run of candidates of one grey level: one peak or plateau.
-    const int first = at[i];
+    const int first = at[i].at;
+    const int v = s.At(first);
     int end = first;
     size_t j = i + 1;
-    while (j < at.size() && at[j] == end + 1 && s[at[j]] == s[first]) {
+    while (j < at.size() && at[j].at == end + 1 && s.At(at[j].at) == v) {
       ++end;
       ++j;
     }
+    const int prominence = std::min(at[i].before, at[j - 1].after);
     i = j;
-    const int v = s[first];
-    // A peak at the row's end (a stripe cut by the image's edge) is taken
-    // at that pixel.
-    const bool at_edge = first == 0 || end == cols - 1;
-    if ((first > 0 && s[first - 1] >= v) || (end < cols - 1 && s[end + 1] >= v)) continue;
-    const int prominence = std::min(fall_left(first), fall_right(end));
+    // A peak at the profile's end (a stripe cut by the image's edge) is
+    // taken at that pixel.
+    const bool at_edge = first == 0 || end == s.n - 1;
+    if ((first > 0 && s.At(first - 1) >= v) || (end < s.n - 1 && s.At(end + 1) >= v)) continue;
     if (prominence < t || (at_edge && prominence == kUnjudged)) continue;
     float c;
     if (at_edge) {
@@ -111,30 +98,149 @@ void RowRidgePoints(const uchar* s, int cols, int y, const RidgeParams& params,
     } else if (end > first) {
       c = 0.5f * static_cast<float>(first + end);
     } else {
-      const float l = s[first - 1], r = s[first + 1];
+      const float l = static_cast<float>(s.At(first - 1)), r = static_cast<float>(s.At(first + 1));
       c = static_cast<float>(first) + 0.5f * (l - r) / (l - 2.0f * static_cast<float>(v) + r);
     }
-    out->push_back({c, y, prominence});
+    out->push_back({c, line, prominence});
   }
+}
+
+#if CV_SIMD128
+// Appends the lanes of `mask` (bit k: pixel first + k) with their falls.
+void AddLanes(unsigned mask, int first, const cv::v_uint8x16& before, const cv::v_uint8x16& after,
+              std::vector<Candidate>* out) {
+  if (!mask) return;
+  uchar b[kVector], a[kVector];
+  cv::v_store(b, before);
+  cv::v_store(a, after);
+  while (mask) {
+    const int k = std::countr_zero(mask);
+    out->push_back({first + k, b[k], a[k]});
+    mask &= mask - 1;
+  }
+}
+#endif
+
+// The candidates of row `s` (cols pixels, readable from s[-w] to
+// s[cols - 1 + w + kVector]: the caller pads it by replication), in
+// increasing order.
+void RowCandidates(const uchar* s, int cols, int w, int t, std::vector<Candidate>* candidates) {
+  const Profile p{s, 1, cols};
+  candidates->clear();
+  int x = 0;
+  for (; x < std::min(w, cols); ++x) AddIfCandidate(p, x, w, t, candidates);
+  const int inner_end = cols - w;  // from here the right window is cut
+#if CV_SIMD128
+  const cv::v_uint8x16 vt = cv::v_setall_u8(static_cast<uchar>(t));
+  // The last step overlaps the one before it where the inner part is no
+  // whole number of steps; its lanes done already are masked off.
+  const int inner_begin = x;
+  for (int done = x; x < inner_end && inner_end - inner_begin >= kVector; x += kVector) {
+    const int from = std::min(x, inner_end - kVector);
+    const cv::v_uint8x16 v = cv::v_load(s + from);
+    const cv::v_uint8x16 peak = (v >= cv::v_load(s + from - 1)) & (v >= cv::v_load(s + from + 1));
+    if (!cv::v_check_any(peak)) {
+      done = from + kVector;
+      continue;
+    }
+    cv::v_uint8x16 left = v, right = v;
+    for (int k = 1; k <= w; ++k) {
+      left = cv::v_min(left, cv::v_load(s + from - k));
+      right = cv::v_min(right, cv::v_load(s + from + k));
+    }
+    const cv::v_uint8x16 before = v - left, after = v - right;  // saturating
+    unsigned mask =
+        static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
+    mask &= ~0u << (done - from);  // lanes before `done` were taken by the step before
+    AddLanes(mask, from, before, after, candidates);
+    done = from + kVector;
+  }
+  x = std::max(x, inner_end);
+#endif
+  for (; x < cols; ++x) AddIfCandidate(p, x, w, t, candidates);
+}
+
+// The candidates of columns x0 .. x0 + kVector - 1 of `image`, each
+// column's in increasing row order. `rows_from` holds the start of every
+// image row for rows -w - 1 .. rows + w (clamped: replication), from index 0.
+void ColumnBlockCandidates(const cv::Mat& image, const std::vector<const uchar*>& rows_from,
+                           int x0, int w, int t, std::vector<Candidate> (&candidates)[kVector]) {
+  for (auto& c : candidates) c.clear();
+  const int rows = image.rows;
+#if CV_SIMD128
+  auto row = [&](int y) { return rows_from[static_cast<size_t>(y + w + 1)] + x0; };
+  const cv::v_uint8x16 vt = cv::v_setall_u8(static_cast<uchar>(t));
+  const cv::v_uint8x16 unjudged = cv::v_setall_u8(static_cast<uchar>(kUnjudged));
+  for (int y = 0; y < rows; ++y) {
+    const cv::v_uint8x16 v = cv::v_load(row(y));
+    const cv::v_uint8x16 peak = (v >= cv::v_load(row(y - 1))) & (v >= cv::v_load(row(y + 1)));
+    if (!cv::v_check_any(peak)) continue;
+    cv::v_uint8x16 above = v, below = v;
+    for (int k = 1; k <= w; ++k) {
+      above = cv::v_min(above, cv::v_load(row(y - k)));
+      below = cv::v_min(below, cv::v_load(row(y + k)));
+    }
+    const cv::v_uint8x16 before = y - w < 0 ? unjudged : v - above;  // saturating
+    const cv::v_uint8x16 after = y + w > rows - 1 ? unjudged : v - below;
+    unsigned mask =
+        static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
+    if (!mask) continue;
+    uchar b[kVector], a[kVector];
+    cv::v_store(b, before);
+    cv::v_store(a, after);
+    while (mask) {
+      const int k = std::countr_zero(mask);
+      candidates[k].push_back({y, b[k], a[k]});
+      mask &= mask - 1;
+    }
+  }
+#else
+  (void)rows_from;
+  for (int k = 0; k < kVector; ++k) {
+    const Profile p{image.ptr<uchar>(0) + x0 + k, static_cast<std::ptrdiff_t>(image.step), rows};
+    for (int y = 0; y < rows; ++y) AddIfCandidate(p, y, w, t, &candidates[k]);
+  }
+#endif
+}
+
+// row_start of `points`, given in order of their line (y).
+void IndexLines(int lines, RidgePoints* points) {
+  points->row_start.assign(static_cast<size_t>(lines) + 1, 0);
+  int line = 0;
+  for (size_t i = 0; i < points->points.size(); ++i)
+    while (line <= points->points[i].y) points->row_start[line++] = static_cast<int>(i);
+  while (line <= lines) points->row_start[line++] = static_cast<int>(points->points.size());
+}
+
+void CheckArguments(const char* who, const cv::Mat& smoothed, const RidgeParams& params) {
+  if (smoothed.empty() || smoothed.type() != CV_8UC1)
+    throw std::invalid_argument(std::string(who) + ": image must be a non-empty CV_8UC1 image");
+  std::string why;
+  if (!params.IsValid(&why)) throw std::invalid_argument(std::string(who) + ": " + why);
+}
+
+// The concatenation of `parts`.
+std::vector<RidgePoint> Joined(const std::vector<std::vector<RidgePoint>>& parts) {
+  size_t total = 0;
+  for (const auto& f : parts) total += f.size();
+  std::vector<RidgePoint> out;
+  out.reserve(total);
+  for (const auto& f : parts) out.insert(out.end(), f.begin(), f.end());
+  return out;
 }
 
 }  // namespace
 
 RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) {
-  if (smoothed.empty() || smoothed.type() != CV_8UC1)
-    throw std::invalid_argument("FindRidgePoints: image must be a non-empty CV_8UC1 image");
-  std::string why;
-  if (!params.IsValid(&why)) throw std::invalid_argument("FindRidgePoints: " + why);
-
+  CheckArguments("FindRidgePoints", smoothed, params);
   // Rows are independent: bands of them in parallel (cv::parallel_for_),
   // each row copied into a buffer padded by replication.
   const int bands = (smoothed.rows + kBandRows - 1) / kBandRows;
-  const int w = params.half_window, cols = smoothed.cols;
-  constexpr int kVector = 16;  // the vector loop reads up to this far past a row's last pixel
+  const int w = params.half_window, t = params.min_prominence, cols = smoothed.cols;
   std::vector<std::vector<RidgePoint>> found(bands);
   cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& r) {
     std::vector<uchar> padded(static_cast<size_t>(cols + 2 * w + kVector));
-    std::vector<int> candidates;
+    std::vector<Candidate> candidates;
     for (int b = r.start; b < r.end; ++b) {
       const int y1 = std::min((b + 1) * kBandRows, smoothed.rows);
       for (int y = b * kBandRows; y < y1; ++y) {
@@ -142,20 +248,50 @@ RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) 
         std::fill(padded.begin(), padded.begin() + w, row[0]);
         std::copy(row, row + cols, padded.begin() + w);
         std::fill(padded.begin() + w + cols, padded.end(), row[cols - 1]);
-        RowRidgePoints(padded.data() + w, cols, y, params, &candidates, &found[b]);
+        RowCandidates(padded.data() + w, cols, w, t, &candidates);
+        ProfileRidgePoints({row, 1, cols}, y, candidates, t, &found[b]);
       }
     }
   });
   RidgePoints out;
-  size_t total = 0;
-  for (const auto& f : found) total += f.size();
-  out.points.reserve(total);
-  for (const auto& f : found) out.points.insert(out.points.end(), f.begin(), f.end());
-  out.row_start.assign(static_cast<size_t>(smoothed.rows) + 1, 0);
-  int row = 0;
-  for (size_t i = 0; i < out.points.size(); ++i)
-    while (row <= out.points[i].y) out.row_start[row++] = static_cast<int>(i);
-  while (row <= smoothed.rows) out.row_start[row++] = static_cast<int>(out.points.size());
+  out.points = Joined(found);
+  IndexLines(smoothed.rows, &out);
+  return out;
+}
+
+RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) {
+  CheckArguments("FindColumnRidgePoints", smoothed, params);
+  // Blocks of kVector columns in parallel; the last, narrower block pixel by pixel.
+  const int w = params.half_window, t = params.min_prominence;
+  const int full_blocks = smoothed.cols / kVector;
+  const int blocks = (smoothed.cols + kVector - 1) / kVector;
+  const auto step = static_cast<std::ptrdiff_t>(smoothed.step);
+  std::vector<const uchar*> rows_from;
+  for (int y = -w - 1; y <= smoothed.rows + w; ++y)
+    rows_from.push_back(smoothed.ptr<uchar>(std::clamp(y, 0, smoothed.rows - 1)));
+  std::vector<std::vector<RidgePoint>> found(blocks);
+  cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& r) {
+    std::vector<Candidate> candidates[kVector];
+    for (int b = r.start; b < r.end; ++b) {
+      const int x0 = b * kVector;
+      const int width = std::min(kVector, smoothed.cols - x0);
+      if (b < full_blocks) {
+        ColumnBlockCandidates(smoothed, rows_from, x0, w, t, candidates);
+      } else {
+        for (int k = 0; k < width; ++k) {
+          candidates[k].clear();
+          const Profile p{smoothed.ptr<uchar>(0) + x0 + k, step, smoothed.rows};
+          for (int y = 0; y < smoothed.rows; ++y) AddIfCandidate(p, y, w, t, &candidates[k]);
+        }
+      }
+      for (int k = 0; k < width; ++k)
+        ProfileRidgePoints({smoothed.ptr<uchar>(0) + x0 + k, step, smoothed.rows}, x0 + k,
+                           candidates[k], t, &found[b]);
+    }
+  });
+  RidgePoints out;
+  out.points = Joined(found);
+  IndexLines(smoothed.cols, &out);
   return out;
 }
 

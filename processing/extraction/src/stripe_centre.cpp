@@ -646,22 +646,20 @@ std::vector<std::optional<double>> StripeCentresInRow(const cv::Mat& image, int 
                                 : MeasureCrowdedRow<float>(image, y, approximate_x, params);
 }
 
-std::optional<double> RidgeCentreInRow(const cv::Mat& image, int y, double approximate_x) {
-  // The smoothed profile is wanted at the guess +-2 px (where the peak is
-  // sought) and one pixel beyond; each smoothed value reads 2 px each side.
-  constexpr int kPeak = 2, kReach = kPeak + 3;
-  constexpr int kEdge = 9;  // px from the image's edges where nothing is measured
-  if (image.empty() || image.type() != CV_8UC1 || y < 0 || y >= image.rows ||
-      !std::isfinite(approximate_x))
-    return std::nullopt;
-  const int x0 = static_cast<int>(std::lround(approximate_x));
-  if (x0 - kEdge < 0 || x0 + kEdge >= image.cols) return std::nullopt;
-  const uchar* above = image.ptr<uchar>(std::max(y - 1, 0)) + x0 - kReach;
-  const uchar* row = image.ptr<uchar>(y) + x0 - kReach;
-  const uchar* below = image.ptr<uchar>(std::min(y + 1, image.rows - 1)) + x0 - kReach;
+namespace {
+
+// RidgeCentreInRow along any direction: pixel k of the profile (k = 0 ..
+// 2 * reach) is first[k * along], its neighbours across the stripe
+// first[k * along -+ across]. Returns the centre in profile units (0 = first).
+template <int kPeak, int kReach>
+std::optional<double> RidgeCentreAlong(const uchar* first, std::ptrdiff_t along,
+                                       std::ptrdiff_t across) {
   constexpr int kSize = 2 * kReach + 1;
   int profile[kSize];
-  for (int k = 0; k < kSize; ++k) profile[k] = above[k] + 2 * row[k] + below[k];
+  for (int k = 0; k < kSize; ++k) {
+    const uchar* p = first + k * along;
+    profile[k] = p[-across] + 2 * p[0] + p[across];
+  }
   int smooth[kSize] = {};
   for (int k = 2; k < kSize - 2; ++k)
     smooth[k] = profile[k - 2] + 4 * profile[k - 1] + 6 * profile[k] + 4 * profile[k + 1] +
@@ -672,7 +670,38 @@ std::optional<double> RidgeCentreInRow(const cv::Mat& image, int y, double appro
   // Differences at peak - 1/2 and peak + 1/2: rising, then falling.
   const double rise = smooth[peak] - smooth[peak - 1], fall = smooth[peak + 1] - smooth[peak];
   if (rise < 0 || fall > 0 || rise == fall) return std::nullopt;
-  return x0 - kReach + (peak - 0.5) + rise / (rise - fall);
+  return (peak - 0.5) + rise / (rise - fall);
+}
+
+// The smoothed profile is wanted at the guess +-2 px (where the peak is
+// sought) and one pixel beyond; each smoothed value reads 2 px each side.
+constexpr int kRidgePeak = 2, kRidgeReach = kRidgePeak + 3;
+constexpr int kRidgeEdge = 9;  // px from the image's edges where nothing is measured
+
+}  // namespace
+
+std::optional<double> RidgeCentreInRow(const cv::Mat& image, int y, double approximate_x) {
+  if (image.empty() || image.type() != CV_8UC1 || y < 1 || y >= image.rows - 1 ||
+      !std::isfinite(approximate_x))
+    return std::nullopt;
+  const int x0 = static_cast<int>(std::lround(approximate_x));
+  if (x0 - kRidgeEdge < 0 || x0 + kRidgeEdge >= image.cols) return std::nullopt;
+  const auto c = RidgeCentreAlong<kRidgePeak, kRidgeReach>(
+      image.ptr<uchar>(y) + x0 - kRidgeReach, 1, static_cast<std::ptrdiff_t>(image.step));
+  if (!c) return std::nullopt;
+  return x0 - kRidgeReach + *c;
+}
+
+std::optional<double> RidgeCentreInColumn(const cv::Mat& image, int x, double approximate_y) {
+  if (image.empty() || image.type() != CV_8UC1 || x < 1 || x >= image.cols - 1 ||
+      !std::isfinite(approximate_y))
+    return std::nullopt;
+  const int y0 = static_cast<int>(std::lround(approximate_y));
+  if (y0 - kRidgeEdge < 0 || y0 + kRidgeEdge >= image.rows) return std::nullopt;
+  const auto c = RidgeCentreAlong<kRidgePeak, kRidgeReach>(
+      image.ptr<uchar>(y0 - kRidgeReach) + x, static_cast<std::ptrdiff_t>(image.step), 1);
+  if (!c) return std::nullopt;
+  return y0 - kRidgeReach + *c;
 }
 
 }  // namespace bsls::extraction

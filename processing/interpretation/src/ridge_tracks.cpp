@@ -15,6 +15,8 @@ bool TrackParams::IsValid(std::string* error) const {
   if (min_track < 1) return fail("min_track must be at least 1");
   if (min_segment < 1) return fail("min_segment must be at least 1");
   if (!(end_reach > 0)) return fail("end_reach must be positive");
+  if (bridge_rows < 1) return fail("bridge_rows must be at least 1");
+  if (!(bridge_distance > 0)) return fail("bridge_distance must be positive");
   return true;
 }
 
@@ -73,6 +75,44 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
   net.columns = std::move(columns);
   net.lines = LinkTracks(net.rows, params, &net.line_of_point);
   net.segments = LinkTracks(net.columns, params);
+
+  // Gaps in lines: each track's end and the start of the nearest track
+  // beginning within bridge_rows below it, when each is the other's nearest.
+  const int n_lines = static_cast<int>(net.lines.size());
+  auto first = [&](int t) { return net.rows.points[net.lines[t].points.front()]; };
+  auto last = [&](int t) { return net.rows.points[net.lines[t].points.back()]; };
+  auto gap = [&](int above, int below) {
+    const extraction::RidgePoint a = last(above), b = first(below);
+    const int rows_between = b.y - a.y;
+    if (rows_between < 1 || rows_between > params.bridge_rows) return -1.0;
+    const double d = std::hypot(b.x - a.x, static_cast<double>(rows_between));
+    return d <= params.bridge_distance ? d : -1.0;
+  };
+  std::vector<int> nearest_below(n_lines, -1), nearest_above(n_lines, -1);
+  std::vector<double> below_d(n_lines, 0), above_d(n_lines, 0);
+  for (int a = 0; a < n_lines; ++a)
+    for (int b = 0; b < n_lines; ++b) {
+      if (a == b) continue;
+      const double d = gap(a, b);
+      if (d < 0) continue;
+      if (nearest_below[a] < 0 || d < below_d[a]) {
+        nearest_below[a] = b;
+        below_d[a] = d;
+      }
+      if (nearest_above[b] < 0 || d < above_d[b]) {
+        nearest_above[b] = a;
+        above_d[b] = d;
+      }
+    }
+  net.line_below.assign(n_lines, -1);
+  net.line_above.assign(n_lines, -1);
+  for (int a = 0; a < n_lines; ++a) {
+    const int b = nearest_below[a];
+    if (b >= 0 && nearest_above[b] == a) {
+      net.line_below[a] = b;
+      net.line_above[b] = a;
+    }
+  }
 
   // The line point of row y within [lo, hi] nearest to `at`, or -1.
   auto line_point = [&](int y, double lo, double hi, double at) {

@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <queue>
+#include <set>
 #include <stdexcept>
 #include <tuple>
 
@@ -20,9 +21,10 @@ struct Link {
   double weight = 1.0;
 };
 
-constexpr double kOneRow = 1.0;      // a step of one or two rows along a line, or a segment
-constexpr double kPerLongRow = 10.0;  // per row of a longer step: over a gap, only when no
-                                      // path of single steps reaches the junction
+constexpr double kTrusted = 0.01;  // a link of a brick that closes (thesis: a complete loop)
+constexpr double kPlain = 10.0;    // any other step of one or two rows, or segment: a path
+                                   // through closed bricks beats any path with one such link;
+                                   // a longer step costs this per row
 
 double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -111,8 +113,12 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   }
   const double frame_spacing = Median(all_spacing);
 
-  // Links along lines: consecutive junctions of a track, a whole number of rows apart.
-  std::vector<std::vector<Link>> adj(n);
+  // Steps along lines: consecutive junctions of a track, a whole number of rows apart.
+  struct Step {
+    int to = -1;
+    int rows = 0;
+  };
+  std::vector<Step> down(n);  // the next junction down the junction's line track
   for (size_t t = 0; t < net.lines.size(); ++t) {
     const std::vector<int>& on = net.junctions_on_line[t];
     const double s = own_spacing[t] > 0 ? own_spacing[t] : frame_spacing;
@@ -132,22 +138,61 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
       // A step that fits no whole number of rows of its parity joins a false
       // junction (a segment's end on the wrong line): no link.
       if (miss > params.max_row_miss * s) continue;
-      const double w = rows <= 2 ? kOneRow : kPerLongRow * rows;
-      adj[on[i - 1]].push_back({on[i], 0, rows, w});
-      adj[on[i]].push_back({on[i - 1], 0, -rows, w});
+      down[on[i - 1]] = {on[i], rows};
     }
   }
-  // Links across segments: a segment with a direct junction at one end and
-  // a corresponding one at the other joins lines p and p + 1.
+  // Segments: a direct junction at one end and a corresponding one at the
+  // other join lines p and p + 1.
+  std::vector<int> across(n, -1);  // for a direct junction: its segment's corresponding end
   std::map<int, std::pair<int, int>> ends;  // segment -> (direct, corresponding)
   for (int j = 0; j < n; ++j) {
     auto& e = ends.try_emplace(net.junctions[j].segment, -1, -1).first->second;
     (net.junctions[j].kind == JunctionKind::kDirect ? e.first : e.second) = j;
   }
-  for (const auto& [segment, e] : ends) {
-    if (e.first < 0 || e.second < 0) continue;
-    adj[e.first].push_back({e.second, +1, 0, kOneRow});
-    adj[e.second].push_back({e.first, -1, 0, kOneRow});
+  for (const auto& [segment, e] : ends)
+    if (e.first >= 0 && e.second >= 0) across[e.first] = e.second;
+
+  // Thesis 5.1.4.1: a complete loop. The brick below segment A-B (A direct
+  // on line p, B corresponding on p + 1) closes when both lines run down
+  // exactly two rows, through their median junctions, to the ends of one
+  // segment; its six links are trusted.
+  auto two_rows_down = [&](int j, std::vector<int>* path) {
+    int rows = 0;
+    for (int cur = j; rows < 2;) {
+      if (down[cur].to < 0) return -1;
+      rows += down[cur].rows;
+      path->push_back(cur);
+      cur = down[cur].to;
+      if (rows == 2) return cur;
+    }
+    return -1;
+  };
+  std::set<std::pair<int, int>> trusted;  // (upper or direct, lower or corresponding)
+  for (int a = 0; a < n; ++a) {
+    const int b = across[a];
+    if (b < 0) continue;
+    std::vector<int> left_path, right_path;
+    const int a2 = two_rows_down(a, &left_path), b2 = two_rows_down(b, &right_path);
+    if (a2 < 0 || b2 < 0 || across[a2] != b2) continue;
+    trusted.insert({a, b});
+    trusted.insert({a2, b2});
+    for (const auto* path : {&left_path, &right_path})
+      for (int j : *path) trusted.insert({j, down[j].to});
+  }
+  std::vector<std::vector<Link>> adj(n);
+  for (int j = 0; j < n; ++j) {
+    if (const Step st = down[j]; st.to >= 0) {
+      const double w = trusted.count({j, st.to}) ? kTrusted
+                       : st.rows <= 2          ? kPlain
+                                               : kPlain * st.rows;
+      adj[j].push_back({st.to, 0, st.rows, w});
+      adj[st.to].push_back({j, 0, -st.rows, w});
+    }
+    if (const int c = across[j]; c >= 0) {
+      const double w = trusted.count({j, c}) ? kTrusted : kPlain;
+      adj[j].push_back({c, +1, 0, w});
+      adj[c].push_back({j, -1, 0, w});
+    }
   }
 
   // Seeds: line 0's direct junctions in order down the image, two rows per
@@ -186,7 +231,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
       centre_seed = i;
   std::vector<double> seed_cost(seeds.size());
   for (size_t i = 0; i < seeds.size(); ++i)
-    seed_cost[i] = kPerLongRow * std::abs(seed_v[i] - seed_v[centre_seed]);
+    seed_cost[i] = kPlain * std::abs(seed_v[i] - seed_v[centre_seed]);
 
   // Propagation, cheapest paths first (Dijkstra over the link weights).
   std::vector<double> cost(n, std::numeric_limits<double>::infinity());

@@ -61,9 +61,12 @@ struct TrackChainParams {
   extraction::RidgeParams ridge;
   interpretation::TrackParams tracks;
   interpretation::TrackLabellingParams labelling;
-  // Rows each side of a line centre whose centres judge it (an outlier beyond
-  // max_centre_residual is dropped) and refill the rows skipped beside a
-  // junction, >= 1.
+  // px: a line centre further than this from its ridge point (the peak of
+  // the smoothed frame the track followed) is dropped: it took another
+  // stripe's light, > 0.
+  double max_centre_shift = 0.5;
+  // A row skipped beside a junction is refilled from the line's centres
+  // within this many rows of the skipped ones on both sides, >= 1.
   int centre_fit_rows = 5;
   // Columns of a segment measured next to its junction to place it, >= 2.
   int segment_columns = 10;

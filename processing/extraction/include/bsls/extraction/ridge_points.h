@@ -57,6 +57,11 @@ struct RidgePoints {
 // invalid params.
 RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params = {});
 
+// The same along the columns: FindRidgePoints of the transposed image,
+// without transposing it. A point's x is its sub-pixel row, its y its
+// column, and RidgePoints::Row(x) holds column x's points from top to bottom.
+RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& params = {});
+
 }  // namespace bsls::extraction
 
 #endif  // BSLS_EXTRACTION_RIDGE_POINTS_H_

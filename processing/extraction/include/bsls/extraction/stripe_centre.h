@@ -90,9 +90,13 @@ std::optional<double> StripeCentreInColumn(const cv::Mat& image, int x, double a
 // track chain (docs/decoding.md, "The track chain"): rows y-1, y, y+1
 // weighted 1-2-1, smoothed by a 5-tap binomial (sigma 1 px), and the zero of
 // its first difference at the brightest smoothed pixel, interpolated
-// linearly. Nullopt within 9 px of the image's left or right edge or where
-// that pixel is no peak.
+// linearly. Nullopt in the first and last row, within 9 px of the image's
+// left or right edge, or where that pixel is no peak.
 std::optional<double> RidgeCentreInRow(const cv::Mat& image, int y, double approximate_x);
+
+// The same across a (roughly horizontal) stripe crossing column x near
+// y = approximate_y (columns x-1, x, x+1 weighted 1-2-1).
+std::optional<double> RidgeCentreInColumn(const cv::Mat& image, int x, double approximate_y);
 
 // Sub-pixel x of (roughly vertical) stripes crossing row y close together,
 // near approximate_x (ascending): one pixel-integrated Gaussian per stripe

@@ -36,6 +36,12 @@ struct TrackParams {
   // px: a segment's end meets a line whose ridge point lies this close to
   // it in the end's row (or the rows either side), > 0.
   double end_reach = 6.0;
+  // A line track continues in another that starts at most bridge_rows rows
+  // below its end and bridge_distance px from it, the two being each other's
+  // nearest (a line broken where it turns too sharply for max_step, at a
+  // fold, or cut by a shadow), >= 1 and > 0.
+  int bridge_rows = 12;
+  double bridge_distance = 8.0;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
@@ -57,7 +63,7 @@ struct TrackJunction {
 
 struct TrackNetwork {
   extraction::RidgePoints rows;     // ridge points along the rows: the lines' crossings
-  // Ridge points along the columns, found on the transposed image: a point's
+  // Ridge points along the columns (extraction::FindColumnRidgePoints): a point's
   // x is an image row, its y an image column.
   extraction::RidgePoints columns;
   std::vector<Track> lines;     // tracks through `rows`
@@ -65,6 +71,9 @@ struct TrackNetwork {
   std::vector<int> line_of_point;  // for each point of `rows`: its line track, or -1
   std::vector<TrackJunction> junctions;
   std::vector<std::vector<int>> junctions_on_line;  // per line track: its junctions by increasing y
+  // Per line track: the track continuing it across a gap below / above it, or -1.
+  std::vector<int> line_below;
+  std::vector<int> line_above;
 };
 
 // Links ridge points from row to row into tracks: each point to the nearest
