@@ -118,6 +118,8 @@ void BM_DecodeNothingAhead(benchmark::State& state) {
   DecodeWithThreads(state, 0, params);
 }
 
+// The track chain: the same as BM_Decode and BM_DecodeSingleThread with
+// DecodeChain::kTracks.
 void BM_DecodeTracks(benchmark::State& state) {
   bsls::decoder::DecodeParams params;
   params.chain = bsls::decoder::DecodeChain::kTracks;

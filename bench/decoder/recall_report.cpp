@@ -194,8 +194,16 @@ void Report(SurfaceKind kind, Side side, std::uint32_t seed, const Options& o, T
                 m.position.y, t ? std::string(bsls::pattern::ToString(t->kind)).c_str() : "",
                 t ? Reason(*t, m.position, decoded, s.v_offset, o.size, o.size).c_str() : "");
   }
-  for (const auto& m : s.wrong)
+  for (const auto& m : s.wrong) {
+    if (!o.crops.empty()) {
+      char file[160];
+      std::snprintf(file, sizeof file, "/wrong_%s_%s_%u_p%d_v%d.png",
+                    std::string(bsls::simulator::ToString(kind)).c_str(),
+                    std::string(bsls::pattern::ToString(side)).c_str(), seed, m.p, m.v);
+      WriteCrop(o.crops + file, frame.image, r, m.position);
+    }
     std::printf("    WRONG  p %2d v %3d at (%7.2f, %7.2f)\n", m.p, m.v, m.position.x, m.position.y);
+  }
   if (o.extra) {
     // Decoded junctions with no truth junction within reach.
     for (const auto& d : decoded) {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
+#include <tuple>
 #include <optional>
 #include <vector>
 
@@ -70,17 +70,35 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
     const auto x = extraction::RidgeCentreInRow(grey, p.y, p.x);
     if (x && std::abs(*x - p.x) <= params.track_chain.max_centre_shift) c.measured[i] = *x;
   }
+  // Refill: each run of rows without a centre (the rows beside a junction,
+  // and a centre or two dropped next to them) from one parabola through the
+  // measured centres within centre_fit_rows on both sides of it.
   const int reach = params.track_chain.centre_fit_rows;
-  Samples near;
-  // Refill: rows without a centre, from measured centres on both sides.
+  const int longest = 2 * clearance + 3;
   c.output = c.measured;
-  for (int i = 0; i < n; ++i) {
-    if (!std::isnan(c.output[i])) continue;
-    MeasuredNear(c, c.first_row + i, reach + clearance, false, &near);
-    const bool above = std::any_of(near.begin(), near.end(), [](const auto& s) { return s.first < 0; });
-    const bool below = std::any_of(near.begin(), near.end(), [](const auto& s) { return s.first > 0; });
-    if (!above || !below) continue;
-    if (auto fit = FitAtZero(near)) c.output[i] = *fit;
+  Samples near;
+  for (int g0 = 0; g0 < n;) {
+    if (!std::isnan(c.measured[g0])) {
+      ++g0;
+      continue;
+    }
+    int g1 = g0;
+    while (g1 + 1 < n && std::isnan(c.measured[g1 + 1])) ++g1;
+    const int gap_start = g0;
+    g0 = g1 + 1;
+    if (gap_start == 0 || g1 == n - 1 || g1 - gap_start + 1 > longest) continue;
+    const double middle = 0.5 * (gap_start + g1);
+    near.clear();
+    for (int i = std::max(gap_start - reach, 0); i <= std::min(g1 + reach, n - 1); ++i)
+      if (!std::isnan(c.measured[i])) near.emplace_back(i - middle, c.measured[i]);
+    cv::Vec3d q;
+    double a, b;
+    if (FitParabola(near, &q)) {
+      for (int i = gap_start; i <= g1; ++i)
+        c.output[i] = q[0] + (i - middle) * (q[1] + (i - middle) * q[2]);
+    } else if (FitLine(near, &a, &b)) {
+      for (int i = gap_start; i <= g1; ++i) c.output[i] = a + b * (i - middle);
+    }
   }
   return c;
 }
@@ -224,19 +242,23 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   // Junctions: one per label; where two claim one, the one on a track of
   // its own p (then the first) keeps it.
   const int q_offset = params.q_offset.value_or(0);
-  std::map<std::pair<int, int>, int> by_label;
-  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j) {
-    if (labels.p[j] == interpretation::kUnlabelled) continue;
-    const auto key = std::make_pair(labels.p[j], labels.v[j]);
-    const auto [it, fresh] = by_label.emplace(key, j);
-    if (fresh) continue;
-    ++result->label_conflicts;
-    const bool mine = labels.line_p[net.junctions[j].line] == labels.p[j];
-    const bool theirs = labels.line_p[net.junctions[it->second].line] == labels.p[it->second];
-    if (mine && !theirs) it->second = j;
-  }
+  std::vector<std::tuple<int, int, int>> claims;  // (p, v, junction), in junction order
+  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
+    if (labels.p[j] != interpretation::kUnlabelled) claims.emplace_back(labels.p[j], labels.v[j], j);
+  std::sort(claims.begin(), claims.end());
+  auto on_own_line = [&](int j) { return labels.line_p[net.junctions[j].line] == labels.p[j]; };
   std::vector<int> placed;
-  for (const auto& [key, j] : by_label) placed.push_back(j);
+  for (size_t i = 0; i < claims.size();) {
+    size_t k = i;
+    int keeper = std::get<2>(claims[i]);
+    for (; k < claims.size() && std::get<0>(claims[k]) == std::get<0>(claims[i]) &&
+           std::get<1>(claims[k]) == std::get<1>(claims[i]);
+         ++k)
+      if (!on_own_line(keeper) && on_own_line(std::get<2>(claims[k]))) keeper = std::get<2>(claims[k]);
+    result->label_conflicts += static_cast<int>(k - i) - 1;
+    placed.push_back(keeper);
+    i = k;
+  }
   result->junctions.resize(placed.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(placed.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
@@ -249,19 +271,24 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     }
   });
 
-  // Lines: the centres of all tracks of one p, one per row.
-  std::map<int, std::map<int, double>> by_line;
-  for (int i : labelled) {
+  // Lines: the centres of all tracks of one p, one per row (the first
+  // labelled track's where two hold one row).
+  std::vector<std::tuple<int, int, int, double>> rows_of_lines;  // (p, y, track order, x)
+  for (size_t order = 0; order < labelled.size(); ++order) {
+    const int i = labelled[order];
     const TrackCentres& c = centres[i];
-    auto& rows_of_line = by_line[labels.line_p[i]];
     for (size_t k = 0; k < c.output.size(); ++k)
-      if (!std::isnan(c.output[k])) rows_of_line.emplace(c.first_row + static_cast<int>(k), c.output[k]);
+      if (!std::isnan(c.output[k]))
+        rows_of_lines.emplace_back(labels.line_p[i], c.first_row + static_cast<int>(k),
+                                   static_cast<int>(order), c.output[k]);
   }
-  for (const auto& [p, rows_of_line] : by_line) {
-    DecodedLine line;
-    line.p = p;
-    for (const auto& [y, x] : rows_of_line) line.points.emplace_back(x, y);
-    if (!line.points.empty()) result->lines.push_back(std::move(line));
+  std::sort(rows_of_lines.begin(), rows_of_lines.end());
+  for (size_t i = 0; i < rows_of_lines.size(); ++i) {
+    const auto& [p, y, order, x] = rows_of_lines[i];
+    if (i > 0 && std::get<0>(rows_of_lines[i - 1]) == p && std::get<1>(rows_of_lines[i - 1]) == y)
+      continue;
+    if (result->lines.empty() || result->lines.back().p != p) result->lines.push_back({p, {}});
+    result->lines.back().points.emplace_back(x, y);
   }
   result->times.subpixel_ms = MsSince(t);
   result->ok = true;

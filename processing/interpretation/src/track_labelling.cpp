@@ -5,7 +5,6 @@
 #include <limits>
 #include <map>
 #include <queue>
-#include <set>
 #include <stdexcept>
 #include <tuple>
 
@@ -144,13 +143,14 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // Segments: a direct junction at one end and a corresponding one at the
   // other join lines p and p + 1.
   std::vector<int> across(n, -1);  // for a direct junction: its segment's corresponding end
-  std::map<int, std::pair<int, int>> ends;  // segment -> (direct, corresponding)
+  // Per segment track: its (direct, corresponding) junctions.
+  std::vector<std::pair<int, int>> ends(net.segments.size(), {-1, -1});
   for (int j = 0; j < n; ++j) {
-    auto& e = ends.try_emplace(net.junctions[j].segment, -1, -1).first->second;
+    auto& e = ends[net.junctions[j].segment];
     (net.junctions[j].kind == JunctionKind::kDirect ? e.first : e.second) = j;
   }
-  for (const auto& [segment, e] : ends)
-    if (e.first >= 0 && e.second >= 0) across[e.first] = e.second;
+  for (const auto& [direct, corresponding] : ends)
+    if (direct >= 0 && corresponding >= 0) across[direct] = corresponding;
 
   // Thesis 5.1.4.1: a complete loop. The brick below segment A-B (A direct
   // on line p, B corresponding on p + 1) closes when both lines run down
@@ -167,29 +167,30 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     }
     return -1;
   };
-  std::set<std::pair<int, int>> trusted;  // (upper or direct, lower or corresponding)
+  std::vector<char> trusted_down(n, 0), trusted_across(n, 0);  // the junction's step / segment
+  std::vector<int> left_path, right_path;
   for (int a = 0; a < n; ++a) {
     const int b = across[a];
     if (b < 0) continue;
-    std::vector<int> left_path, right_path;
+    left_path.clear();
+    right_path.clear();
     const int a2 = two_rows_down(a, &left_path), b2 = two_rows_down(b, &right_path);
     if (a2 < 0 || b2 < 0 || across[a2] != b2) continue;
-    trusted.insert({a, b});
-    trusted.insert({a2, b2});
+    trusted_across[a] = trusted_across[a2] = 1;
     for (const auto* path : {&left_path, &right_path})
-      for (int j : *path) trusted.insert({j, down[j].to});
+      for (int j : *path) trusted_down[j] = 1;
   }
   std::vector<std::vector<Link>> adj(n);
   for (int j = 0; j < n; ++j) {
     if (const Step st = down[j]; st.to >= 0) {
-      const double w = trusted.count({j, st.to}) ? kTrusted
+      const double w = trusted_down[j] ? kTrusted
                        : st.rows <= 2          ? kPlain
                                                : kPlain * st.rows;
       adj[j].push_back({st.to, 0, st.rows, w});
       adj[st.to].push_back({j, 0, -st.rows, w});
     }
     if (const int c = across[j]; c >= 0) {
-      const double w = trusted.count({j, c}) ? kTrusted : kPlain;
+      const double w = trusted_across[j] ? kTrusted : kPlain;
       adj[j].push_back({c, +1, 0, w});
       adj[c].push_back({j, -1, 0, w});
     }
