@@ -135,7 +135,8 @@ void RowCandidates(const uchar* s, int cols, int w, int t, std::vector<Candidate
   // The last step overlaps the one before it where the inner part is no
   // whole number of steps; its lanes done already are masked off.
   const int inner_begin = x;
-  for (int done = x; x < inner_end && inner_end - inner_begin >= kVector; x += kVector) {
+  const bool vectors = inner_end - inner_begin >= kVector;
+  for (int done = x; vectors && x < inner_end; x += kVector) {
     const int from = std::min(x, inner_end - kVector);
     const cv::v_uint8x16 v = cv::v_load(s + from);
     const cv::v_uint8x16 peak = (v >= cv::v_load(s + from - 1)) & (v >= cv::v_load(s + from + 1));
@@ -155,7 +156,7 @@ void RowCandidates(const uchar* s, int cols, int w, int t, std::vector<Candidate
     AddLanes(mask, from, before, after, candidates);
     done = from + kVector;
   }
-  x = std::max(x, inner_end);
+  if (vectors) x = inner_end;  // the steps covered the inner part up to here
 #endif
   for (; x < cols; ++x) AddIfCandidate(p, x, w, t, candidates);
 }
