@@ -15,6 +15,8 @@ bool TrackParams::IsValid(std::string* error) const {
   if (min_track < 1) return fail("min_track must be at least 1");
   if (min_segment < 1) return fail("min_segment must be at least 1");
   if (!(end_reach > 0)) return fail("end_reach must be positive");
+  if (end_skip < 0 || end_fit < 2) return fail("end_skip must be >= 0 and end_fit >= 2");
+  if (!(end_bend >= 0)) return fail("end_bend must not be negative");
   if (bridge_rows < 1) return fail("bridge_rows must be at least 1");
   if (!(bridge_distance > 0)) return fail("bridge_distance must be positive");
   return true;
@@ -135,7 +137,30 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
     const double middle = 0.5 * (cp[t.front()].y + cp[t.back()].y);
     for (const bool left_end : {true, false}) {
       const extraction::RidgePoint& end = cp[left_end ? t.front() : t.back()];
-      const double ex = end.y, ey = end.x;
+      const double ex = end.y;
+      // The segment's row at its end; where its last points bend away from
+      // a straight line through the points a few columns in (next to the
+      // line the light of both strokes can pull them, at a line's end most),
+      // from that line.
+      double ey = end.x;
+      const int n_points = static_cast<int>(t.size());
+      if (n_points >= params.end_skip + 2) {
+        double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
+        for (int k = params.end_skip; k < std::min(n_points, params.end_skip + params.end_fit); ++k) {
+          const extraction::RidgePoint& q = cp[left_end ? t[k] : t[n_points - 1 - k]];
+          const double x = q.y - ex, y = q.x;
+          sx += x;
+          sy += y;
+          sxx += x * x;
+          sxy += x * y;
+          n += 1;
+        }
+        const double den = n * sxx - sx * sx;
+        if (den > 0) {
+          const double fit = (sy * sxx - sx * sxy) / den;  // the fit's value at x = ex
+          if (std::abs(fit - ey) > params.end_bend) ey = fit;
+        }
+      }
       const double lo = left_end ? ex - params.end_reach : std::max(ex - params.end_reach, middle);
       const double hi = left_end ? std::min(ex + params.end_reach, middle) : ex + params.end_reach;
       int hit = -1;
@@ -143,16 +168,31 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
         hit = line_point(static_cast<int>(std::lround(ey)) + dy, lo, hi, ex);
         if (hit >= 0) break;
       }
-      if (hit < 0) continue;
       TrackJunction j;
-      j.line = net.line_of_point[hit];
+      if (hit >= 0) {
+        j.line = net.line_of_point[hit];
+        j.position = {net.rows.points[hit].x, static_cast<double>(net.rows.points[hit].y)};
+      } else {
+        // No ridge point there: the end may meet a line across a gap, on the
+        // chord joining its two tracks (a break next to the junction).
+        for (int a = 0; a < n_lines && j.line < 0; ++a) {
+          const int b = net.line_below[a];
+          if (b < 0) continue;
+          const extraction::RidgePoint p0 = last(a), p1 = first(b);
+          if (ey <= p0.y || ey >= p1.y) continue;
+          const double x = p0.x + (p1.x - p0.x) * (ey - p0.y) / (p1.y - p0.y);
+          if (x < lo || x > hi) continue;
+          j.line = a;
+          j.position = {x, ey};
+        }
+        if (j.line < 0) continue;
+      }
       j.segment = s;
       // The left end meets the line on its left: the segment lies to its right.
       j.segment_left = !left_end;
       const int segment_direction = j.segment_left ? -1 : +1;
       j.kind = segment_direction == towards_p ? pattern::JunctionKind::kDirect
                                               : pattern::JunctionKind::kCorresponding;
-      j.position = {net.rows.points[hit].x, static_cast<double>(net.rows.points[hit].y)};
       net.junctions.push_back(j);
     }
   }

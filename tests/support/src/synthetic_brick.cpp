@@ -53,6 +53,20 @@ SyntheticBrick DrawSyntheticBrick(const SyntheticBrickParams& params) {
   return b;
 }
 
+cv::Mat RenderGrey(const SyntheticBrick& brick, double noise_sigma, unsigned seed) {
+  cv::Mat strokes, grey;
+  cv::dilate(brick.skeleton, strokes, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}));
+  strokes.convertTo(grey, CV_32F, 180.0 / 255.0, 20.0);
+  cv::GaussianBlur(grey, grey, cv::Size(0, 0), 1.0);
+  cv::Mat noise(grey.size(), CV_32F);
+  cv::RNG rng(seed);
+  rng.fill(noise, cv::RNG::NORMAL, 0.0, noise_sigma);
+  grey += noise;
+  cv::Mat out;
+  grey.convertTo(out, CV_8U);
+  return out;
+}
+
 const TruthJunction* FindTruth(const SyntheticBrick& brick, int p, int v) {
   for (const TruthJunction& j : brick.junctions)
     if (j.p == p && j.v == v) return &j;

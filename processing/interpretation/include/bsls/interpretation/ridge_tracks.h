@@ -36,6 +36,13 @@ struct TrackParams {
   // px: a segment's end meets a line whose ridge point lies this close to
   // it in the end's row (or the rows either side), > 0.
   double end_reach = 6.0;
+  // The row where a segment's end meets its line is its end point's, or,
+  // where that lies more than end_bend rows off a straight line through
+  // end_fit of its points end_skip in from the end (a segment of end_skip + 2
+  // points or more), the line's; >= 0, >= 2 and >= 0.
+  int end_skip = 3;
+  int end_fit = 6;
+  double end_bend = 2.5;
   // A line track continues in another that starts at most bridge_rows rows
   // below its end and bridge_distance px from it, the two being each other's
   // nearest (a line broken where it turns too sharply for max_step, at a
@@ -58,7 +65,9 @@ struct TrackJunction {
   int segment = -1;  // the segment's track
   bool segment_left = false;  // the segment lies to the left of the line in the image
   pattern::JunctionKind kind = pattern::JunctionKind::kDirect;
-  cv::Point2d position;  // the line's ridge point in the row where the segment's end meets it
+  // Where the segment's end meets the line: the line's ridge point in that
+  // row, or the point of the chord across a gap in the line.
+  cv::Point2d position;
 };
 
 struct TrackNetwork {

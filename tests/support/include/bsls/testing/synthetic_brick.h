@@ -47,6 +47,11 @@ struct SyntheticBrick {
 // Draws the skeleton and lists its junctions.
 SyntheticBrick DrawSyntheticBrick(const SyntheticBrickParams& params);
 
+// A grey frame of the skeleton as a camera would see it: every stroke
+// dilated to 3 px, blurred (Gaussian, 1 px), 200 grey levels on a ground of
+// 20, with seeded Gaussian noise of `noise_sigma` grey levels.
+cv::Mat RenderGrey(const SyntheticBrick& brick, double noise_sigma = 2.0, unsigned seed = 1);
+
 // The truth junction (p, v), or nullptr.
 const TruthJunction* FindTruth(const SyntheticBrick& brick, int p, int v);
 

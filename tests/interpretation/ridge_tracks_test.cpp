@@ -1,0 +1,136 @@
+#include "bsls/interpretation/ridge_tracks.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "bsls/testing/synthetic_brick.h"
+
+namespace bsls::interpretation {
+namespace {
+
+using extraction::RidgePoint;
+using extraction::RidgePoints;
+using testing::DrawSyntheticBrick;
+using testing::RenderGrey;
+using testing::SyntheticBrick;
+using testing::SyntheticBrickParams;
+
+constexpr double kJunctionReach = 2.5;  // px between a network junction and the true one
+
+// Ridge points from (x, y) pairs given in raster order.
+RidgePoints Points(int rows, const std::vector<std::pair<float, int>>& at) {
+  RidgePoints out;
+  for (const auto& [x, y] : at) out.points.push_back({x, y, 50});
+  out.row_start.assign(rows + 1, 0);
+  int row = 0;
+  for (size_t i = 0; i < out.points.size(); ++i)
+    while (row <= out.points[i].y) out.row_start[row++] = static_cast<int>(i);
+  while (row <= rows) out.row_start[row++] = static_cast<int>(out.points.size());
+  return out;
+}
+
+TrackNetwork NetworkOf(const cv::Mat& grey, pattern::Side side, const TrackParams& params = {}) {
+  cv::Mat s;
+  cv::GaussianBlur(grey, s, cv::Size(0, 0), 1.0, 1.0, cv::BORDER_REPLICATE);
+  return BuildTrackNetwork(extraction::FindRidgePoints(s), extraction::FindColumnRidgePoints(s),
+                           side, params);
+}
+
+TEST(RidgeTracks, PointsLinkRowToRowWithinTheStep) {
+  // A line leaning 1 px per row, one jumping 3 px at row 4, and a short one.
+  std::vector<std::pair<float, int>> at;
+  for (int y = 0; y < 8; ++y) {
+    at.push_back({10.0f + y, y});
+    at.push_back({40.0f + (y >= 4 ? 3.0f : 0.0f), y});
+    if (y < 2) at.push_back({70.0f, y});
+  }
+  std::sort(at.begin(), at.end(), [](auto a, auto b) { return a.second != b.second ? a.second < b.second : a.first < b.first; });
+  const RidgePoints points = Points(8, at);
+  std::vector<int> track_of;
+  const std::vector<Track> tracks = LinkTracks(points, {}, &track_of);
+  ASSERT_EQ(tracks.size(), 3u);  // the leaning line and the jumping one's two halves; not the short one
+  EXPECT_EQ(tracks[0].points.size(), 8u);
+  EXPECT_EQ(tracks[1].points.size(), 4u);
+  EXPECT_EQ(tracks[2].points.size(), 4u);
+  for (size_t k = 1; k < tracks[0].points.size(); ++k)
+    EXPECT_EQ(points.points[tracks[0].points[k]].y, points.points[tracks[0].points[k - 1]].y + 1);
+  int unlinked = 0;
+  for (int t : track_of) unlinked += t < 0;
+  EXPECT_EQ(unlinked, 2);  // the short line's two points
+}
+
+TEST(RidgeTracks, TheNearerClaimantKeepsAPoint) {
+  // Two points of row 0 both nearest to the one point of row 1.
+  const RidgePoints points = Points(4, {{10.0f, 0}, {11.0f, 0}, {10.8f, 1}, {10.8f, 2}, {10.8f, 3}});
+  TrackParams params;
+  params.min_track = 1;
+  std::vector<int> track_of;
+  const std::vector<Track> tracks = LinkTracks(points, params, &track_of);
+  ASSERT_EQ(tracks.size(), 2u);
+  EXPECT_EQ(track_of[1], track_of[2]);  // x 11.0 is 0.2 away, x 10.0 0.8
+  EXPECT_NE(track_of[0], track_of[2]);
+}
+
+class CleanBrickTracks : public ::testing::TestWithParam<pattern::Side> {};
+
+TEST_P(CleanBrickTracks, EveryJunctionFoundWithItsKind) {
+  SyntheticBrickParams params;
+  params.side = GetParam();
+  if (params.side == pattern::Side::kRight) params.line0_x = 511 - params.line0_x;
+  const SyntheticBrick b = DrawSyntheticBrick(params);
+  const TrackNetwork net = NetworkOf(RenderGrey(b), params.side);
+  for (const testing::TruthJunction& t : b.junctions) {
+    const TrackJunction* best = nullptr;
+    for (const TrackJunction& j : net.junctions)
+      if (cv::norm(j.position - t.position) <= kJunctionReach &&
+          (!best || cv::norm(j.position - t.position) < cv::norm(best->position - t.position)))
+        best = &j;
+    ASSERT_NE(best, nullptr) << "no junction at (" << t.p << ", " << t.v << ")";
+    EXPECT_EQ(best->kind, t.kind) << "(" << t.p << ", " << t.v << ")";
+  }
+  // Every junction sits on its line track in order down it.
+  for (size_t line = 0; line < net.lines.size(); ++line)
+    for (size_t k = 1; k < net.junctions_on_line[line].size(); ++k)
+      EXPECT_LE(net.junctions[net.junctions_on_line[line][k - 1]].position.y,
+                net.junctions[net.junctions_on_line[line][k]].position.y);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothSides, CleanBrickTracks,
+                         ::testing::Values(pattern::Side::kLeft, pattern::Side::kRight),
+                         [](const auto& test_info) { return std::string(pattern::ToString(test_info.param)); });
+
+TEST(RidgeTracks, AGapInALineIsBridged) {
+  SyntheticBrickParams params;
+  SyntheticBrick b = DrawSyntheticBrick(params);
+  testing::EraseLineBetween(b, 3, 0.15, 0.85);  // 9 px of 13 between two junctions
+  const TrackNetwork net = NetworkOf(RenderGrey(b), params.side);
+  // The track of line 3 above the gap continues in the one below it.
+  auto track_at = [&](cv::Point2d at) {
+    const int y = cvRound(at.y);
+    for (int i = net.rows.row_start[y]; i < net.rows.row_start[y + 1]; ++i)
+      if (std::abs(net.rows.points[i].x - at.x) < 2) return net.line_of_point[i];
+    return -1;
+  };
+  const int upper = track_at(b.Map(3, 0.1)), lower = track_at(b.Map(3, 0.9));
+  ASSERT_GE(upper, 0);
+  ASSERT_GE(lower, 0);
+  ASSERT_NE(upper, lower) << "no gap";
+  EXPECT_EQ(net.line_below[upper], lower);
+  EXPECT_EQ(net.line_above[lower], upper);
+}
+
+TEST(RidgeTracks, InvalidParamsAreRejected) {
+  TrackParams bad;
+  bad.max_step = 0;
+  EXPECT_THROW(BuildTrackNetwork({}, {}, pattern::Side::kLeft, bad), std::invalid_argument);
+  bad = {};
+  bad.bridge_rows = 0;
+  std::string why;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("bridge_rows"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace bsls::interpretation
