@@ -27,6 +27,7 @@ struct ProcessOptions {
   std::string overlay;
   std::string skeleton;
   std::string method = "modern";
+  std::string chain = "skeleton";
   std::string calibration;
   std::string surface;
   SurfaceChoices surface_choices;
@@ -79,6 +80,7 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   if (o.geometric_setup)
     throw CommandError(kExitUsage, "--geometric-setup runs here only: drop --server");
   if (!o.skeleton.empty()) throw CommandError(kExitUsage, "--skeleton runs here only: drop --server");
+  if (o.chain != "skeleton") throw CommandError(kExitUsage, "--chain runs here only: drop --server");
   io::FrameConversion conversion;
   const cv::Mat frame = io::LoadGreyFrame(o.image, &conversion);
   if (conversion.converted())
@@ -152,6 +154,7 @@ void RunProcess(const ProcessOptions& o) {
   params.decode.extraction.method =
       o.method == "thesis" ? extraction::ExtractionMethod::kThesis : extraction::ExtractionMethod::kModern;
   params.decode.interpretation.enable_repair = !o.no_repair;
+  params.decode.chain = o.chain == "tracks" ? decoder::DecodeChain::kTracks : decoder::DecodeChain::kSkeleton;
   ApplySurfaceChoices(o.surface_choices, &params);
   params.reconstruct = !o.surface.empty();
 
@@ -228,6 +231,10 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--skeleton", opts->skeleton, "Output PNG of the repaired one-pixel skeleton");
   cmd->add_option("--method", opts->method, "Feature extraction: modern (default) or thesis")
       ->check(CLI::IsMember({"modern", "thesis"}));
+  cmd->add_option("--chain", opts->chain,
+                  "Decoding chain: skeleton (default: thinning and loop tracing, thesis ch. 4-5) "
+                  "or tracks (ridge tracks, several times faster; docs/decoding.md)")
+      ->check(CLI::IsMember({"skeleton", "tracks"}));
   cmd->add_option("--calibration", opts->calibration,
                   "Calibration of this side (bsls calibrate): absolute q and the surface");
   cmd->add_option("--surface", opts->surface,

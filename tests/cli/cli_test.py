@@ -106,6 +106,17 @@ class CliTest(unittest.TestCase):
         self.assertGreater(os.path.getsize(overlay), 10000)
         self.assertIn("junctions", r.stdout)
 
+    def test_the_track_chain_decodes_the_frame_as_well(self):
+        out = self.path("tracks.json")
+        r = run("process", self.frame, "--side", "left", "--chain", "tracks", "--junctions", out)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        with open(out) as f:
+            doc = json.load(f)
+        self.assertGreater(len(doc["junctions"]), 300)
+        self.assertEqual(doc["lines"][0]["p"], 0)
+        bad = run("process", self.frame, "--side", "left", "--chain", "pixels", "--junctions", out)
+        self.assertEqual(bad.returncode, EXIT_USAGE)
+
     def test_evaluate_scores_the_decode_against_the_truth(self):
         out = self.path("e.json")
         self.assertEqual(run("process", self.frame, "--side", "left", "--junctions", out).returncode,
