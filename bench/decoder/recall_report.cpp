@@ -179,29 +179,26 @@ void Report(SurfaceKind kind, Side side, std::uint32_t seed, const Options& o, T
   totals->wrong += s.Wrong();
   totals->worst_recall = std::min(totals->worst_recall, s.Recall());
   if (o.quiet) return;
+  // A crop around junction m of the truth, named by the scene and m's label.
+  auto crop = [&](const char* prefix, const bsls::simulator::PointLabel& m) {
+    if (o.crops.empty()) return;
+    char file[160];
+    std::snprintf(file, sizeof file, "/%s%s_%s_%u_p%d_v%d.png", prefix,
+                  std::string(bsls::simulator::ToString(kind)).c_str(),
+                  std::string(bsls::pattern::ToString(side)).c_str(), seed, m.p, m.v);
+    WriteCrop(o.crops + file, frame.image, r, m.position);
+  };
   for (const auto& m : s.missed) {
     const bsls::simulator::TruthJunction* t = nullptr;
     for (size_t i = 0; i < truth.size(); ++i)
       if (truth[i].p == m.p && truth[i].v == m.v) t = records[i];
-    if (!o.crops.empty()) {
-      char file[160];
-      std::snprintf(file, sizeof file, "/%s_%s_%u_p%d_v%d.png",
-                    std::string(bsls::simulator::ToString(kind)).c_str(),
-                    std::string(bsls::pattern::ToString(side)).c_str(), seed, m.p, m.v);
-      WriteCrop(o.crops + file, frame.image, r, m.position);
-    }
+    crop("", m);
     std::printf("    missed p %2d v %3d at (%7.2f, %7.2f) %-13s%s\n", m.p, m.v, m.position.x,
                 m.position.y, t ? std::string(bsls::pattern::ToString(t->kind)).c_str() : "",
                 t ? Reason(*t, m.position, decoded, s.v_offset, o.size, o.size).c_str() : "");
   }
   for (const auto& m : s.wrong) {
-    if (!o.crops.empty()) {
-      char file[160];
-      std::snprintf(file, sizeof file, "/wrong_%s_%s_%u_p%d_v%d.png",
-                    std::string(bsls::simulator::ToString(kind)).c_str(),
-                    std::string(bsls::pattern::ToString(side)).c_str(), seed, m.p, m.v);
-      WriteCrop(o.crops + file, frame.image, r, m.position);
-    }
+    crop("wrong_", m);
     std::printf("    WRONG  p %2d v %3d at (%7.2f, %7.2f)\n", m.p, m.v, m.position.x, m.position.y);
   }
   if (o.extra) {

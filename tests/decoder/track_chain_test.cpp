@@ -1,5 +1,5 @@
-// The decoder's track chain (DecodeChain::kTracks) against the simulator's
-// ground truth: the same targets as the skeleton chain's (decoder_test.cpp).
+// What is the track chain's (DecodeChain::kTracks) own: the targets
+// on objects and faces hold it with the skeleton chain in decoder_test.cpp.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -18,72 +18,6 @@ DecodeParams TrackChain() {
   params.chain = DecodeChain::kTracks;
   return params;
 }
-
-struct SceneCase {
-  SurfaceKind kind;
-  Side side;
-};
-
-std::string Name(const SceneCase& c) {
-  return std::string(simulator::ToString(c.kind)) + "_" + std::string(pattern::ToString(c.side));
-}
-
-void PrintTo(const SceneCase& c, std::ostream* os) { *os << Name(c); }
-
-class TrackChainObjects : public ::testing::TestWithParam<SceneCase> {};
-
-// Planes, ramp and ball: every junction, no wrong label.
-TEST_P(TrackChainObjects, EveryJunctionRightlyLabelled) {
-  const SceneCase c = GetParam();
-  const simulator::Frame frame = RenderFrame(c.kind, c.side, 7);
-  const DecodeResult r = Decode(frame.image, c.side, TrackChain());
-  ASSERT_TRUE(r.ok) << r.error;
-  const Evaluation e = Evaluate(frame, r);
-  EXPECT_EQ(e.all.found, e.all.truth) << Name(c) << ": " << e.all.Summary();
-  EXPECT_EQ(e.all.Wrong(), 0) << Name(c) << ": " << e.all.Summary();
-  EXPECT_EQ(e.all.v_offset % 2, 0);
-  EXPECT_LE(e.line_rms, 0.1) << Name(c);
-  EXPECT_GT(e.line_points, 5000) << Name(c);
-}
-
-INSTANTIATE_TEST_SUITE_P(
-    Simulated, TrackChainObjects,
-    ::testing::Values(SceneCase{SurfaceKind::kPlane, Side::kLeft},
-                      SceneCase{SurfaceKind::kPlane, Side::kRight},
-                      SceneCase{SurfaceKind::kRamp, Side::kLeft},
-                      SceneCase{SurfaceKind::kRamp, Side::kRight},
-                      SceneCase{SurfaceKind::kBall, Side::kLeft},
-                      SceneCase{SurfaceKind::kBall, Side::kRight}),
-    [](const auto& test_info) { return Name(test_info.param); });
-
-class TrackChainFaces : public ::testing::TestWithParam<Side> {};
-
-// Faces with eyebrow patches and noise: no wrong label, line centres within
-// 0.15 px RMS, >= 98 % of the lit and visible junctions (seeds 1-5 of both
-// sides: 98.70 % together, the worst frame 98.18 %; docs/decoding.md).
-TEST_P(TrackChainFaces, LabelsAreRightAndCentresSubPixel) {
-  const Side side = GetParam();
-  for (std::uint32_t seed : {1u, 2u}) {
-    const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, seed);
-    const DecodeResult r = Decode(frame.image, side, TrackChain());
-    ASSERT_TRUE(r.ok) << r.error;
-    const Evaluation e = Evaluate(frame, r);
-    EXPECT_EQ(e.all.wrong_p, 0) << e.all.Summary();
-    EXPECT_EQ(e.all.wrong_v, 0) << e.all.Summary();
-    EXPECT_GE(e.all.Recall(), 0.98) << e.all.Summary();
-    EXPECT_LE(e.line_rms, 0.15) << "points " << e.line_points;
-    EXPECT_GT(e.line_points, 4000);
-    // One point per row of a line, in order.
-    for (const DecodedLine& line : r.lines)
-      for (size_t k = 1; k < line.points.size(); ++k)
-        EXPECT_GT(line.points[k].y, line.points[k - 1].y) << "line " << line.p;
-  }
-}
-
-INSTANTIATE_TEST_SUITE_P(BothSides, TrackChainFaces, ::testing::Values(Side::kLeft, Side::kRight),
-                         [](const auto& test_info) {
-                           return std::string(pattern::ToString(test_info.param));
-                         });
 
 TEST(TrackChain, TheResultDoesNotDependOnTheThreadCount) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 1);

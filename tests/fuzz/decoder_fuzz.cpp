@@ -1,7 +1,8 @@
 // libFuzzer target: arbitrary bytes through the frame loader and the decoder.
 // Byte 0 chooses the path: even = the bytes are an image file (any format
 // OpenCV reads), odd = raw 8-bit pixels of a small frame whose size and side
-// come from bytes 1-3. Neither path may crash, hang or leak; errors are fine.
+// come from bytes 1-3. Bit 2 of byte 0 chooses the decoding chain (skeleton
+// or tracks). Neither path may crash, hang or leak; errors are fine.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -31,7 +32,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (int i = 0; i < width * height; ++i)
       frame.data[i] = payload ? data[4 + (i * 7919u) % payload] ^ static_cast<std::uint8_t>(i * data[3]) : 0;
   }
-  const bsls::decoder::DecodeResult result = bsls::decoder::Decode(frame, side);
+  bsls::decoder::DecodeParams params;
+  params.chain = (data[0] & 4) ? bsls::decoder::DecodeChain::kTracks
+                               : bsls::decoder::DecodeChain::kSkeleton;
+  const bsls::decoder::DecodeResult result = bsls::decoder::Decode(frame, side, params);
   (void)result;
   return 0;
 }

@@ -103,9 +103,7 @@ TEST(Interpreter, LineOneMistakenForLineZeroIsRejected) {
   // Cut line 0 away: the right-most line now carries corresponding junctions.
   SyntheticBrickParams params;
   SyntheticBrick b = DrawSyntheticBrick(params);
-  const cv::Point2d l0 = b.Map(0, 0), l1 = b.Map(1, 0);
-  const int cut = cvRound((l0.x + l1.x) / 2 + 3);
-  b.skeleton.colRange(cut, b.skeleton.cols).setTo(0);
+  testing::CutAwayLineZero(b);
   const InterpretationResult r = Interpret(b.skeleton, params.side, params.spec);
   EXPECT_FALSE(r.ok);
   EXPECT_NE(r.error.find("not line 0"), std::string::npos) << r.error;

@@ -133,9 +133,7 @@ TEST(TrackLabelling, LineOneMistakenForLineZeroIsRejected) {
   // segments that came from line 0, i.e. corresponding junctions.
   SyntheticBrickParams params;
   SyntheticBrick b = DrawSyntheticBrick(params);
-  const cv::Point2d l0 = b.Map(0, 0), l1 = b.Map(1, 0);
-  const int cut = cvRound((l0.x + l1.x) / 2 + 3);
-  b.skeleton.colRange(cut, b.skeleton.cols).setTo(0);
+  testing::CutAwayLineZero(b);
   const Labelled l = Label(RenderGrey(b), params.side);
   EXPECT_FALSE(l.labels.ok);
   EXPECT_NE(l.labels.error.find("line 0"), std::string::npos) << l.labels.error;

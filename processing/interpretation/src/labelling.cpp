@@ -7,9 +7,12 @@
 #include <queue>
 #include <set>
 
+#include "median.h"
+
 namespace bsls::interpretation {
 namespace {
 
+using internal::Median;
 using pattern::JunctionKind;
 
 struct Link {
@@ -40,12 +43,6 @@ JunctionKind KindOf(const JunctionNetwork& net, int node) {
 // The kind a junction at (p, v) must have; v is relative but keeps its parity.
 bool KindFits(const pattern::PatternSpec& spec, int p, int v, JunctionKind kind) {
   return pattern::JunctionOnRowParity(spec, p, v) == kind;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 // Positioned samples bucketed by the cells of a square grid `cell` wide.

@@ -8,9 +8,12 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "median.h"
+
 namespace bsls::interpretation {
 namespace {
 
+using internal::Median;
 using pattern::JunctionKind;
 
 struct Link {
@@ -24,12 +27,6 @@ constexpr double kTrusted = 0.01;  // a link of a brick that closes (thesis: a c
 constexpr double kPlain = 10.0;    // any other step of one or two rows, or segment: a path
                                    // through closed bricks beats any path with one such link;
                                    // a longer step costs this per row
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 // The row spacing along a line: the dy of a step between junctions of
 // alternating kinds, half of one between junctions of the same kind.

@@ -67,6 +67,17 @@ cv::Mat RenderGrey(const SyntheticBrick& brick, double noise_sigma, unsigned see
   return out;
 }
 
+void CutAwayLineZero(SyntheticBrick& brick) {
+  const cv::Point2d l0 = brick.Map(0, 0), l1 = brick.Map(1, 0);
+  // Line 0 lies opposite to increasing p: the cut keeps 3 px of the middle on line 1's side.
+  const int towards_p = pattern::ImageDirectionOfIncreasingP(brick.params.side);
+  const int cut = cvRound((l0.x + l1.x) / 2 - 3 * towards_p);
+  if (towards_p < 0)
+    brick.skeleton.colRange(cut, brick.skeleton.cols).setTo(0);
+  else
+    brick.skeleton.colRange(0, cut + 1).setTo(0);
+}
+
 const TruthJunction* FindTruth(const SyntheticBrick& brick, int p, int v) {
   for (const TruthJunction& j : brick.junctions)
     if (j.p == p && j.v == v) return &j;

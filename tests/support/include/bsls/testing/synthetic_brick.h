@@ -52,6 +52,11 @@ SyntheticBrick DrawSyntheticBrick(const SyntheticBrickParams& params);
 // 20, with seeded Gaussian noise of `noise_sigma` grey levels.
 cv::Mat RenderGrey(const SyntheticBrick& brick, double noise_sigma = 2.0, unsigned seed = 1);
 
+// Cuts line 0 away (every pixel from 3 px beyond the middle between lines 0
+// and 1 on), leaving line 1 outermost with the stubs of the segments that
+// came from line 0: the frame a labelling must not take line 1 for line 0 in.
+void CutAwayLineZero(SyntheticBrick& brick);
+
 // The truth junction (p, v), or nullptr.
 const TruthJunction* FindTruth(const SyntheticBrick& brick, int p, int v);
 
