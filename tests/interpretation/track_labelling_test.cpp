@@ -122,6 +122,23 @@ TEST(TrackLabelling, AHoleLosesOnlyWhatItCovers) {
         << "missed (" << m.p << ", " << m.v << ") away from the hole";
 }
 
+TEST(TrackLabelling, AStrayJunctionOnLineZeroShiftsNoRow) {
+  // A stub of a segment leaving line 0 half a row below its junction
+  // (0, 2) (a segment's end caught at a fold): a direct junction too close
+  // to the real one to be a row of its own. Counted as one, it would shift
+  // every row below it by two.
+  SyntheticBrickParams params;
+  SyntheticBrick b = DrawSyntheticBrick(params);
+  const cv::Point2d from = b.Map(0, 2.5), to = b.Map(0.6, 2.5);
+  cv::line(b.skeleton, cv::Point(cvRound(from.x), cvRound(from.y)),
+           cv::Point(cvRound(to.x), cvRound(to.y)), 255, 1, cv::LINE_8);
+  const Labelled l = Label(RenderGrey(b), params.side);
+  ASSERT_TRUE(l.labels.ok) << l.labels.error;
+  const auto score = Score(b, l);
+  EXPECT_EQ(score.Wrong(), 0) << score.Summary();
+  EXPECT_GE(score.found, score.truth - 2) << score.Summary();
+}
+
 TEST(TrackLabelling, NoReferenceLineIsReportedNotGuessed) {
   const Labelled blank = Label(cv::Mat(256, 256, CV_8UC1, cv::Scalar(20)), pattern::Side::kLeft);
   EXPECT_FALSE(blank.labels.ok);

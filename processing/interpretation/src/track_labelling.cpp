@@ -24,6 +24,7 @@ struct Link {
 };
 
 constexpr double kTrusted = 0.01;  // a link of a brick that closes (thesis: a complete loop)
+constexpr double kLineZeroGap = 1.0;  // rows of line 0 counted across a gap between its tracks
 constexpr double kPlain = 10.0;    // any other step of one or two rows, or segment: a path
                                    // through closed bricks beats any path with one such link;
                                    // a longer step costs this per row
@@ -35,12 +36,19 @@ double RowSpacing(const TrackJunction& a, const TrackJunction& b) {
   return a.kind != b.kind ? dy : dy / 2.0;
 }
 
-// Thesis 5.2.1: the line tracks the moving column from the unlit side stops
-// on in most of their rows, carrying direct junctions only.
+// Thesis 5.2.1: line 0. The moving column from the unlit side stops, in
+// each row, on the outermost line track; a track it stops on in most of its
+// rows is a candidate. Line 0 is followed from the candidate nearest the
+// centre row up and down through the candidates that start (end) within
+// follow_distance of where it ends (starts), as the thesis follows it
+// through its gaps; its junctions must be direct but for max_inner_fraction
+// of them (a stray segment's end at a fold), or it is not line 0. Empty
+// when nothing passes; `why` says what failed.
 std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
-                                 const TrackLabellingParams& params) {
+                                 const TrackLabellingParams& params, std::string* why) {
   const int towards_p = pattern::ImageDirectionOfIncreasingP(side);
-  std::vector<int> outermost(net.lines.size(), 0);
+  const int n_lines = static_cast<int>(net.lines.size());
+  std::vector<int> outermost(n_lines, 0);
   const int rows = static_cast<int>(net.rows.row_start.size()) - 1;
   for (int y = 0; y < rows; ++y) {
     int best = -1;
@@ -51,19 +59,69 @@ std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
     }
     if (best >= 0) ++outermost[net.line_of_point[best]];
   }
-  std::vector<int> reference;
-  for (int t = 0; t < static_cast<int>(net.lines.size()); ++t) {
-    if (outermost[t] < params.reference_share * static_cast<double>(net.lines[t].points.size()))
-      continue;
-    int direct = 0, corresponding = 0;
+  std::vector<char> candidate(n_lines, 0);
+  for (int t = 0; t < n_lines; ++t)
+    candidate[t] =
+        outermost[t] >= params.reference_share * static_cast<double>(net.lines[t].points.size());
+  auto first = [&](int t) { return net.rows.points[net.lines[t].points.front()]; };
+  auto last = [&](int t) { return net.rows.points[net.lines[t].points.back()]; };
+  // The candidate nearest the centre row (covering it, or closest to it).
+  const double centre_row = (rows - 1) / 2.0;
+  int centre = -1;
+  double centre_miss = 0;
+  for (int t = 0; t < n_lines; ++t) {
+    if (!candidate[t]) continue;
+    const double miss = std::max({0.0, first(t).y - centre_row, centre_row - last(t).y});
+    if (centre < 0 || miss < centre_miss ||
+        (miss == centre_miss && net.lines[t].points.size() > net.lines[centre].points.size())) {
+      centre = t;
+      centre_miss = miss;
+    }
+  }
+  if (centre < 0) {
+    *why = "no reference line (line 0) found";
+    return {};
+  }
+  std::vector<int> chain{centre};
+  std::vector<char> taken(n_lines, 0);
+  taken[centre] = 1;
+  for (const bool down : {true, false}) {
+    for (int cur = centre;;) {
+      int next = -1;
+      double next_d = 0;
+      for (int t = 0; t < n_lines; ++t) {
+        if (!candidate[t] || taken[t]) continue;
+        const extraction::RidgePoint from = down ? last(cur) : first(cur);
+        const extraction::RidgePoint to = down ? first(t) : last(t);
+        const int dy = down ? to.y - from.y : from.y - to.y;
+        if (dy < 1) continue;
+        const double d = std::hypot(to.x - from.x, static_cast<double>(dy));
+        if (d > params.follow_distance) continue;
+        if (next < 0 || d < next_d) {
+          next = t;
+          next_d = d;
+        }
+      }
+      if (next < 0) break;
+      taken[next] = 1;
+      chain.push_back(next);
+      cur = next;
+    }
+  }
+  int direct = 0, corresponding = 0;
+  for (int t : chain)
     for (int j : net.junctions_on_line[t])
       ++(net.junctions[j].kind == JunctionKind::kDirect ? direct : corresponding);
-    if (direct < params.min_reference_junctions ||
-        corresponding > params.max_inner_fraction * (direct + corresponding))
-      continue;
-    reference.push_back(t);
+  if (direct < params.min_reference_junctions) {
+    *why = "line 0 carries " + std::to_string(direct) + " junctions";
+    return {};
   }
-  return reference;
+  if (corresponding > params.max_inner_fraction * (direct + corresponding)) {
+    *why = "the outermost line has " + std::to_string(corresponding) +
+           " segments on its inner side, so it is not line 0";
+    return {};
+  }
+  return chain;
 }
 
 }  // namespace
@@ -79,6 +137,7 @@ bool TrackLabellingParams::IsValid(std::string* error) const {
   if (!(max_inner_fraction >= 0 && max_inner_fraction <= 1))
     return fail("max_inner_fraction must lie in [0, 1]");
   if (!(max_row_miss > 0 && max_row_miss <= 0.5)) return fail("max_row_miss must lie in (0, 0.5]");
+  if (!(follow_distance > 0)) return fail("follow_distance must be positive");
   if (max_rows < 1) return fail("max_rows must be at least 1");
   if (min_own_spacings < 1) return fail("min_own_spacings must be at least 1");
   return true;
@@ -198,28 +257,44 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // each other starts at the cost of a long step from it, so that it keeps
   // the row counted from the spacing only where no path through the links
   // reaches it (a gap in line 0 that no neighbour bridges).
-  out.reference = ReferenceTracks(net, side, params);
+  std::string why;
+  out.reference = ReferenceTracks(net, side, params, &why);
   std::vector<int> seeds;
   for (int t : out.reference)
     for (int j : net.junctions_on_line[t])
       if (net.junctions[j].kind == JunctionKind::kDirect) seeds.push_back(j);
-  if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
-    out.error = out.reference.empty()
-                    ? "no reference line (line 0) found"
-                    : "line 0 carries " + std::to_string(seeds.size()) + " junctions";
+  if (out.reference.empty()) {
+    out.error = why;
     return out;
   }
   std::sort(seeds.begin(), seeds.end(), [&](int a, int b) {
     return net.junctions[a].position.y < net.junctions[b].position.y;
   });
-  std::vector<int> seed_v{0};
-  for (size_t i = 1; i < seeds.size(); ++i) {
-    const double gap = net.junctions[seeds[i]].position.y - net.junctions[seeds[i - 1]].position.y;
-    const double s = own_spacing[net.junctions[seeds[i]].line] > 0
-                         ? own_spacing[net.junctions[seeds[i]].line]
-                         : frame_spacing;
-    seed_v.push_back(seed_v.back() + 2 * std::max(1, static_cast<int>(std::lround(gap / (2 * s)))));
+  // Two rows per step of line 0's row spacing between consecutive seeds.
+  // Two seeds closer than one step cannot both be line 0's junctions (a
+  // stray segment's end at a fold): neither seeds.
+  auto spacing_at = [&](int j) {
+    const double own = own_spacing[net.junctions[j].line];
+    return own > 0 ? own : frame_spacing;
+  };
+  auto steps_between = [&](int a, int b) {
+    const double gap = net.junctions[b].position.y - net.junctions[a].position.y;
+    return static_cast<int>(std::lround(gap / (2 * spacing_at(b))));
+  };
+  std::vector<char> doubtful(seeds.size(), 0);
+  for (size_t i = 1; i < seeds.size(); ++i)
+    if (steps_between(seeds[i - 1], seeds[i]) < 1) doubtful[i - 1] = doubtful[i] = 1;
+  std::vector<int> kept;
+  for (size_t i = 0; i < seeds.size(); ++i)
+    if (!doubtful[i]) kept.push_back(seeds[i]);
+  seeds.swap(kept);
+  if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
+    out.error = "line 0 carries " + std::to_string(seeds.size()) + " junctions";
+    return out;
   }
+  std::vector<int> seed_v{0};
+  for (size_t i = 1; i < seeds.size(); ++i)
+    seed_v.push_back(seed_v.back() + 2 * steps_between(seeds[i - 1], seeds[i]));
 
   const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
   size_t centre_seed = 0;
@@ -227,9 +302,19 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     if (std::abs(net.junctions[seeds[i]].position.y - centre_row) <
         std::abs(net.junctions[seeds[centre_seed]].position.y - centre_row))
       centre_seed = i;
-  std::vector<double> seed_cost(seeds.size());
-  for (size_t i = 0; i < seeds.size(); ++i)
-    seed_cost[i] = kPlain * std::abs(seed_v[i] - seed_v[centre_seed]);
+  // Along one track the rows are counted step by step; across a gap
+  // between two of line 0's tracks they are estimated from its length. A
+  // seed starts at a cost for each such gap between it and the central one:
+  // more than a path through closed bricks, less than one plain link.
+  std::vector<double> seed_cost(seeds.size(), 0.0);
+  for (size_t i = centre_seed + 1; i < seeds.size(); ++i) {
+    const bool same_track = net.junctions[seeds[i]].line == net.junctions[seeds[i - 1]].line;
+    seed_cost[i] = seed_cost[i - 1] + (same_track ? 0.0 : kLineZeroGap);
+  }
+  for (size_t i = centre_seed; i-- > 0;) {
+    const bool same_track = net.junctions[seeds[i]].line == net.junctions[seeds[i + 1]].line;
+    seed_cost[i] = seed_cost[i + 1] + (same_track ? 0.0 : kLineZeroGap);
+  }
 
   // Propagation, cheapest paths first (Dijkstra over the link weights).
   std::vector<double> cost(n, std::numeric_limits<double>::infinity());

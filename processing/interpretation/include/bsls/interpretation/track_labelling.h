@@ -7,9 +7,13 @@
 // column" of 5.2.1 swept in from that side stops on it in each row, so a
 // line track that is outermost in most of its rows and carries direct
 // junctions only (its segments all leave towards p = 1) is part of line 0.
-// A break in a line or a lost segment does not stop the labels: every
-// junction is reached through its brick's other junctions, which is what
-// the thesis's repairs (5.1.4.3-5.1.4.8) restore the paths for.
+// Its junctions are numbered two rows a step of its row spacing; two closer
+// than one step are not both line 0's and neither seeds. A break in a line
+// or a lost segment does not stop the labels: every junction is reached
+// through its brick's other junctions, which is what the thesis's repairs
+// (5.1.4.3-5.1.4.8) restore the paths for. Links of closed bricks are
+// trusted over any other, and a row count across a gap of line 0 over any
+// path with an untrusted link.
 //
 // A label must agree with the junction's kind (a direct junction on line p
 // lies on a row v = p mod 2); a junction whose neighbours mostly disagree
@@ -32,10 +36,13 @@
 namespace bsls::interpretation {
 
 struct TrackLabellingParams {
-  // A line track is part of line 0 when it is the outermost on the unlit
-  // side in at least this fraction of its rows, (0, 1],
+  // A line track is a candidate for line 0 when it is the outermost on the
+  // unlit side in at least this fraction of its rows, (0, 1].
   double reference_share = 0.5;
-  // carries at least this many direct junctions, >= 1,
+  // Line 0 is followed from candidate to candidate across gaps of up to
+  // this (px from one's end to the next's start, the next starting lower), > 0;
+  double follow_distance = 24.0;
+  // it carries at least this many direct junctions, >= 1,
   int min_reference_junctions = 2;
   // and at most this fraction of corresponding ones, [0, 1].
   double max_inner_fraction = 0.2;
