@@ -113,7 +113,8 @@ std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
     for (int j : net.junctions_on_line[t])
       ++(net.junctions[j].kind == JunctionKind::kDirect ? direct : corresponding);
   if (direct < params.min_reference_junctions) {
-    *why = "line 0 carries " + std::to_string(direct) + " junctions";
+    *why = "no reference line (line 0): the outermost line carries " + std::to_string(direct) +
+           " junctions";
     return {};
   }
   if (corresponding > params.max_inner_fraction * (direct + corresponding)) {
@@ -289,7 +290,8 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     if (!doubtful[i]) kept.push_back(seeds[i]);
   seeds.swap(kept);
   if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
-    out.error = "line 0 carries " + std::to_string(seeds.size()) + " junctions";
+    out.error = "no reference line (line 0): it carries " + std::to_string(seeds.size()) +
+                " junctions that number its rows";
     return out;
   }
   std::vector<int> seed_v{0};
