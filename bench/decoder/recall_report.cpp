@@ -13,10 +13,16 @@
 // Not a Google benchmark: a plain program so that its output can be diffed.
 //
 //   recall_report [--seeds N] [--size PX] [--quiet] [--extra] [--crops DIR]
+//                 [--chain tracks|skeleton]
 //     --quiet   summary lines only; --extra  also list unmatched decoded junctions;
-//     --crops   write a PNG around each missed junction into DIR (6x: the frame,
-//               skeleton red, decoded line centres yellow, decoded junctions
-//               blue, the missed truth junction green)
+//     --crops   write a PNG around each missed (and, prefixed wrong_, each
+//               wrongly labelled) junction into DIR (6x: the frame, skeleton
+//               red, decoded line centres yellow, decoded junctions blue, the
+//               truth junction green)
+//     --chain   the decoding chain (DecodeParams::chain; default: the decoder's)
+// For experiments, the track chain's main parameters can be overridden from
+// the environment: BSLS_TRACK_STEP (TrackParams::max_step), BSLS_TRACK_SIGMA
+// (smoothing_sigma), BSLS_TRACK_PROMINENCE and BSLS_TRACK_WINDOW (RidgeParams).
 #include <chrono>
 #include <cmath>
 #include <cstdio>
