@@ -4,10 +4,11 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <queue>
 #include <set>
 
-#include "median.h"
+#include "label_votes.h"
 
 namespace bsls::interpretation {
 namespace {
@@ -337,21 +338,13 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
   }
 
   // A label most of whose neighbours disagree is dropped, not guessed.
-  for (int pass = 0; pass < 2; ++pass) {
-    std::vector<int> drop;
-    for (int n = 0; n < n_nodes; ++n) {
-      if (label[n].p == kNoLabel) continue;
-      int agree = 0, disagree = 0;
-      for (const Link& l : adj[n]) {
-        if (label[l.to].p == kNoLabel) continue;
-        const Label expect{label[n].p + l.dp, label[n].v + l.dv};
-        (expect == label[l.to] ? agree : disagree)++;
-      }
-      if (disagree >= 2 && disagree > agree) drop.push_back(n);
-    }
-    for (int n : drop) label[n] = {kNoLabel, kNoLabel};
-    out->conflicts += static_cast<int>(drop.size());
-  }
+  out->conflicts += internal::DropDisagreeingLabels(
+      adj,
+      [&](int n) {
+        return label[n].p == kNoLabel ? std::nullopt
+                                      : std::optional(std::make_pair(label[n].p, label[n].v));
+      },
+      [&](int n) { label[n] = {kNoLabel, kNoLabel}; });
 
   // Thesis point O: line 0's junction nearest the centre row is v = 0.
   const double centre_row = (g.size().height - 1) / 2.0;

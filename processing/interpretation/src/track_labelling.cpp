@@ -4,11 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <queue>
 #include <stdexcept>
 #include <tuple>
 
-#include "median.h"
+#include "label_votes.h"
 
 namespace bsls::interpretation {
 namespace {
@@ -346,21 +347,13 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   }
 
   // A label most of whose neighbours disagree is dropped, not guessed.
-  for (int pass = 0; pass < 2; ++pass) {
-    std::vector<int> drop;
-    for (int j = 0; j < n; ++j) {
-      if (out.p[j] == kUnlabelled) continue;
-      int agree = 0, disagree = 0;
-      for (const Link& l : adj[j]) {
-        if (out.p[l.to] == kUnlabelled) continue;
-        const bool same = out.p[l.to] == out.p[j] + l.dp && out.v[l.to] == out.v[j] + l.dv;
-        ++(same ? agree : disagree);
-      }
-      if (disagree >= 2 && disagree > agree) drop.push_back(j);
-    }
-    for (int j : drop) out.p[j] = out.v[j] = kUnlabelled;
-    out.conflicts += static_cast<int>(drop.size());
-  }
+  out.conflicts += internal::DropDisagreeingLabels(
+      adj,
+      [&](int j) {
+        return out.p[j] == kUnlabelled ? std::nullopt
+                                       : std::optional(std::make_pair(out.p[j], out.v[j]));
+      },
+      [&](int j) { out.p[j] = out.v[j] = kUnlabelled; });
 
   // Thesis point O: line 0's junction nearest the centre row is v = 0.
   int origin_v = 0;

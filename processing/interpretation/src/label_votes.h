@@ -1,0 +1,53 @@
+// Private to bsls::interpretation: what the two labellings (labelling.cpp
+// on the skeleton graph, track_labelling.cpp on the track network) judge
+// alike: the median of row-spacing samples, and the rule that a label its
+// neighbours disagree with is dropped rather than guessed (thesis 5.1.4.9).
+#ifndef BSLS_INTERPRETATION_SRC_LABEL_VOTES_H_
+#define BSLS_INTERPRETATION_SRC_LABEL_VOTES_H_
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace bsls::interpretation::internal {
+
+// The median of `v` (the upper middle one of an even count); 0 when empty.
+inline double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Drops every label most of whose labelled neighbours disagree with it (two
+// or more, and more than agree), in two passes; returns how many it
+// dropped. adj[j] lists j's links (members to, dp, dv: the neighbour and
+// the label change towards it); label_of(j) gives j's (p, v) as an
+// optional pair, empty when unlabelled; unlabel(j) drops it.
+template <typename Link, typename LabelOf, typename Unlabel>
+int DropDisagreeingLabels(const std::vector<std::vector<Link>>& adj, LabelOf label_of,
+                          Unlabel unlabel) {
+  int dropped = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<int> drop;
+    for (int j = 0; j < static_cast<int>(adj.size()); ++j) {
+      const auto mine = label_of(j);
+      if (!mine) continue;
+      int agree = 0, disagree = 0;
+      for (const Link& l : adj[j]) {
+        const auto theirs = label_of(l.to);
+        if (!theirs) continue;
+        const bool same =
+            theirs->first == mine->first + l.dp && theirs->second == mine->second + l.dv;
+        ++(same ? agree : disagree);
+      }
+      if (disagree >= 2 && disagree > agree) drop.push_back(j);
+    }
+    for (int j : drop) unlabel(j);
+    dropped += static_cast<int>(drop.size());
+  }
+  return dropped;
+}
+
+}  // namespace bsls::interpretation::internal
+
+#endif  // BSLS_INTERPRETATION_SRC_LABEL_VOTES_H_
