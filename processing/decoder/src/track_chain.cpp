@@ -172,7 +172,7 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
     for (size_t k = 0; k + 1 < path.size(); ++k) {
       const double d0 = off(path[k]), d1 = off(path[k + 1]);
       if ((d0 > 0) == (d1 > 0) && d0 != 0) continue;
-      const double f = d0 / (d0 - d1);
+      const double f = d0 == d1 ? 0.0 : d0 / (d0 - d1);  // both on the line: the first
       const double x = path[k].x + f * (path[k + 1].x - path[k].x);
       const cv::Point2d c(x, a + b * (x - x_ref));
       if (std::abs(c.y - a) < nearest) {

@@ -281,7 +281,9 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   };
   auto steps_between = [&](int a, int b) {
     const double gap = net.junctions[b].position.y - net.junctions[a].position.y;
-    return static_cast<int>(std::lround(gap / (2 * spacing_at(b))));
+    const double s = spacing_at(b);
+    if (!(s > 0)) return 1;  // no spacing measured anywhere: one step each
+    return static_cast<int>(std::lround(gap / (2 * s)));
   };
   std::vector<char> doubtful(seeds.size(), 0);
   for (size_t i = 1; i < seeds.size(); ++i)
