@@ -106,24 +106,32 @@ void ProfileRidgePoints(const Profile& s, int line, const std::vector<Candidate>
 }
 
 #if CV_SIMD128
-// Appends the lanes of `mask` (bit k: pixel first + k) with their falls.
-void AddLanes(unsigned mask, int first, const cv::v_uint8x16& before, const cv::v_uint8x16& after,
-              std::vector<Candidate>* out) {
+// Calls add(k, before_k, after_k) for each lane k set in `mask`, with the
+// lane's two falls.
+template <typename Add>
+void ForEachLane(unsigned mask, const cv::v_uint8x16& before, const cv::v_uint8x16& after,
+                 Add add) {
   if (!mask) return;
   uchar b[kVector], a[kVector];
   cv::v_store(b, before);
   cv::v_store(a, after);
   while (mask) {
     const int k = std::countr_zero(mask);
-    out->push_back({first + k, b[k], a[k]});
+    add(k, b[k], a[k]);
     mask &= mask - 1;
   }
 }
 #endif
 
-// The candidates of row `s` (cols pixels, readable from s[-w] to
-// s[cols - 1 + w + kVector]: the caller pads it by replication), in
-// increasing order.
+// Appends the candidates of column x of `image` to `out`, pixel by pixel.
+void ColumnCandidates(const cv::Mat& image, int x, int w, int t, std::vector<Candidate>* out) {
+  const Profile p{image.ptr<uchar>(0) + x, static_cast<std::ptrdiff_t>(image.step), image.rows};
+  for (int y = 0; y < image.rows; ++y) AddIfCandidate(p, y, w, t, out);
+}
+
+// The candidates of row `s` (cols pixels), in increasing order. The vector
+// steps read only the row's own pixels: they cover the part where both
+// windows lie inside it; the rest is judged pixel by pixel.
 void RowCandidates(const uchar* s, int cols, int w, int t, std::vector<Candidate>* candidates) {
   const Profile p{s, 1, cols};
   candidates->clear();
@@ -153,7 +161,8 @@ void RowCandidates(const uchar* s, int cols, int w, int t, std::vector<Candidate
     unsigned mask =
         static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
     mask &= ~0u << (done - from);  // lanes before `done` were taken by the step before
-    AddLanes(mask, from, before, after, candidates);
+    ForEachLane(mask, before, after,
+                [&](int k, uchar b, uchar a) { candidates->push_back({from + k, b, a}); });
     done = from + kVector;
   }
   if (vectors) x = inner_end;  // the steps covered the inner part up to here
@@ -185,22 +194,12 @@ void ColumnBlockCandidates(const cv::Mat& image, const std::vector<const uchar*>
     const cv::v_uint8x16 after = y + w > rows - 1 ? unjudged : v - below;
     unsigned mask =
         static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
-    if (!mask) continue;
-    uchar b[kVector], a[kVector];
-    cv::v_store(b, before);
-    cv::v_store(a, after);
-    while (mask) {
-      const int k = std::countr_zero(mask);
-      candidates[k].push_back({y, b[k], a[k]});
-      mask &= mask - 1;
-    }
+    ForEachLane(mask, before, after,
+                [&](int k, uchar b, uchar a) { candidates[k].push_back({y, b, a}); });
   }
 #else
   (void)rows_from;
-  for (int k = 0; k < kVector; ++k) {
-    const Profile p{image.ptr<uchar>(0) + x0 + k, static_cast<std::ptrdiff_t>(image.step), rows};
-    for (int y = 0; y < rows; ++y) AddIfCandidate(p, y, w, t, &candidates[k]);
-  }
+  for (int k = 0; k < kVector; ++k) ColumnCandidates(image, x0 + k, w, t, &candidates[k]);
 #endif
 }
 
@@ -234,22 +233,17 @@ std::vector<RidgePoint> Joined(const std::vector<std::vector<RidgePoint>>& parts
 
 RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) {
   CheckArguments("FindRidgePoints", smoothed, params);
-  // Rows are independent: bands of them in parallel (cv::parallel_for_),
-  // each row copied into a buffer padded by replication.
+  // Rows are independent: bands of them in parallel (cv::parallel_for_).
   const int bands = (smoothed.rows + kBandRows - 1) / kBandRows;
   const int w = params.half_window, t = params.min_prominence, cols = smoothed.cols;
   std::vector<std::vector<RidgePoint>> found(bands);
   cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& r) {
-    std::vector<uchar> padded(static_cast<size_t>(cols + 2 * w + kVector));
     std::vector<Candidate> candidates;
     for (int b = r.start; b < r.end; ++b) {
       const int y1 = std::min((b + 1) * kBandRows, smoothed.rows);
       for (int y = b * kBandRows; y < y1; ++y) {
         const uchar* row = smoothed.ptr<uchar>(y);
-        std::fill(padded.begin(), padded.begin() + w, row[0]);
-        std::copy(row, row + cols, padded.begin() + w);
-        std::fill(padded.begin() + w + cols, padded.end(), row[cols - 1]);
-        RowCandidates(padded.data() + w, cols, w, t, &candidates);
+        RowCandidates(row, cols, w, t, &candidates);
         ProfileRidgePoints({row, 1, cols}, y, candidates, t, &found[b]);
       }
     }
@@ -281,8 +275,7 @@ RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& pa
       } else {
         for (int k = 0; k < width; ++k) {
           candidates[k].clear();
-          const Profile p{smoothed.ptr<uchar>(0) + x0 + k, step, smoothed.rows};
-          for (int y = 0; y < smoothed.rows; ++y) AddIfCandidate(p, y, w, t, &candidates[k]);
+          ColumnCandidates(smoothed, x0 + k, w, t, &candidates[k]);
         }
       }
       for (int k = 0; k < width; ++k)
