@@ -1,12 +1,15 @@
 // Private to bsls::interpretation: what the two labellings (labelling.cpp
 // on the skeleton graph, track_labelling.cpp on the track network) judge
-// alike: the median of row-spacing samples, and the rule that a label its
-// neighbours disagree with is dropped rather than guessed (thesis 5.1.4.9).
+// alike: the median of row-spacing samples, the rows a step along a line
+// spans, and the rule that a label its neighbours disagree with is dropped
+// rather than guessed (thesis 5.1.4.9).
 #ifndef BSLS_INTERPRETATION_SRC_LABEL_VOTES_H_
 #define BSLS_INTERPRETATION_SRC_LABEL_VOTES_H_
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 namespace bsls::interpretation::internal {
@@ -16,6 +19,22 @@ inline double Median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
+}
+
+// How many rows a step of dy px along a line spans at `spacing` px a row:
+// the whole number (odd between junctions of alternating kinds, even
+// between junctions of one kind, at most max_rows) nearest to dy, and how
+// far dy misses it (px).
+struct RowCount {
+  int rows = 0;
+  double miss = 0.0;
+};
+inline RowCount NearestRowCount(double dy, double spacing, bool alternating, int max_rows) {
+  const int first = alternating ? 1 : 2;
+  RowCount best{first, std::numeric_limits<double>::infinity()};
+  for (int rows = first; rows <= max_rows; rows += 2)
+    if (std::abs(dy - rows * spacing) < best.miss) best = {rows, std::abs(dy - rows * spacing)};
+  return best;
 }
 
 // Drops every label most of whose labelled neighbours disagree with it (two

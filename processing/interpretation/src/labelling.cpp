@@ -244,18 +244,9 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
   std::vector<std::vector<Link>> adj(n_nodes);
   for (const VerticalLink& l : vlinks) {
     const double s = local_spacing(l.mid);
-    int best_rows = l.alternating ? 1 : 2;
-    double best_miss = 1e9;
-    for (int rows = l.alternating ? 1 : 2; rows <= 8; rows += 2) {
-      const double miss = std::abs(l.dy - rows * s);
-      if (miss < best_miss) {
-        best_miss = miss;
-        best_rows = rows;
-      }
-    }
-    // A step that fits no whole number of rows of its parity joins a false
-    // junction (e.g. where two lines overlap, thesis 5.1.4.8): no link.
-    if (best_miss > 0.35 * s) continue;
+    const internal::RowCount step = internal::NearestRowCount(l.dy, s, l.alternating, 8);
+    const int best_rows = step.rows;
+    if (step.miss > 0.35 * s) continue;
     const bool normal_step = best_rows <= 2;
     const double w = l.trusted ? kTrusted : (normal_step ? kPlain : kPlain * best_rows);
     adj[l.a].push_back({l.b, 0, best_rows, w, l.first, true});

@@ -169,6 +169,9 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
       own_spacing[t] = Median(samples);
   }
   const double frame_spacing = Median(all_spacing);
+  auto spacing_of = [&](int track) {
+    return own_spacing[track] > 0 ? own_spacing[track] : frame_spacing;
+  };
 
   // Steps along lines: consecutive junctions of a track, a whole number of rows apart.
   struct Step {
@@ -178,24 +181,17 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   std::vector<Step> down(n);  // the next junction down the junction's line track
   for (size_t t = 0; t < net.lines.size(); ++t) {
     const std::vector<int>& on = net.junctions_on_line[t];
-    const double s = own_spacing[t] > 0 ? own_spacing[t] : frame_spacing;
+    const double s = spacing_of(static_cast<int>(t));
     if (!(s > 0)) continue;
     for (size_t i = 1; i < on.size(); ++i) {
       const TrackJunction& a = net.junctions[on[i - 1]];
       const TrackJunction& b = net.junctions[on[i]];
-      const double dy = b.position.y - a.position.y;
-      const int first = a.kind != b.kind ? 1 : 2;
-      int rows = first;
-      double miss = std::numeric_limits<double>::infinity();
-      for (int r = first; r <= params.max_rows; r += 2)
-        if (std::abs(dy - r * s) < miss) {
-          miss = std::abs(dy - r * s);
-          rows = r;
-        }
+      const internal::RowCount step = internal::NearestRowCount(
+          b.position.y - a.position.y, s, a.kind != b.kind, params.max_rows);
       // A step that fits no whole number of rows of its parity joins a false
       // junction (a segment's end on the wrong line): no link.
-      if (miss > params.max_row_miss * s) continue;
-      down[on[i - 1]] = {on[i], rows};
+      if (step.miss > params.max_row_miss * s) continue;
+      down[on[i - 1]] = {on[i], step.rows};
     }
   }
   // Segments: a direct junction at one end and a corresponding one at the
@@ -275,13 +271,9 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // Two rows per step of line 0's row spacing between consecutive seeds.
   // Two seeds closer than one step cannot both be line 0's junctions (a
   // stray segment's end at a fold): neither seeds.
-  auto spacing_at = [&](int j) {
-    const double own = own_spacing[net.junctions[j].line];
-    return own > 0 ? own : frame_spacing;
-  };
   auto steps_between = [&](int a, int b) {
     const double gap = net.junctions[b].position.y - net.junctions[a].position.y;
-    const double s = spacing_at(b);
+    const double s = spacing_of(net.junctions[b].line);
     if (!(s > 0)) return 1;  // no spacing measured anywhere: one step each
     return static_cast<int>(std::lround(gap / (2 * s)));
   };
