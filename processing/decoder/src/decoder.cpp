@@ -11,17 +11,18 @@
 #include <optional>
 #include <stdexcept>
 
+#include "bsls/geometry/curve_fit.h"
 #include "centres_ahead.h"
-#include "curve_fit.h"
 #include "track_chain.h"
 #include "working_resolution.h"
 
 namespace bsls::decoder {
 namespace {
 
-using internal::FitAtZero;
-using internal::FitLine;
-using internal::FitParabola;
+using geometry::FitAtZero;
+using geometry::FitLine;
+using geometry::FitParabola;
+using geometry::Quadratic;
 
 using Clock = std::chrono::steady_clock;
 
@@ -48,7 +49,7 @@ std::string CheckFrame(const cv::Mat& grey, const DecodeParams& params) {
 // samples is at most max_rms; nullopt otherwise (also for max_rms <= 0).
 std::optional<double> CloseParabolaAtZero(const std::vector<std::pair<double, double>>& s,
                                           double max_rms) {
-  cv::Vec3d c;
+  Quadratic c;
   if (!(max_rms > 0.0) || !FitParabola(s, &c)) return std::nullopt;
   double squares = 0.0;
   for (const auto& [t, x] : s) {
@@ -533,7 +534,7 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
       // Where the parabola x = k0 + k1 t + k2 t^2 (t = y - y0) meets the
       // segment: e k2 t^2 + (e k1 - 1) t + c + e (k0 - a) - y0 = 0; the root
       // nearer t = 0, in the form that stays exact as e k2 -> 0.
-      auto meet_curve = [&](const cv::Vec3d& k, cv::Point2d* out) {
+      auto meet_curve = [&](const Quadratic& k, cv::Point2d* out) {
         const double qa = e * k[2], qb = e * k[1] - 1.0, qc = c + e * (k[0] - a) - y0;
         const double disc = qb * qb - 4 * qa * qc;
         if (disc < 0) return false;
@@ -569,10 +570,10 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
           for (const auto& v : plan.wide)
             if ((v.first < 0) == entered_upper) branch.push_back(v);
           cv::Point2d curved;
-          if (cv::Vec3d k; FitParabola(branch, &k) && meet_curve(k, &curved)) return curved;
+          if (Quadratic k; FitParabola(branch, &k) && meet_curve(k, &curved)) return curved;
           return entered_upper ? cv::Point2d(xu, yu) : cv::Point2d(xl, yl);
         }
-      } else if (cv::Vec3d k; branches && FitParabola(vertical, &k)) {
+      } else if (Quadratic k; branches && FitParabola(vertical, &k)) {
         // A line curving smoothly through it: its centres on both sides as a
         // parabola.
         if (cv::Point2d curved; meet_curve(k, &curved)) return curved;
@@ -586,7 +587,7 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
         for (const auto& v : plan.wide)
           if ((v.first < 0) == (upper.size() >= 2)) one_side.push_back(v);
         cv::Point2d curved;
-        if (cv::Vec3d q; FitParabola(one_side, &q) && meet_curve(q, &curved)) return curved;
+        if (Quadratic q; FitParabola(one_side, &q) && meet_curve(q, &curved)) return curved;
       }
       if (meet(a, b, &ya)) y = ya;
     }

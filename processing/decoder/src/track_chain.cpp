@@ -10,10 +10,16 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bsls/extraction/stripe_centre.h"
-#include "curve_fit.h"
+#include "bsls/geometry/curve_fit.h"
 
 namespace bsls::decoder::internal {
 namespace {
+
+using geometry::FitAtZero;
+using geometry::FitLine;
+using geometry::FitParabola;
+using geometry::Sample;
+using geometry::Samples;
 
 using Clock = std::chrono::steady_clock;
 
@@ -91,7 +97,7 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
     near.clear();
     for (int i = std::max(gap_start - reach, 0); i <= std::min(g1 + reach, n - 1); ++i)
       if (!std::isnan(c.measured[i])) near.emplace_back(i - middle, c.measured[i]);
-    cv::Vec3d q;
+    geometry::Quadratic q;
     double a, b;
     if (FitParabola(near, &q)) {
       for (int i = gap_start; i <= g1; ++i)

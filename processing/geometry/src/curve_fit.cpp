@@ -1,9 +1,9 @@
-#include "curve_fit.h"
+#include "bsls/geometry/curve_fit.h"
 
 #include <cmath>
 #include <limits>
 
-namespace bsls::decoder::internal {
+namespace bsls::geometry {
 
 // Least-squares line x = a + b t through (t, x) samples; false with < 2 samples.
 bool FitLine(std::span<const Sample> s, double* a, double* b) {
@@ -27,7 +27,7 @@ bool FitLine(std::span<const Sample> s, double* a, double* b) {
 // there are fewer than five or they do not fix a parabola. The normal
 // equations are solved by Cholesky's method (as cv::solve's DECOMP_CHOLESKY),
 // written out for 3 x 3.
-bool FitParabola(std::span<const Sample> s, cv::Vec3d* c) {
+bool FitParabola(std::span<const Sample> s, Quadratic* c) {
   if (s.size() < 5) return false;
   double m[5] = {0, 0, 0, 0, 0};  // sums of t^0 .. t^4
   double r[3] = {0, 0, 0};        // sums of x, t x, t^2 x
@@ -68,11 +68,11 @@ bool FitParabola(std::span<const Sample> s, cv::Vec3d* c) {
 // The value at t = 0 of a parabola through (t, x) samples (a line when there
 // are fewer than five), or nullopt.
 std::optional<double> FitAtZero(std::span<const Sample> s) {
-  cv::Vec3d c;
+  Quadratic c;
   if (FitParabola(s, &c)) return c[0];
   double a, b;
   if (!FitLine(s, &a, &b)) return std::nullopt;
   return a;
 }
 
-}  // namespace bsls::decoder::internal
+}  // namespace bsls::geometry

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "bsls/geometry/curve_fit.h"
+
 namespace bsls::interpretation {
 
 bool TrackParams::IsValid(std::string* error) const {
@@ -129,6 +131,7 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
   };
   const int towards_p = pattern::ImageDirectionOfIncreasingP(side);
   const auto& cp = net.columns.points;  // x: image row, y: image column
+  geometry::Samples in;  // a segment's end: (column - the end's column, row)
   for (int s = 0; s < static_cast<int>(net.segments.size()); ++s) {
     const std::vector<int>& t = net.segments[s].points;
     if (static_cast<int>(t.size()) < params.min_segment) continue;
@@ -145,21 +148,14 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
       double ey = end.x;
       const int n_points = static_cast<int>(t.size());
       if (n_points >= params.end_skip + 2) {
-        double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
+        in.clear();
         for (int k = params.end_skip; k < std::min(n_points, params.end_skip + params.end_fit); ++k) {
           const extraction::RidgePoint& q = cp[left_end ? t[k] : t[n_points - 1 - k]];
-          const double x = q.y - ex, y = q.x;
-          sx += x;
-          sy += y;
-          sxx += x * x;
-          sxy += x * y;
-          n += 1;
+          in.emplace_back(q.y - ex, q.x);
         }
-        const double den = n * sxx - sx * sx;
-        if (den > 0) {
-          const double fit = (sy * sxx - sx * sxy) / den;  // the fit's value at x = ex
-          if (std::abs(fit - ey) > params.end_bend) ey = fit;
-        }
+        double at_end, slope;  // the fit's row at the end's column
+        if (geometry::FitLine(in, &at_end, &slope) && std::abs(at_end - ey) > params.end_bend)
+          ey = at_end;
       }
       const double lo = left_end ? ex - params.end_reach : std::max(ex - params.end_reach, middle);
       const double hi = left_end ? std::min(ex + params.end_reach, middle) : ex + params.end_reach;

@@ -1,22 +1,23 @@
-// Private to bsls::decoder: least-squares curves through the sub-pixel
-// centres of a line (x as a function of the row) or of a segment (y as a
-// function of the column), which place junctions and refill skipped rows.
+// Least-squares curves through samples: a line or a parabola x(t) fitted
+// to (t, x) pairs, t the free coordinate and x the fitted one (a stripe's
+// centre as a function of the row, a segment's row as a function of the
+// column, ...).
 //
-// Samples are (t, x) pairs: t the free coordinate, x the fitted one.
-#ifndef BSLS_DECODER_SRC_CURVE_FIT_H_
-#define BSLS_DECODER_SRC_CURVE_FIT_H_
+// Thread-safety: pure functions of their arguments.
+#ifndef BSLS_GEOMETRY_CURVE_FIT_H_
+#define BSLS_GEOMETRY_CURVE_FIT_H_
 
+#include <array>
 #include <optional>
 #include <span>
 #include <utility>
 #include <vector>
 
-#include <opencv2/core.hpp>
+namespace bsls::geometry {
 
-namespace bsls::decoder::internal {
-
-using Sample = std::pair<double, double>;
+using Sample = std::pair<double, double>;  // (t, x)
 using Samples = std::vector<Sample>;
+using Quadratic = std::array<double, 3>;   // x = c[0] + c[1] t + c[2] t^2
 
 // Least-squares line x = a + b t through the samples; false with fewer than
 // two or all at one t.
@@ -24,12 +25,12 @@ bool FitLine(std::span<const Sample> s, double* a, double* b);
 
 // Least-squares x = c0 + c1 t + c2 t^2 through the samples; false when
 // there are fewer than five or they do not fix a parabola.
-bool FitParabola(std::span<const Sample> s, cv::Vec3d* c);
+bool FitParabola(std::span<const Sample> s, Quadratic* c);
 
 // The value at t = 0 of a parabola through the samples (a line when there
 // are fewer than five), or nullopt.
 std::optional<double> FitAtZero(std::span<const Sample> s);
 
-}  // namespace bsls::decoder::internal
+}  // namespace bsls::geometry
 
-#endif  // BSLS_DECODER_SRC_CURVE_FIT_H_
+#endif  // BSLS_GEOMETRY_CURVE_FIT_H_
