@@ -21,6 +21,8 @@ bool TrackParams::IsValid(std::string* error) const {
   if (!(end_bend >= 0)) return fail("end_bend must not be negative");
   if (bridge_rows < 1) return fail("bridge_rows must be at least 1");
   if (!(bridge_distance > 0)) return fail("bridge_distance must be positive");
+  if (!(max_segment_slope > 0)) return fail("max_segment_slope must be positive");
+  if (steep_columns < 2) return fail("steep_columns must be at least 2");
   return true;
 }
 
@@ -70,6 +72,44 @@ std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const Track
   return tracks;
 }
 
+std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
+                                     std::vector<Track> segments, const TrackParams& params) {
+  const auto& cp = columns.points;  // x: image row, y: image column
+  const int w = params.steep_columns;
+  std::vector<Track> out;
+  std::vector<char> steep;
+  for (Track& t : segments) {
+    const int n = static_cast<int>(t.points.size());
+    if (n <= w) {
+      out.push_back(std::move(t));
+      continue;
+    }
+    // Every point of a window of w + 1 points (w columns) that climbs too
+    // steeply belongs to a steep stretch.
+    steep.assign(n, 0);
+    bool any = false;
+    for (int i = 0; i + w < n; ++i)
+      if (std::abs(cp[t.points[i + w]].x - cp[t.points[i]].x) > params.max_segment_slope * w) {
+        std::fill(steep.begin() + i, steep.begin() + i + w + 1, 1);
+        any = true;
+      }
+    if (!any) {
+      out.push_back(std::move(t));
+      continue;
+    }
+    for (int i = 0; i < n;) {
+      if (steep[i]) {
+        ++i;
+        continue;
+      }
+      Track piece;
+      for (; i < n && !steep[i]; ++i) piece.points.push_back(t.points[i]);
+      if (static_cast<int>(piece.points.size()) >= params.min_track) out.push_back(std::move(piece));
+    }
+  }
+  return out;
+}
+
 TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePoints columns,
                                pattern::Side side, const TrackParams& params) {
   std::string why;
@@ -78,7 +118,7 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
   net.rows = std::move(rows);
   net.columns = std::move(columns);
   net.lines = LinkTracks(net.rows, params, &net.line_of_point);
-  net.segments = LinkTracks(net.columns, params);
+  net.segments = CutSteepStretches(net.columns, LinkTracks(net.columns, params), params);
 
   // Gaps in lines: each track's end and the start of the nearest track
   // beginning within bridge_rows below it, when each is the other's nearest.

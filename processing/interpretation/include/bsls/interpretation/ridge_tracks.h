@@ -49,6 +49,12 @@ struct TrackParams {
   // fold, or cut by a shadow), >= 1 and > 0.
   int bridge_rows = 12;
   double bridge_distance = 8.0;
+  // A segment track is cut where it climbs more than max_segment_slope rows
+  // per column over steep_columns columns or more: there it follows a
+  // steeply slanted line from one segment's end to the next row's segment
+  // (at a fold); a segment itself runs nearly along its row. > 0 and >= 2.
+  double max_segment_slope = 0.6;
+  int steep_columns = 4;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
@@ -91,6 +97,12 @@ struct TrackNetwork {
 // `track_of_point` (optional) receives each point's track or -1.
 std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const TrackParams& params,
                               std::vector<int>* track_of_point = nullptr);
+
+// Cuts the stretches of `segments` (tracks through `columns`) that climb
+// more than max_segment_slope rows per column over steep_columns or more;
+// pieces shorter than min_track are dropped.
+std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
+                                     std::vector<Track> segments, const TrackParams& params);
 
 // Links both sets of ridge points and finds the junctions of the brick
 // slide of `side`. Throws std::invalid_argument for invalid params.
