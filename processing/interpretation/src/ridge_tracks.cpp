@@ -178,6 +178,7 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
     // The segment's middle column: each end looks for its line on its own
     // half, so that a short segment's two ends find their two lines.
     const double middle = 0.5 * (cp[t.front()].y + cp[t.back()].y);
+    const size_t first_junction = net.junctions.size();
     for (const bool left_end : {true, false}) {
       const extraction::RidgePoint& end = cp[left_end ? t.front() : t.back()];
       const double ex = end.y;
@@ -231,6 +232,11 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
                                               : pattern::JunctionKind::kCorresponding;
       net.junctions.push_back(j);
     }
+    // A segment joins two lines; one whose ends both meet the same line
+    // (a speck of light beside it) makes no junction.
+    if (net.junctions.size() == first_junction + 2 &&
+        net.junctions[first_junction].line == net.junctions[first_junction + 1].line)
+      net.junctions.resize(first_junction);
   }
   net.junctions_on_line.assign(net.lines.size(), {});
   for (int i = 0; i < static_cast<int>(net.junctions.size()); ++i)

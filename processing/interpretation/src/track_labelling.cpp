@@ -26,6 +26,8 @@ struct Link {
 
 constexpr double kTrusted = 0.01;  // a link of a brick that closes (thesis: a complete loop)
 constexpr double kLineZeroGap = 1.0;  // rows of line 0 counted across a gap between its tracks
+constexpr double kSpacingSpread = 1.6;  // a line's own row spacing lies within this factor
+                                        // of the frame's
 constexpr double kPlain = 10.0;    // any other step of one or two rows, or segment: a path
                                    // through closed bricks beats any path with one such link;
                                    // a longer step costs this per row
@@ -156,19 +158,41 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   out.v.assign(n, kUnlabelled);
   out.line_p.assign(net.lines.size(), -1);
 
-  // Row spacing: each line's own where it has enough steps, else the frame's.
+  // Line 0 (thesis 5.2.1): found first, since its segments all leave
+  // towards p = 1: a corresponding junction on it is a stray segment's end.
+  std::string why;
+  out.reference = ReferenceTracks(net, side, params, &why);
+  if (out.reference.empty()) {
+    out.error = why;
+    return out;
+  }
+  std::vector<char> is_reference(net.lines.size(), 0);
+  for (int t : out.reference) is_reference[t] = 1;
+
+  // Row spacing: each line's own where it has enough steps, else the
+  // frame's. A stray junction splits a step in two shorter ones, so a line's
+  // own spacing is the median of its steps within kSpacingSpread of the
+  // frame's (the median of all steps).
+  std::vector<std::vector<double>> samples(net.lines.size());
   std::vector<double> all_spacing;
-  std::vector<double> own_spacing(net.lines.size(), 0.0);
   for (size_t t = 0; t < net.lines.size(); ++t) {
-    const std::vector<int>& on = net.junctions_on_line[t];
-    std::vector<double> samples;
-    for (size_t i = 1; i < on.size(); ++i)
-      samples.push_back(RowSpacing(net.junctions[on[i - 1]], net.junctions[on[i]]));
-    all_spacing.insert(all_spacing.end(), samples.begin(), samples.end());
-    if (static_cast<int>(samples.size()) >= params.min_own_spacings)
-      own_spacing[t] = Median(samples);
+    int previous = -1;
+    for (int j : net.junctions_on_line[t]) {
+      if (is_reference[t] && net.junctions[j].kind != JunctionKind::kDirect) continue;
+      if (previous >= 0) samples[t].push_back(RowSpacing(net.junctions[previous], net.junctions[j]));
+      previous = j;
+    }
+    all_spacing.insert(all_spacing.end(), samples[t].begin(), samples[t].end());
   }
   const double frame_spacing = Median(all_spacing);
+  std::vector<double> own_spacing(net.lines.size(), 0.0);
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    std::erase_if(samples[t], [&](double s) {
+      return !(s >= frame_spacing / kSpacingSpread && s <= frame_spacing * kSpacingSpread);
+    });
+    if (static_cast<int>(samples[t].size()) >= params.min_own_spacings)
+      own_spacing[t] = Median(samples[t]);
+  }
   auto spacing_of = [&](int track) {
     return own_spacing[track] > 0 ? own_spacing[track] : frame_spacing;
   };
@@ -255,16 +279,10 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // each other starts at the cost of a long step from it, so that it keeps
   // the row counted from the spacing only where no path through the links
   // reaches it (a gap in line 0 that no neighbour bridges).
-  std::string why;
-  out.reference = ReferenceTracks(net, side, params, &why);
   std::vector<int> seeds;
   for (int t : out.reference)
     for (int j : net.junctions_on_line[t])
       if (net.junctions[j].kind == JunctionKind::kDirect) seeds.push_back(j);
-  if (out.reference.empty()) {
-    out.error = why;
-    return out;
-  }
   std::sort(seeds.begin(), seeds.end(), [&](int a, int b) {
     return net.junctions[a].position.y < net.junctions[b].position.y;
   });
