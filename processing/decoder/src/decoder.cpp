@@ -617,14 +617,6 @@ DecodeParams ScaledForBinning(const DecodeParams& params, int n) {
   return out;
 }
 
-// The binning n for a frame of measured stripe pitch `pitch` (px; 0: none).
-int BinningFor(double pitch, const DecodeParams& params) {
-  if (params.binning > 0) return params.binning;
-  if (pitch <= 0.0) return 1;
-  return std::clamp(static_cast<int>(std::lround(pitch / params.tuned_pitch)), 1,
-                    params.max_binning);
-}
-
 }  // namespace
 
 bool TrackChainParams::IsValid(std::string* error) const {
@@ -639,6 +631,7 @@ bool TrackChainParams::IsValid(std::string* error) const {
   if (centre_fit_rows < 1 || centre_fit_rows > 50)
     return fail("track_chain.centre_fit_rows must lie in 1..50");
   if (segment_columns < 2) return fail("track_chain.segment_columns must be at least 2");
+  if (!(tuned_pitch > 0)) return fail("track_chain.tuned_pitch must be positive");
   return true;
 }
 
@@ -700,7 +693,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   auto t = Clock::now();
   if (params.binning == 0)
     result.pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
-  const int n = BinningFor(result.pitch, params);
+  const int n = internal::BinningFor(result.pitch, params.tuned_pitch, params);
   result.binning = n;
   // The columns beside the lit pattern hold nothing to find.
   const cv::Rect region =

@@ -10,7 +10,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bsls/extraction/stripe_centre.h"
+#include "bsls/extraction/stripe_pitch.h"
 #include "bsls/geometry/curve_fit.h"
+#include "working_resolution.h"
 
 namespace bsls::decoder::internal {
 namespace {
@@ -197,14 +199,66 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
   return at;
 }
 
+// The line and segment tracks' ridge points drawn on a CV_8UC1 image of
+// the full frame's `size` (0/255), each track as a polyline through its
+// points' full-frame pixels (n: the binning they were found at).
+cv::Mat DrawTracks(const interpretation::TrackNetwork& net, int n, cv::Size size) {
+  cv::Mat out = cv::Mat::zeros(size, CV_8UC1);
+  std::vector<cv::Point> path;
+  auto draw = [&](const std::vector<interpretation::Track>& tracks,
+                  const extraction::RidgePoints& points, bool transposed) {
+    for (const interpretation::Track& track : tracks) {
+      path.clear();
+      for (int k : track.points) {
+        const extraction::RidgePoint& p = points.points[k];
+        const cv::Point2d at =
+            ToFullFrame(transposed ? cv::Point2d(p.y, p.x) : cv::Point2d(p.x, p.y), n);
+        path.emplace_back(static_cast<int>(std::lround(at.x)), static_cast<int>(std::lround(at.y)));
+      }
+      cv::polylines(out, path, false, cv::Scalar(255), 1, cv::LINE_8);
+    }
+  };
+  draw(net.lines, net.rows, false);
+  draw(net.segments, net.columns, true);  // a column point's x is its row
+  return out;
+}
+
+// A line's centres on the binned frame (one per binned row, ordered by y)
+// as one per row of the full frame: each mapped to the full frame and the
+// rows between two consecutive binned rows interpolated linearly; no row is
+// filled across a binned row without a centre.
+std::vector<cv::Point2d> RowsOfFullFrame(const std::vector<cv::Point2d>& binned, int n) {
+  std::vector<cv::Point2d> out;
+  for (size_t k = 0; k < binned.size(); ++k) {
+    const cv::Point2d a = ToFullFrame(binned[k], n);
+    const bool joined = k + 1 < binned.size() && binned[k + 1].y - binned[k].y == 1.0;
+    if (!joined) {
+      if (a.y == std::floor(a.y)) out.push_back(a);  // an odd n: a full row of its own
+      continue;
+    }
+    const cv::Point2d b = ToFullFrame(binned[k + 1], n);
+    for (int y = static_cast<int>(std::ceil(a.y)); y < b.y; ++y)
+      out.emplace_back(a.x + (b.x - a.x) * (y - a.y) / (b.y - a.y), y);
+  }
+  return out;
+}
+
 }  // namespace
 
 void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
                     DecodeResult* result) {
   const TrackChainParams& tp = params.track_chain;
   auto t = Clock::now();
+  // The working resolution: a frame whose stripes lie n times further apart
+  // than the pixel sizes are tuned for is binned n x n.
+  if (params.binning == 0)
+    result->pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
+  const int n = BinningFor(result->pitch, tp.tuned_pitch, params);
+  result->binning = n;
+  result->region = cv::Rect(0, 0, grey.cols, grey.rows);
+  const cv::Mat working = BinFrame(grey, n);
   cv::Mat smoothed;
-  cv::GaussianBlur(grey, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
+  cv::GaussianBlur(working, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
                    cv::BORDER_REPLICATE);
   extraction::RidgePoints rows = extraction::FindRidgePoints(smoothed, tp.ridge);
   extraction::RidgePoints columns = extraction::FindColumnRidgePoints(smoothed, tp.ridge);
@@ -218,17 +272,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
   // The tracks' ridge points, as the skeleton chain's repaired skeleton.
-  result->skeleton = cv::Mat::zeros(grey.size(), CV_8UC1);
-  for (const interpretation::Track& track : net.lines)
-    for (int k : track.points) {
-      const extraction::RidgePoint& p = net.rows.points[k];
-      result->skeleton.at<uchar>(p.y, static_cast<int>(std::lround(p.x))) = 255;
-    }
-  for (const interpretation::Track& track : net.segments)
-    for (int k : track.points) {
-      const extraction::RidgePoint& p = net.columns.points[k];  // x: row, y: column
-      result->skeleton.at<uchar>(static_cast<int>(std::lround(p.x)), p.y) = 255;
-    }
+  result->skeleton = DrawTracks(net, n, grey.size());
   if (!labels.ok) {
     result->error = labels.error;
     return;
@@ -242,7 +286,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   std::vector<TrackCentres> centres(net.lines.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(labelled.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
-      centres[labelled[i]] = MeasureTrack(grey, net, labelled[i], params);
+      centres[labelled[i]] = MeasureTrack(working, net, labelled[i], params);
   });
 
   // Junctions: one per label; where two claim one, the one on a track of
@@ -273,7 +317,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       d.p = labels.p[j];
       d.q = labels.v[j] + q_offset;
       d.kind = net.junctions[j].kind;
-      d.position = PlaceJunction(grey, net, j, centres[net.junctions[j].line], params);
+      d.position = ToFullFrame(
+          PlaceJunction(working, net, j, centres[net.junctions[j].line], params), n);
     }
   });
 
@@ -296,6 +341,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     if (result->lines.empty() || result->lines.back().p != p) result->lines.push_back({p, {}});
     result->lines.back().points.emplace_back(x, y);
   }
+  if (n > 1)
+    for (DecodedLine& line : result->lines) line.points = RowsOfFullFrame(line.points, n);
   result->times.subpixel_ms = MsSince(t);
   result->ok = true;
 }

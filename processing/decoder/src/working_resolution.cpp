@@ -1,6 +1,7 @@
 #include "working_resolution.h"
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
@@ -45,6 +46,13 @@ std::vector<cv::Point> RedrawSet(const std::vector<cv::Point>& pixels, const cv:
 }
 
 }  // namespace
+
+int BinningFor(double pitch, double tuned_pitch, const DecodeParams& params) {
+  if (params.binning > 0) return params.binning;
+  if (pitch <= 0.0) return 1;
+  return std::clamp(static_cast<int>(std::lround(pitch / tuned_pitch)), 1,
+                    params.max_binning);
+}
 
 cv::Mat BinFrame(const cv::Mat& grey, int n) {
   if (n <= 1) return grey;

@@ -14,9 +14,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "bsls/decoder/decoder.h"
 #include "bsls/interpretation/interpreter.h"
 
 namespace bsls::decoder::internal {
+
+// The binning n for a frame of measured stripe pitch `pitch` (px; 0: none):
+// params.binning when set, else round(pitch / tuned_pitch) within
+// 1..params.max_binning.
+int BinningFor(double pitch, double tuned_pitch, const DecodeParams& params);
 
 // The frame (CV_8UC1) binned n x n: every block of n x n pixels averaged
 // and rounded into one; the last cols % n columns and rows % n rows, which

@@ -57,6 +57,11 @@ enum class DecodeChain {
 
 // The track chain's own stages (DecodeChain::kTracks).
 struct TrackChainParams {
+  // The pixel sizes below hold for a stripe pitch near this (px, > 0); a
+  // frame whose measured pitch is n times wider is binned n x n
+  // (DecodeParams::pitch, max_binning and binning apply as for the skeleton
+  // chain).
+  double tuned_pitch = 15.0;
   double smoothing_sigma = 1.0;  // px, Gaussian applied before the ridge points, > 0
   extraction::RidgeParams ridge;
   interpretation::TrackParams tracks;

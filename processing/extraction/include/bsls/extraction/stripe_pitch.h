@@ -21,7 +21,10 @@
 // evaluation set, docs/decoding.md; synthetic combs in tests/extraction/
 // stripe_pitch_test.cpp): plane 11.6 px, ball cap 10.4, face 15.2-15.4, ramp
 // 20.8 (the true line spacings at the centre row: 10-14, 6-16, 13-42, 20-22);
-// doubling the image size doubles the measurement to within 1 %.
+// doubling the image size doubles the measurement to within 1 %. 16 rows
+// measure these scenes to within 2 % of 64 rows (4 % on the 2048 face) at a
+// quarter of the cost (0.08 ms at 512 x 512): enough for the binning, which
+// rounds the pitch to a multiple of about 21 px.
 //
 // Images: CV_8UC1 grey, x = column, y = row.
 //
@@ -41,7 +44,7 @@ namespace bsls::extraction {
 
 struct StripePitchParams {
   double central_band = 0.6;         // fraction of the rows, centred, that are sampled, (0, 1]
-  int sampled_rows = 64;             // rows taken from the band (fewer if it is shorter), >= 1
+  int sampled_rows = 16;             // rows taken from the band (fewer if it is shorter), >= 1
   double min_pitch = 4.0;            // px, smallest pitch reported, >= 2
   double max_pitch_fraction = 0.25;  // largest pitch reported, fraction of the width, (0, 0.5]
   // The pitch's autocorrelation must reach this fraction of the one at lag 0
