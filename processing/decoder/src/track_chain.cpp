@@ -200,14 +200,22 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
 }
 
 // The line and segment tracks' ridge points drawn on a CV_8UC1 image of
-// the full frame's `size` (0/255), each track as a polyline through its
-// points' full-frame pixels (n: the binning they were found at).
+// the full frame's `size` (0/255); found on a frame binned n x n (n > 1),
+// each track as a polyline through its points' full-frame pixels.
 cv::Mat DrawTracks(const interpretation::TrackNetwork& net, int n, cv::Size size) {
   cv::Mat out = cv::Mat::zeros(size, CV_8UC1);
   std::vector<cv::Point> path;
   auto draw = [&](const std::vector<interpretation::Track>& tracks,
                   const extraction::RidgePoints& points, bool transposed) {
     for (const interpretation::Track& track : tracks) {
+      if (n == 1) {  // each point on its own pixel, next to its neighbours
+        for (int k : track.points) {
+          const extraction::RidgePoint& p = points.points[k];
+          const int x = static_cast<int>(std::lround(p.x));
+          out.at<uchar>(transposed ? x : p.y, transposed ? p.y : x) = 255;
+        }
+        continue;
+      }
       path.clear();
       for (int k : track.points) {
         const extraction::RidgePoint& p = points.points[k];
@@ -324,22 +332,27 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
 
   // Lines: the centres of all tracks of one p, one per row (the first
   // labelled track's where two hold one row).
-  std::vector<std::tuple<int, int, int, double>> rows_of_lines;  // (p, y, track order, x)
-  for (size_t order = 0; order < labelled.size(); ++order) {
-    const int i = labelled[order];
-    const TrackCentres& c = centres[i];
-    for (size_t k = 0; k < c.output.size(); ++k)
-      if (!std::isnan(c.output[k]))
-        rows_of_lines.emplace_back(labels.line_p[i], c.first_row + static_cast<int>(k),
-                                   static_cast<int>(order), c.output[k]);
-  }
-  std::sort(rows_of_lines.begin(), rows_of_lines.end());
-  for (size_t i = 0; i < rows_of_lines.size(); ++i) {
-    const auto& [p, y, order, x] = rows_of_lines[i];
-    if (i > 0 && std::get<0>(rows_of_lines[i - 1]) == p && std::get<1>(rows_of_lines[i - 1]) == y)
-      continue;
-    if (result->lines.empty() || result->lines.back().p != p) result->lines.push_back({p, {}});
-    result->lines.back().points.emplace_back(x, y);
+  int max_p = -1;
+  for (int i : labelled) max_p = std::max(max_p, labels.line_p[i]);
+  std::vector<double> row_x;
+  for (int p = 0; p <= max_p; ++p) {
+    row_x.assign(working.rows, NAN);
+    bool any = false;
+    for (int i : labelled) {
+      if (labels.line_p[i] != p) continue;
+      const TrackCentres& c = centres[i];
+      for (size_t k = 0; k < c.output.size(); ++k) {
+        double& x = row_x[c.first_row + k];
+        if (std::isnan(x) && !std::isnan(c.output[k])) {
+          x = c.output[k];
+          any = true;
+        }
+      }
+    }
+    if (!any) continue;
+    DecodedLine& line = result->lines.emplace_back(DecodedLine{p, {}});
+    for (int y = 0; y < working.rows; ++y)
+      if (!std::isnan(row_x[y])) line.points.emplace_back(row_x[y], y);
   }
   if (n > 1)
     for (DecodedLine& line : result->lines) line.points = RowsOfFullFrame(line.points, n);
