@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 
 #include "bsls/calibration/calibration_file.h"
@@ -27,7 +28,7 @@ struct ProcessOptions {
   std::string overlay;
   std::string skeleton;
   std::string method = "modern";
-  std::string chain = "skeleton";
+  std::string chain;  // empty: the decoder's choice (decoder::ChainFor)
   std::string calibration;
   std::string surface;
   SurfaceChoices surface_choices;
@@ -80,7 +81,6 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   if (o.geometric_setup)
     throw CommandError(kExitUsage, "--geometric-setup runs here only: drop --server");
   if (!o.skeleton.empty()) throw CommandError(kExitUsage, "--skeleton runs here only: drop --server");
-  if (o.chain != "skeleton") throw CommandError(kExitUsage, "--chain runs here only: drop --server");
   io::FrameConversion conversion;
   const cv::Mat frame = io::LoadGreyFrame(o.image, &conversion);
   if (conversion.converted())
@@ -96,6 +96,9 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   request.mutable_decode()->set_method(o.method == "thesis" ? v1::DecodeOptions::METHOD_THESIS
                                                             : v1::DecodeOptions::METHOD_MODERN);
   request.mutable_decode()->set_no_repair(o.no_repair);
+  request.mutable_decode()->set_chain(o.chain == "tracks"     ? v1::DecodeOptions::CHAIN_TRACKS
+                                      : o.chain == "skeleton" ? v1::DecodeOptions::CHAIN_SKELETON
+                                                              : v1::DecodeOptions::CHAIN_UNSPECIFIED);
   ApplySurfaceChoices(o.surface_choices, request.mutable_surface());
   request.mutable_surface()->set_ascii_ply(o.ascii);
   request.set_request_tag(o.image.substr(0, 256));
@@ -154,7 +157,13 @@ void RunProcess(const ProcessOptions& o) {
   params.decode.extraction.method =
       o.method == "thesis" ? extraction::ExtractionMethod::kThesis : extraction::ExtractionMethod::kModern;
   params.decode.interpretation.enable_repair = !o.no_repair;
-  params.decode.chain = o.chain == "tracks" ? decoder::DecodeChain::kTracks : decoder::DecodeChain::kSkeleton;
+  std::optional<decoder::DecodeChain> named;
+  if (o.chain == "tracks") named = decoder::DecodeChain::kTracks;
+  if (o.chain == "skeleton") named = decoder::DecodeChain::kSkeleton;
+  std::string why;
+  const std::optional<decoder::DecodeChain> chain = decoder::ChainFor(named, params.decode, &why);
+  if (!chain) throw CommandError(kExitUsage, "--chain tracks: " + why);
+  params.decode.chain = *chain;
   ApplySurfaceChoices(o.surface_choices, &params);
   params.reconstruct = !o.surface.empty();
 
@@ -228,12 +237,14 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("--junctions", opts->junctions, "Output JSON of junctions and lines (contracts 5)")
       ->required();
   cmd->add_option("--overlay", opts->overlay, "Output PNG with the lines coloured by p");
-  cmd->add_option("--skeleton", opts->skeleton, "Output PNG of the repaired one-pixel skeleton");
-  cmd->add_option("--method", opts->method, "Feature extraction: modern (default) or thesis")
+  cmd->add_option("--skeleton", opts->skeleton, "Output PNG of what was traced: the repaired one-pixel skeleton, or the "
+                  "track chain's tracks");
+  cmd->add_option("--method", opts->method, "Skeleton chain's feature extraction: modern (default) or thesis")
       ->check(CLI::IsMember({"modern", "thesis"}));
   cmd->add_option("--chain", opts->chain,
-                  "Decoding chain: skeleton (default: thinning and loop tracing, thesis ch. 4-5) "
-                  "or tracks (ridge tracks, several times faster; docs/decoding.md)")
+                  "Decoding chain: tracks (default: ridge points linked into tracks) or "
+                  "skeleton (thinning and loop tracing, thesis ch. 4-5; the default with "
+                  "--method thesis or --no-repair, its options); docs/decoding.md")
       ->check(CLI::IsMember({"skeleton", "tracks"}));
   cmd->add_option("--calibration", opts->calibration,
                   "Calibration of this side (bsls calibrate): absolute q and the surface");
@@ -244,7 +255,7 @@ void AddProcessCommand(CLI::App& app) {
                 "Tables 2.1/2.2 (a fallback: millimetres only as good as those distances)");
   AddSurfaceChoices(cmd, &opts->surface_choices);
   cmd->add_flag("--ascii", opts->ascii, "Write an ASCII PLY instead of binary");
-  cmd->add_flag("--no-repair", opts->no_repair, "Label what is seen; seal no discontinuity");
+  cmd->add_flag("--no-repair", opts->no_repair, "Skeleton chain: label what is seen; seal no discontinuity");
   cmd->add_flag("--json", opts->json_summary, "Print the summary as one JSON object");
   cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
   AddServerOptions(*cmd, opts->server);

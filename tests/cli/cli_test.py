@@ -117,6 +117,28 @@ class CliTest(unittest.TestCase):
         bad = run("process", self.frame, "--side", "left", "--chain", "pixels", "--junctions", out)
         self.assertEqual(bad.returncode, EXIT_USAGE)
 
+    def test_the_chain_follows_the_options_asked_for(self):
+        """The track chain by default; the skeleton chain when named or when its own
+        options are given; the track chain named with them is a usage error."""
+        def junctions(*extra):
+            out = self.path("chain_%d.json" % len(extra))
+            r = run("process", self.frame, "--side", "left", "--junctions", out, *extra)
+            self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+            with open(out) as f:
+                return json.load(f)["junctions"]
+        default = junctions()
+        self.assertEqual(default, junctions("--chain", "tracks"))
+        skeleton = junctions("--chain", "skeleton")
+        self.assertNotEqual(default, skeleton)
+        self.assertEqual(junctions("--no-repair"), junctions("--no-repair", "--chain", "skeleton"))
+        thesis = junctions("--method", "thesis")
+        self.assertEqual(thesis, junctions("--method", "thesis", "--chain", "skeleton"))
+        self.assertNotEqual(thesis, default)
+        bad = run("process", self.frame, "--side", "left", "--junctions", self.path("bad.json"),
+                  "--chain", "tracks", "--method", "thesis")
+        self.assertEqual(bad.returncode, EXIT_USAGE)
+        self.assertIn("skeleton chain", bad.stderr)
+
     def test_evaluate_scores_the_decode_against_the_truth(self):
         out = self.path("e.json")
         self.assertEqual(run("process", self.frame, "--side", "left", "--junctions", out).returncode,

@@ -22,7 +22,10 @@ TEST(Decoder, CentresMeasuredAheadGiveTheSameResult) {
   for (const Side side : {Side::kLeft, Side::kRight}) {
     SCOPED_TRACE(std::string(pattern::ToString(side)));
     const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, 2);
-    DecodeParams after_params;
+    // Measuring ahead is the skeleton chain's.
+    DecodeParams ahead_params;
+    ahead_params.chain = DecodeChain::kSkeleton;
+    DecodeParams after_params = ahead_params;
     after_params.measure_ahead = false;
     const DecodeResult after = Decode(frame.image, side, after_params);
     ASSERT_TRUE(after.ok);
@@ -34,7 +37,7 @@ TEST(Decoder, CentresMeasuredAheadGiveTheSameResult) {
     DecodeResult ahead;
     for (int attempt = 0; attempt < 10; ++attempt) {
       SCOPED_TRACE("attempt " + std::to_string(attempt));
-      ahead = Decode(frame.image, side);
+      ahead = Decode(frame.image, side, ahead_params);
       ASSERT_TRUE(ahead.ok);
       ASSERT_NO_FATAL_FAILURE(ExpectSameJunctions(ahead, after));
       ASSERT_EQ(ahead.lines.size(), after.lines.size());

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <utility>
+#include <vector>
 
 #include "bsls/decoder/decoder.h"
 #include "decoder_evaluation.h"
@@ -32,8 +34,10 @@ class LesionFace : public ::testing::Test {
     frame_ = new simulator::Frame(simulator::Render(
         simulator::ThesisScene(Side::kLeft, SurfaceKind::kFace, options), render));
     result_ = new DecodeResult(Decode(frame_->image, Side::kLeft));
+    skeleton_ = new DecodeResult(Decode(frame_->image, Side::kLeft, Skeleton()));
   }
   static void TearDownTestSuite() {
+    delete skeleton_;
     delete result_;
     delete frame_;
   }
@@ -59,8 +63,23 @@ class LesionFace : public ::testing::Test {
     return {points, std::sqrt(sum_sq / std::max(points, 1))};
   }
 
+  // The parameters of the skeleton chain, whose own measures some tests
+  // below switch off.
+  static DecodeParams Skeleton() {
+    DecodeParams params;
+    params.chain = DecodeChain::kSkeleton;
+    return params;
+  }
+
+  // The decodes by the default chain (the track chain) and by the skeleton
+  // chain: the outcomes below hold for both.
+  static std::vector<std::pair<const char*, const DecodeResult*>> BothChains() {
+    return {{"default chain", result_}, {"skeleton chain", skeleton_}};
+  }
+
   static inline simulator::Frame* frame_ = nullptr;
-  static inline DecodeResult* result_ = nullptr;
+  static inline DecodeResult* result_ = nullptr;    // the default chain's
+  static inline DecodeResult* skeleton_ = nullptr;  // the skeleton chain's
 };
 
 // Below the nasolabial fold lines 4-6 run 3-8 px apart (rows 355-385), so
@@ -70,17 +89,20 @@ class LesionFace : public ::testing::Test {
 // unlabelled there. Each such H is split into its two junctions
 // (interpretation::SkeletonGraph::Build).
 TEST_F(LesionFace, JunctionsJoinedByShortSegmentsBelowTheFoldAreFound) {
-  const DecodeResult& r = *result_;
-  ASSERT_TRUE(r.ok) << r.error;
-  const cv::Rect2d fold(295.0, 355.0, 35.0, 30.0);
-  std::vector<simulator::PointLabel> truth, decoded;
-  for (const simulator::PointLabel& l : simulator::VisibleJunctions(frame_->truth))
-    if (fold.contains(l.position)) truth.push_back(l);
-  for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
-  const simulator::LabelScore score = simulator::ScoreLabels(truth, decoded, kMatchReach);
-  EXPECT_GE(score.truth, 6) << score.Summary();
-  EXPECT_EQ(score.found, score.truth) << score.Summary();
-  EXPECT_EQ(score.Wrong(), 0) << score.Summary();
+  for (const auto& [chain, decoded_by] : BothChains()) {
+    SCOPED_TRACE(chain);
+    const DecodeResult& r = *decoded_by;
+    ASSERT_TRUE(r.ok) << r.error;
+    const cv::Rect2d fold(295.0, 355.0, 35.0, 30.0);
+    std::vector<simulator::PointLabel> truth, decoded;
+    for (const simulator::PointLabel& l : simulator::VisibleJunctions(frame_->truth))
+      if (fold.contains(l.position)) truth.push_back(l);
+    for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
+    const simulator::LabelScore score = simulator::ScoreLabels(truth, decoded, kMatchReach);
+    EXPECT_GE(score.truth, 6) << score.Summary();
+    EXPECT_EQ(score.found, score.truth) << score.Summary();
+    EXPECT_EQ(score.Wrong(), 0) << score.Summary();
+  }
 }
 
 // Above the hidden stretch of the nasolabial fold line 3 comes out from
@@ -91,20 +113,20 @@ TEST_F(LesionFace, JunctionsJoinedByShortSegmentsBelowTheFoldAreFound) {
 // junction at the end of the Y's short way on takes that edge for its line
 // (interpretation::JunctionParams::max_merge_edge); the Y is a crossing.
 TEST_F(LesionFace, ALineComingOutFromBehindTheFoldLeavesItsNeighbourWhole) {
-  DecodeParams before;
+  DecodeParams before = Skeleton();
   before.interpretation.junction.max_merge_edge = 0;
   const DecodeResult as_before = Decode(frame_->image, Side::kLeft, before);
-  ASSERT_TRUE(result_->ok && as_before.ok);
+  ASSERT_TRUE(skeleton_->ok && as_before.ok);
   // Lines 3-5 in rows 336-348.
   auto score = [](const DecodeResult& r) { return ScoreStretch(r, 3, 5, 336, 348); };
-  const auto [now_points, now_rms] = score(*result_);
+  const auto [now_points, now_rms] = score(*skeleton_);
   const auto [before_points, before_rms] = score(as_before);
   std::printf("[ figures  ] lines 3-5, rows 336-348: %d points, RMS %.3f px; as before %d, RMS %.3f px\n",
               now_points, now_rms, before_points, before_rms);
   // 14 points at 0.202 px against 8 at 0.266 px (2026-11-26).
   EXPECT_GE(now_points, before_points + 5);
   EXPECT_LE(now_rms, before_rms);
-  const Evaluation now = Evaluate(*frame_, *result_), then = Evaluate(*frame_, as_before);
+  const Evaluation now = Evaluate(*frame_, *skeleton_), then = Evaluate(*frame_, as_before);
   EXPECT_EQ(now.all.Wrong(), 0);
   EXPECT_GE(now.all.found, then.all.found);
   EXPECT_LE(now.line_rms, then.line_rms + 0.002);
@@ -117,15 +139,18 @@ TEST_F(LesionFace, ALineComingOutFromBehindTheFoldLeavesItsNeighbourWhole) {
 // frame: 1 wrong p, 94.0 % found, line centre RMS 0.47 px, line 3 with 110
 // points).
 TEST_F(LesionFace, CrowdedLinesKeepTheirOwnStrands) {
-  const DecodeResult& r = *result_;
-  ASSERT_TRUE(r.ok) << r.error;
-  const Evaluation e = Evaluate(*frame_, r);
-  EXPECT_EQ(e.all.Wrong(), 0) << e.all.Summary();
-  EXPECT_GE(e.all.Recall(), 0.95) << e.all.Summary();
-  EXPECT_LE(e.line_rms, 0.15) << "points " << e.line_points;
-  for (const DecodedLine& line : r.lines) {
-    if (line.p >= 3 && line.p <= 5) {
-      EXPECT_GT(line.points.size(), 250u) << "line " << line.p;
+  for (const auto& [chain, decoded_by] : BothChains()) {
+    SCOPED_TRACE(chain);
+    const DecodeResult& r = *decoded_by;
+    ASSERT_TRUE(r.ok) << r.error;
+    const Evaluation e = Evaluate(*frame_, r);
+    EXPECT_EQ(e.all.Wrong(), 0) << e.all.Summary();
+    EXPECT_GE(e.all.Recall(), 0.95) << e.all.Summary();
+    EXPECT_LE(e.line_rms, 0.15) << "points " << e.line_points;
+    for (const DecodedLine& line : r.lines) {
+      if (line.p >= 3 && line.p <= 5) {
+        EXPECT_GT(line.points.size(), 250u) << "line " << line.p;
+      }
     }
   }
 }
@@ -137,11 +162,13 @@ TEST_F(LesionFace, CrowdedLinesKeepTheirOwnStrands) {
 // Skipping them on both sides, as before, kept 4050 points at 0.130 px RMS
 // on this frame.
 TEST_F(LesionFace, SteepLinesKeepTheRowsLeaningAwayFromASegment) {
-  const DecodeResult& r = *result_;
-  ASSERT_TRUE(r.ok) << r.error;
-  const Evaluation e = Evaluate(*frame_, r);
-  EXPECT_GE(e.line_points, 4100);
-  EXPECT_LE(e.line_rms, 0.13) << "points " << e.line_points;
+  for (const auto& [chain, decoded_by] : BothChains()) {
+      SCOPED_TRACE(chain);
+      ASSERT_TRUE(decoded_by->ok) << decoded_by->error;
+      const Evaluation e = Evaluate(*frame_, *decoded_by);
+      EXPECT_GE(e.line_points, 4100);
+      EXPECT_LE(e.line_rms, 0.13) << "points " << e.line_points;
+  }
 }
 
 // On the lump's lower skirt lines lean 50-60 degrees, and the rows beside
@@ -151,10 +178,10 @@ TEST_F(LesionFace, SteepLinesKeepTheRowsLeaningAwayFromASegment) {
 // (steep_fill_residual) it is, and those refills are as good as the
 // measured rows.
 TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
-  DecodeParams never;
+  DecodeParams never = Skeleton();
   never.steep_fill_residual = 0.0;
   const DecodeResult unfilled = Decode(frame_->image, Side::kLeft, never);
-  ASSERT_TRUE(result_->ok && unfilled.ok);
+  ASSERT_TRUE(skeleton_->ok && unfilled.ok);
   // The refilled points: in the decode, not in the one that never refills
   // steep stretches; scored against the true centre in their row.
   std::map<int, std::map<int, double>> truth, before;  // p -> row -> x
@@ -165,7 +192,7 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
     for (const cv::Point2d& q : line.points) before[line.p][static_cast<int>(std::lround(q.y))] = q.x;
   int refilled = 0;
   double sum_sq = 0.0;
-  for (const DecodedLine& line : result_->lines)
+  for (const DecodedLine& line : skeleton_->lines)
     for (const cv::Point2d& q : line.points) {
       const int y = static_cast<int>(std::lround(q.y));
       if (before[line.p].contains(y)) continue;
@@ -174,7 +201,7 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
       sum_sq += std::pow(q.x - truth[line.p][y], 2);
     }
   const double rms = std::sqrt(sum_sq / std::max(refilled, 1));
-  const Evaluation with = Evaluate(*frame_, *result_), without = Evaluate(*frame_, unfilled);
+  const Evaluation with = Evaluate(*frame_, *skeleton_), without = Evaluate(*frame_, unfilled);
   std::printf("[ figures  ] steep stretches refilled: %d points, RMS %.3f px; whole frame %d points, "
               "RMS %.4f px (without: %d, %.4f px)\n",
               refilled, rms, with.line_points, with.line_rms, without.line_points, without.line_rms);
@@ -184,7 +211,7 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
   EXPECT_LE(rms, 0.12);
   EXPECT_LE(with.line_rms, without.line_rms + 0.002);
   // Only points are added; junctions and labels are the same.
-  ASSERT_NO_FATAL_FAILURE(ExpectSameJunctions(*result_, unfilled));
+  ASSERT_NO_FATAL_FAILURE(ExpectSameJunctions(*skeleton_, unfilled));
 }
 
 // Where the lump's edge meets the nasolabial fold, lines 3-5 crowd to 4-7 px
@@ -194,13 +221,13 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
 // a segment; the rows of each crowd fitted jointly (crowd_distance,
 // extraction::StripeCentresInRow) keep more of them, and more accurately.
 TEST_F(LesionFace, LinesCrowdedAtAFoldAreMeasuredTogether) {
-  DecodeParams alone;
+  DecodeParams alone = Skeleton();
   alone.crowd_distance = 0.0;
   const DecodeResult one_by_one = Decode(frame_->image, Side::kLeft, alone);
-  ASSERT_TRUE(result_->ok && one_by_one.ok);
+  ASSERT_TRUE(skeleton_->ok && one_by_one.ok);
   // Lines 4 and 5 in rows 300-335.
   auto score = [](const DecodeResult& r) { return ScoreStretch(r, 4, 5, 300, 335); };
-  const auto [joint_points, joint_rms] = score(*result_);
+  const auto [joint_points, joint_rms] = score(*skeleton_);
   const auto [alone_points, alone_rms] = score(one_by_one);
   std::printf("[ figures  ] lines 4-5, rows 300-335: jointly %d points, RMS %.3f px; one by one %d, RMS %.3f px\n",
               joint_points, joint_rms, alone_points, alone_rms);
@@ -208,7 +235,7 @@ TEST_F(LesionFace, LinesCrowdedAtAFoldAreMeasuredTogether) {
   EXPECT_GE(joint_points, alone_points + 4);
   EXPECT_LE(joint_rms, 0.5 * alone_rms);
   // The whole frame no worse.
-  const Evaluation joint = Evaluate(*frame_, *result_), apart = Evaluate(*frame_, one_by_one);
+  const Evaluation joint = Evaluate(*frame_, *skeleton_), apart = Evaluate(*frame_, one_by_one);
   std::printf("[ figures  ] whole frame: jointly %d points, RMS %.4f px; one by one %d, RMS %.4f px\n",
               joint.line_points, joint.line_rms, apart.line_points, apart.line_rms);
   EXPECT_GE(joint.line_points, apart.line_points);

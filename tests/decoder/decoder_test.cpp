@@ -124,9 +124,9 @@ std::optional<double> JunctionErrorIn(const simulator::Frame& frame, const Decod
 }
 
 // The decoded junction (p, v) on a face frame against its truth, px.
-double JunctionError(Side side, std::uint32_t seed, int p, int v) {
+double JunctionError(Side side, std::uint32_t seed, int p, int v, DecodeChain chain) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, seed);
-  const DecodeResult r = Decode(frame.image, side);
+  const DecodeResult r = Decode(frame.image, side, WithChain(chain));
   EXPECT_TRUE(r.ok) << r.error;
   const std::optional<double> error = JunctionErrorIn(frame, r, p, v, 0);
   EXPECT_TRUE(error && *error < kNotDecoded);
@@ -143,7 +143,8 @@ TEST(Decoder, ASegmentEnteringAFoldFromItsOpenSideMeetsTheNearerBranch) {
   for (const auto& [side, seed] :
        {std::pair{Side::kLeft, 3u}, std::pair{Side::kLeft, 4u}, std::pair{Side::kRight, 4u}}) {
     SCOPED_TRACE(std::string(pattern::ToString(side)) + " seed " + std::to_string(seed));
-    EXPECT_LT(JunctionError(side, seed, 4, 7), 2.0);
+    for (const DecodeChain chain : {DecodeChain::kSkeleton, DecodeChain::kTracks})
+      EXPECT_LT(JunctionError(side, seed, 4, 7, chain), 2.0) << ChainName(chain);
   }
 }
 
@@ -155,7 +156,8 @@ TEST(Decoder, ASegmentEnteringAFoldFromItsOpenSideMeetsTheNearerBranch) {
 TEST(Decoder, ALineWithOneRowBesideItsJunctionIsFittedFromItsOtherSide) {
   for (const auto& [side, seed] : {std::pair{Side::kLeft, 4u}, std::pair{Side::kRight, 2u}}) {
     SCOPED_TRACE(std::string(pattern::ToString(side)) + " seed " + std::to_string(seed));
-    EXPECT_LT(JunctionError(side, seed, 3, 7), 2.5);
+    for (const DecodeChain chain : {DecodeChain::kSkeleton, DecodeChain::kTracks})
+      EXPECT_LT(JunctionError(side, seed, 3, 7, chain), 2.5) << ChainName(chain);
   }
 }
 
@@ -169,28 +171,35 @@ TEST(Decoder, TheChinsBottomRowIsDecodedAndPlaced) {
   for (const auto& [side, seed] : {std::pair{Side::kLeft, 2u}, std::pair{Side::kRight, 1u}}) {
     SCOPED_TRACE(std::string(pattern::ToString(side)) + " seed " + std::to_string(seed));
     const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, seed);
-    const DecodeResult r = Decode(frame.image, side);
-    ASSERT_TRUE(r.ok) << r.error;
-    const Evaluation e = Evaluate(frame, r);
-    int checked = 0;
-    for (int p : {2, 4}) {
-      const std::optional<double> error = JunctionErrorIn(frame, r, p, 16, e.all.v_offset);
-      if (!error) continue;  // not lit and seen on this frame
-      ++checked;
-      ASSERT_LT(*error, kNotDecoded) << "(" << p << ", 16) not decoded";
-      EXPECT_LT(*error, 2.0) << "(" << p << ", 16)";
+    for (const DecodeChain chain : {DecodeChain::kSkeleton, DecodeChain::kTracks}) {
+      SCOPED_TRACE(ChainName(chain));
+      const DecodeResult r = Decode(frame.image, side, WithChain(chain));
+      ASSERT_TRUE(r.ok) << r.error;
+      const Evaluation e = Evaluate(frame, r);
+      int checked = 0;
+      for (int p : {2, 4}) {
+        const std::optional<double> error = JunctionErrorIn(frame, r, p, 16, e.all.v_offset);
+        if (!error) continue;  // not lit and seen on this frame
+        ++checked;
+        ASSERT_LT(*error, kNotDecoded) << "(" << p << ", 16) not decoded";
+        EXPECT_LT(*error, 2.0) << "(" << p << ", 16)";
+      }
+      EXPECT_GE(checked, 1);
     }
-    EXPECT_GE(checked, 1);
   }
 }
 
 // Frame size: a 2048 x 2048 face (stripe pitch about 61 px, four times the
-// thesis's) is decoded as well as a 512 one. Its junctions are matched within
+// thesis's) is decoded as well as a 512 one by either chain, each binning it
+// to the pitch its pixel sizes are tuned for (the skeleton chain 3 x 3 for
+// 21 px, the track chain 4 x 4 for 15 px). Its junctions are matched within
 // the same part of the pattern as at 512 (2.5 px there, 0.16 of the pitch),
 // so 10 px here; sub-pixel centres within 0.6 px (0.15 px at 512). Before the
 // working resolution (docs/decoding.md, "Frame size") this frame failed: its
 // reference line was not found.
-TEST(Decoder, LargeFrameIsBinnedAndDecodedAsWell) {
+class LargeFrame : public ::testing::TestWithParam<DecodeChain> {};
+
+TEST_P(LargeFrame, IsBinnedAndDecodedAsWell) {
   constexpr int kSize = 2048;
   constexpr double kScale = kSize / 512.0;
   simulator::ThesisSceneOptions options;
@@ -205,10 +214,10 @@ TEST(Decoder, LargeFrameIsBinnedAndDecodedAsWell) {
   render.supersampling = 1;
   const simulator::Frame frame =
       simulator::Render(simulator::ThesisScene(Side::kRight, SurfaceKind::kFace, options), render);
-  const DecodeResult r = Decode(frame.image, Side::kRight);
+  const DecodeResult r = Decode(frame.image, Side::kRight, WithChain(GetParam()));
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(r.pitch, 61.0, 3.0);
-  EXPECT_EQ(r.binning, 3);
+  EXPECT_EQ(r.binning, GetParam() == DecodeChain::kTracks ? 4 : 3);
   std::vector<simulator::PointLabel> decoded;
   for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
   const simulator::LabelScore score = simulator::ScoreLabels(
@@ -221,9 +230,18 @@ TEST(Decoder, LargeFrameIsBinnedAndDecodedAsWell) {
   const simulator::LineScore centres =
       simulator::ScoreLines(simulator::TruthLines(frame.truth), lines);
   EXPECT_LE(centres.rms, 0.15 * kScale) << "points " << centres.points;
-  std::printf("2048 frame: %s, line centres %.3f px RMS over %d points\n", score.Summary().c_str(),
-              centres.rms, centres.points);
+  EXPECT_GT(centres.points, 15000);
+  for (const DecodedLine& line : r.lines)  // one point per row of the full frame, in order
+    for (size_t k = 1; k < line.points.size(); ++k)
+      ASSERT_GT(line.points[k].y, line.points[k - 1].y) << "line " << line.p;
+  EXPECT_EQ(r.skeleton.size(), frame.image.size());
+  std::printf("2048 frame, %s chain: %s, line centres %.3f px RMS over %d points\n",
+              ChainName(GetParam()).c_str(), score.Summary().c_str(), centres.rms, centres.points);
 }
+
+INSTANTIATE_TEST_SUITE_P(BothChains, LargeFrame,
+                         ::testing::Values(DecodeChain::kSkeleton, DecodeChain::kTracks),
+                         [](const auto& test_info) { return ChainName(test_info.param); });
 
 // The 512 x 512 frames are not binned: their pitch is what the parameters
 // are tuned for.
@@ -235,9 +253,9 @@ TEST(Decoder, ThesisSizeFrameIsNotBinned) {
   EXPECT_EQ(r.binning, 1);
 }
 
-// The dark columns beside a face or a plane are left out of extraction and
-// interpretation (DecodeParams::region_rise): the same junctions, labels and
-// centres as from the whole frame.
+// The skeleton chain leaves the dark columns beside a face or a plane out
+// of extraction and interpretation (DecodeParams::region_rise): the same
+// junctions, labels and centres as from the whole frame.
 TEST(Decoder, ColumnsBesideThePatternAreLeftOutWithTheSameResult) {
   struct Case {
     SurfaceKind kind;
@@ -250,8 +268,8 @@ TEST(Decoder, ColumnsBesideThePatternAreLeftOutWithTheSameResult) {
     SCOPED_TRACE(std::string(simulator::ToString(c.kind)) + " " +
                  std::string(pattern::ToString(c.side)));
     const simulator::Frame frame = RenderFrame(c.kind, c.side, c.seed);
-    const DecodeResult cut = Decode(frame.image, c.side);
-    DecodeParams whole_frame;
+    const DecodeResult cut = Decode(frame.image, c.side, WithChain(DecodeChain::kSkeleton));
+    DecodeParams whole_frame = WithChain(DecodeChain::kSkeleton);
     whole_frame.region_rise = 0.0;
     const DecodeResult whole = Decode(frame.image, c.side, whole_frame);
     ASSERT_TRUE(cut.ok && whole.ok);
@@ -272,7 +290,7 @@ TEST(Decoder, ColumnsBesideThePatternAreLeftOutWithTheSameResult) {
 
 TEST(Decoder, ThesisChainStillLabelsAPlaneRightly) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kPlane, Side::kLeft, 3);
-  DecodeParams params;
+  DecodeParams params = WithChain(DecodeChain::kSkeleton);
   params.extraction.method = extraction::ExtractionMethod::kThesis;
   const DecodeResult r = Decode(frame.image, Side::kLeft, params);
   ASSERT_TRUE(r.ok) << r.error;
@@ -335,6 +353,26 @@ TEST(Decoder, FrameWithoutReferenceLineIsReportedNotGuessed) {
   const DecodeResult cut = Decode(face.image, Side::kLeft);
   EXPECT_FALSE(cut.ok);
   EXPECT_NE(cut.error.find("reference line"), std::string::npos) << cut.error;
+}
+
+// The chain a caller gets: the one named, else the track chain, or the
+// skeleton chain where only it can do what the params ask for.
+TEST(Decoder, ChainForAnswersTheCallersChoice) {
+  DecodeParams plain, thesis, no_repair;
+  thesis.extraction.method = extraction::ExtractionMethod::kThesis;
+  no_repair.interpretation.enable_repair = false;
+  std::string why;
+  EXPECT_EQ(ChainFor(std::nullopt, plain, &why), DecodeChain::kTracks);
+  EXPECT_EQ(ChainFor(std::nullopt, thesis, &why), DecodeChain::kSkeleton);
+  EXPECT_EQ(ChainFor(std::nullopt, no_repair, &why), DecodeChain::kSkeleton);
+  EXPECT_EQ(ChainFor(DecodeChain::kSkeleton, plain, &why), DecodeChain::kSkeleton);
+  EXPECT_EQ(ChainFor(DecodeChain::kTracks, plain, &why), DecodeChain::kTracks);
+  EXPECT_EQ(ChainFor(DecodeChain::kSkeleton, thesis, &why), DecodeChain::kSkeleton);
+  EXPECT_FALSE(ChainFor(DecodeChain::kTracks, thesis, &why));
+  EXPECT_NE(why.find("thesis"), std::string::npos) << why;
+  EXPECT_FALSE(ChainFor(DecodeChain::kTracks, no_repair, &why));
+  EXPECT_NE(why.find("repair"), std::string::npos) << why;
+  EXPECT_EQ(DecodeParams{}.chain, DecodeChain::kTracks);
 }
 
 TEST(Decoder, InvalidInputIsRejectedWithReason) {

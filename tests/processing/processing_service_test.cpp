@@ -10,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <thread>
 
+#include "bsls/decoder/decode_output.h"
+#include "bsls/decoder/decoder.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/simulator/calibration_session.h"
 #include "service_fixture.h"
@@ -87,6 +89,46 @@ TEST(ProcessingService, ProcessFrameDecodesAndReconstructsOneSide) {
   EXPECT_EQ(overlay.cols, FaceFrame(pattern::Side::kLeft).cols);
   // The calibration sent inline is now cached by its id.
   EXPECT_EQ(s.service().calibrations().size(), 1u);
+}
+
+// Either chain decodes on the service, and the same as here: the skeleton
+// chain when named or asked for the thesis's extraction, the track chain by
+// default.
+TEST(ProcessingService, ProcessFrameDecodesByTheChainAskedFor) {
+  InProcessService s;
+  const cv::Mat frame = FaceFrame(pattern::Side::kRight);
+  auto junctions_of = [&](v1::DecodeOptions::Chain chain, v1::DecodeOptions::Method method) {
+    v1::ProcessFrameRequest request = FaceRequest(pattern::Side::kRight, false);
+    request.mutable_decode()->set_chain(chain);
+    request.mutable_decode()->set_method(method);
+    const WorkOutcome out = s.Client().ProcessFrame(request);
+    EXPECT_TRUE(out.status.ok()) << out.status.error_message();
+    return out.files.count("junctions.json") ? nlohmann::json::parse(out.files.at("junctions.json"))
+                                             : nlohmann::json();
+  };
+  auto local = [&](decoder::DecodeChain chain, extraction::ExtractionMethod method) {
+    decoder::DecodeParams params;
+    params.chain = chain;
+    params.extraction.method = method;
+    return decoder::ToJson(decoder::Decode(frame, pattern::Side::kRight, params));
+  };
+  using extraction::ExtractionMethod;
+  const nlohmann::json tracks = local(decoder::DecodeChain::kTracks, ExtractionMethod::kModern);
+  const nlohmann::json skeleton = local(decoder::DecodeChain::kSkeleton, ExtractionMethod::kModern);
+  const nlohmann::json thesis = local(decoder::DecodeChain::kSkeleton, ExtractionMethod::kThesis);
+  ASSERT_NE(tracks["junctions"], skeleton["junctions"]);
+  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_UNSPECIFIED, v1::DecodeOptions::METHOD_UNSPECIFIED)
+                ["junctions"],
+            tracks["junctions"]);
+  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_TRACKS, v1::DecodeOptions::METHOD_MODERN)
+                ["junctions"],
+            tracks["junctions"]);
+  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_SKELETON, v1::DecodeOptions::METHOD_UNSPECIFIED)
+                ["junctions"],
+            skeleton["junctions"]);
+  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_UNSPECIFIED, v1::DecodeOptions::METHOD_THESIS)
+                ["junctions"],
+            thesis["junctions"]);
 }
 
 TEST(ProcessingService, ProcessFrameWithoutCalibrationDecodesOnly) {
@@ -207,6 +249,12 @@ TEST(ProcessingService, BadRequestsAreRefusedWithTheFieldNamed) {
        StatusCode::FAILED_PRECONDITION, "frame"},
       {"long tag", [](auto& r) { r.set_request_tag(std::string(300, 'x')); },
        StatusCode::INVALID_ARGUMENT, "request_tag"},
+      {"track chain with the thesis's extraction",
+       [](auto& r) {
+         r.mutable_decode()->set_chain(v1::DecodeOptions::CHAIN_TRACKS);
+         r.mutable_decode()->set_method(v1::DecodeOptions::METHOD_THESIS);
+       },
+       StatusCode::INVALID_ARGUMENT, "decode.chain"},
   };
   for (const Case& c : cases) {
     v1::ProcessFrameRequest request = FaceRequest(pattern::Side::kLeft, true);

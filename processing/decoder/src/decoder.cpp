@@ -665,6 +665,23 @@ bool DecodeParams::IsValid(std::string* error) const {
   return true;
 }
 
+std::optional<DecodeChain> ChainFor(std::optional<DecodeChain> named, const DecodeParams& params,
+                                    std::string* why) {
+  const bool thesis_extraction = params.extraction.method != extraction::ExtractionMethod::kModern;
+  const bool no_repair = !params.interpretation.enable_repair;
+  if (!named) {
+    if (thesis_extraction || no_repair) return DecodeChain::kSkeleton;
+    return DecodeParams{}.chain;
+  }
+  if (*named == DecodeChain::kTracks && (thesis_extraction || no_repair)) {
+    if (why)
+      *why = std::string(thesis_extraction ? "the thesis's feature extraction" : "no repair") +
+             " is an option of the skeleton chain, not of the track chain";
+    return std::nullopt;
+  }
+  return named;
+}
+
 DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams& params) {
   if (grey.empty() || grey.type() != CV_8UC1)
     throw std::invalid_argument("Decode: frame must be a non-empty CV_8UC1 image");

@@ -121,8 +121,8 @@ std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
     return {};
   }
   if (corresponding > params.max_inner_fraction * (direct + corresponding)) {
-    *why = "the outermost line has " + std::to_string(corresponding) +
-           " segments on its inner side, so it is not line 0";
+    *why = "no reference line (line 0): the outermost line has " +
+           std::to_string(corresponding) + " segments on its inner side";
     return {};
   }
   return chain;

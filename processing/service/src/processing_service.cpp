@@ -84,6 +84,13 @@ reconstruction::SidePipelineParams SideParams(const v1::DecodeOptions& decode,
                                         ? extraction::ExtractionMethod::kThesis
                                         : extraction::ExtractionMethod::kModern;
   params.decode.interpretation.enable_repair = !decode.no_repair();
+  std::optional<decoder::DecodeChain> named;
+  if (decode.chain() == v1::DecodeOptions::CHAIN_TRACKS) named = decoder::DecodeChain::kTracks;
+  if (decode.chain() == v1::DecodeOptions::CHAIN_SKELETON) named = decoder::DecodeChain::kSkeleton;
+  std::string why;
+  const std::optional<decoder::DecodeChain> chain = decoder::ChainFor(named, params.decode, &why);
+  if (!chain) Refuse(StatusCode::INVALID_ARGUMENT, "decode.chain: " + why);
+  params.decode.chain = *chain;
   params.planes = surface.plane_model() == v1::SurfaceOptions::PLANE_MODEL_PARALLEL
                       ? reconstruction::PlaneModelKind::kParallel
                       : reconstruction::PlaneModelKind::kPerspective;

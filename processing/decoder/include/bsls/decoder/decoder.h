@@ -82,7 +82,7 @@ struct TrackChainParams {
 
 struct DecodeParams {
   pattern::PatternSpec spec;
-  DecodeChain chain = DecodeChain::kSkeleton;
+  DecodeChain chain = DecodeChain::kTracks;
   TrackChainParams track_chain;
   extraction::ExtractionParams extraction;
   interpretation::InterpretationParams interpretation;
@@ -192,6 +192,14 @@ struct DecodeResult {
   // for the track chain, the ridge points of its line and segment tracks.
   cv::Mat skeleton;
 };
+
+// The chain that decodes with `params` when a caller names `named` (nullopt:
+// none): the one named; where none is, the default (the track chain) unless
+// params ask for what only the skeleton chain does (the thesis's feature
+// extraction, no repair), then the skeleton chain. nullopt, with the reason
+// in `why`, when the track chain is named with such options.
+std::optional<DecodeChain> ChainFor(std::optional<DecodeChain> named, const DecodeParams& params,
+                                    std::string* why);
 
 // Decodes a CV_8UC1 frame of the brick slide of `side`. A blank or saturated
 // frame, or one whose reference line cannot be found, comes back with
