@@ -148,6 +148,8 @@ void Report(SurfaceKind kind, Side side, std::uint32_t seed, const Options& o, T
   if (const char* v = std::getenv("BSLS_TRACK_SIGMA")) decode.track_chain.smoothing_sigma = std::atof(v);
   if (const char* v = std::getenv("BSLS_TRACK_PROMINENCE")) decode.track_chain.ridge.min_prominence = std::atoi(v);
   if (const char* v = std::getenv("BSLS_TRACK_WINDOW")) decode.track_chain.ridge.half_window = std::atoi(v);
+  if (const char* v = std::getenv("BSLS_TRACK_SEGCOLS")) decode.track_chain.segment_columns = std::atoi(v);
+  if (const char* v = std::getenv("BSLS_TRACK_FITROWS")) decode.junction_fit_rows = std::atoi(v);
   const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame.image, side, decode);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -161,9 +161,9 @@ void RunProcess(const ProcessOptions& o) {
   if (o.chain == "tracks") named = decoder::DecodeChain::kTracks;
   if (o.chain == "skeleton") named = decoder::DecodeChain::kSkeleton;
   std::string why;
-  const std::optional<decoder::DecodeChain> chain = decoder::ChainFor(named, params.decode, &why);
-  if (!chain) throw CommandError(kExitUsage, "--chain tracks: " + why);
-  params.decode.chain = *chain;
+  if (!decoder::ChainFor(named, params.decode, &why))
+    throw CommandError(kExitUsage, "--chain tracks: " + why);
+  params.chain = named;
   ApplySurfaceChoices(o.surface_choices, &params);
   params.reconstruct = !o.surface.empty();
 

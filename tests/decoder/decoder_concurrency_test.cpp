@@ -23,8 +23,7 @@ TEST(Decoder, CentresMeasuredAheadGiveTheSameResult) {
     SCOPED_TRACE(std::string(pattern::ToString(side)));
     const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, side, 2);
     // Measuring ahead is the skeleton chain's.
-    DecodeParams ahead_params;
-    ahead_params.chain = DecodeChain::kSkeleton;
+    const DecodeParams ahead_params = SkeletonChainParams();
     DecodeParams after_params = ahead_params;
     after_params.measure_ahead = false;
     const DecodeResult after = Decode(frame.image, side, after_params);

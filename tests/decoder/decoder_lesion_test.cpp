@@ -34,7 +34,7 @@ class LesionFace : public ::testing::Test {
     frame_ = new simulator::Frame(simulator::Render(
         simulator::ThesisScene(Side::kLeft, SurfaceKind::kFace, options), render));
     result_ = new DecodeResult(Decode(frame_->image, Side::kLeft));
-    skeleton_ = new DecodeResult(Decode(frame_->image, Side::kLeft, Skeleton()));
+    skeleton_ = new DecodeResult(Decode(frame_->image, Side::kLeft, SkeletonChainParams()));
   }
   static void TearDownTestSuite() {
     delete skeleton_;
@@ -61,14 +61,6 @@ class LesionFace : public ::testing::Test {
       }
     }
     return {points, std::sqrt(sum_sq / std::max(points, 1))};
-  }
-
-  // The parameters of the skeleton chain, whose own measures some tests
-  // below switch off.
-  static DecodeParams Skeleton() {
-    DecodeParams params;
-    params.chain = DecodeChain::kSkeleton;
-    return params;
   }
 
   // The decodes by the default chain (the track chain) and by the skeleton
@@ -113,7 +105,7 @@ TEST_F(LesionFace, JunctionsJoinedByShortSegmentsBelowTheFoldAreFound) {
 // junction at the end of the Y's short way on takes that edge for its line
 // (interpretation::JunctionParams::max_merge_edge); the Y is a crossing.
 TEST_F(LesionFace, ALineComingOutFromBehindTheFoldLeavesItsNeighbourWhole) {
-  DecodeParams before = Skeleton();
+  DecodeParams before = SkeletonChainParams();
   before.interpretation.junction.max_merge_edge = 0;
   const DecodeResult as_before = Decode(frame_->image, Side::kLeft, before);
   ASSERT_TRUE(skeleton_->ok && as_before.ok);
@@ -178,7 +170,7 @@ TEST_F(LesionFace, SteepLinesKeepTheRowsLeaningAwayFromASegment) {
 // (steep_fill_residual) it is, and those refills are as good as the
 // measured rows.
 TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
-  DecodeParams never = Skeleton();
+  DecodeParams never = SkeletonChainParams();
   never.steep_fill_residual = 0.0;
   const DecodeResult unfilled = Decode(frame_->image, Side::kLeft, never);
   ASSERT_TRUE(skeleton_->ok && unfilled.ok);
@@ -221,7 +213,7 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
 // a segment; the rows of each crowd fitted jointly (crowd_distance,
 // extraction::StripeCentresInRow) keep more of them, and more accurately.
 TEST_F(LesionFace, LinesCrowdedAtAFoldAreMeasuredTogether) {
-  DecodeParams alone = Skeleton();
+  DecodeParams alone = SkeletonChainParams();
   alone.crowd_distance = 0.0;
   const DecodeResult one_by_one = Decode(frame_->image, Side::kLeft, alone);
   ASSERT_TRUE(skeleton_->ok && one_by_one.ok);

@@ -628,6 +628,8 @@ bool TrackChainParams::IsValid(std::string* error) const {
   if (!(smoothing_sigma > 0 && smoothing_sigma <= 10))
     return fail("track_chain.smoothing_sigma must lie in (0, 10]");
   if (!(max_centre_shift > 0)) return fail("track_chain.max_centre_shift must be positive");
+  if (!(max_centre_residual > 0) || residual_rows < 2)
+    return fail("track_chain.max_centre_residual must be positive and residual_rows at least 2");
   if (centre_fit_rows < 1 || centre_fit_rows > 50)
     return fail("track_chain.centre_fit_rows must lie in 1..50");
   if (segment_columns < 2) return fail("track_chain.segment_columns must be at least 2");
@@ -663,6 +665,12 @@ bool DecodeParams::IsValid(std::string* error) const {
   if (region_margin < 0) return fail("region_margin must not be negative");
   if (binning < 0 || binning > 16) return fail("binning must lie in 0..16");
   return true;
+}
+
+DecodeParams SkeletonChainParams() {
+  DecodeParams params;
+  params.chain = DecodeChain::kSkeleton;
+  return params;
 }
 
 std::optional<DecodeChain> ChainFor(std::optional<DecodeChain> named, const DecodeParams& params,

@@ -57,6 +57,7 @@ void MeasuredNear(const TrackCentres& c, int y, int reach, bool skip_own, Sample
 // junctions refilled from the centres on both sides.
 TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwork& net, int t,
                           const DecodeParams& params) {
+  const TrackChainParams& tp = params.track_chain;
   const auto& pts = net.lines[t].points;
   const auto& rp = net.rows.points;
   TrackCentres c;
@@ -76,15 +77,27 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
     // A centre far from its ridge point took another stripe's light (a
     // neighbour crowding in, a segment nearby): dropped.
     const auto x = extraction::RidgeCentreInRow(grey, p.y, p.x);
-    if (x && std::abs(*x - p.x) <= params.track_chain.max_centre_shift) c.measured[i] = *x;
+    if (x && std::abs(*x - p.x) <= tp.max_centre_shift) c.measured[i] = *x;
   }
+  // A centre its neighbours' curve misses by more than max_centre_residual
+  // took a segment's or a shadow's light (the row next to a skipped junction
+  // most): dropped, and refilled below where it lies in a short gap.
+  Samples near;
+  std::vector<double> kept = c.measured;
+  for (int i = 0; i < n; ++i) {
+    if (std::isnan(c.measured[i])) continue;
+    MeasuredNear(c, c.first_row + i, tp.residual_rows, true, &near);
+    if (near.size() < 3) continue;
+    const std::optional<double> expected = FitAtZero(near);
+    if (expected && std::abs(*expected - c.measured[i]) > tp.max_centre_residual) kept[i] = NAN;
+  }
+  c.measured.swap(kept);
   // Refill: each run of rows without a centre (the rows beside a junction,
   // and a centre or two dropped next to them) from one parabola through the
   // measured centres within centre_fit_rows on both sides of it.
-  const int reach = params.track_chain.centre_fit_rows;
+  const int reach = tp.centre_fit_rows;
   const int longest = 2 * clearance + 3;
   c.output = c.measured;
-  Samples near;
   for (int g0 = 0; g0 < n;) {
     if (!std::isnan(c.measured[g0])) {
       ++g0;

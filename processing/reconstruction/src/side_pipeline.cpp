@@ -10,6 +10,11 @@ bool SidePipelineParams::IsValid(std::string* error) const {
       *error = "SidePipelineParams.decode.q_offset must be unset (the calibration fixes q)";
     return false;
   }
+  std::string why;
+  if (!decoder::ChainFor(chain, decode, &why)) {
+    if (error) *error = "SidePipelineParams.chain: " + why;
+    return false;
+  }
   return decode.IsValid(error) && reconstruction.IsValid(error) && rows.IsValid(error);
 }
 
@@ -30,8 +35,15 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
                                   std::to_string(grey.cols) + "x" + std::to_string(grey.rows));
   }
 
+  // The chain: the one named, else the precise one for a surface and the
+  // quick one for labels alone.
+  const bool surface = params.reconstruct && !std::holds_alternative<std::monostate>(geometry);
+  decoder::DecodeParams decode = params.decode;
+  decode.chain = params.chain ? *decoder::ChainFor(params.chain, params.decode, nullptr)  // IsValid
+                 : surface    ? decoder::DecodeChain::kSkeleton
+                              : *decoder::ChainFor(std::nullopt, params.decode, nullptr);
   SideOutcome outcome;
-  outcome.decode = decoder::Decode(grey, side, params.decode);
+  outcome.decode = decoder::Decode(grey, side, decode);
   if (!outcome.decode.ok) return outcome;
   if (calibration) {
     if (const auto offset =

@@ -88,9 +88,9 @@ reconstruction::SidePipelineParams SideParams(const v1::DecodeOptions& decode,
   if (decode.chain() == v1::DecodeOptions::CHAIN_TRACKS) named = decoder::DecodeChain::kTracks;
   if (decode.chain() == v1::DecodeOptions::CHAIN_SKELETON) named = decoder::DecodeChain::kSkeleton;
   std::string why;
-  const std::optional<decoder::DecodeChain> chain = decoder::ChainFor(named, params.decode, &why);
-  if (!chain) Refuse(StatusCode::INVALID_ARGUMENT, "decode.chain: " + why);
-  params.decode.chain = *chain;
+  if (!decoder::ChainFor(named, params.decode, &why))
+    Refuse(StatusCode::INVALID_ARGUMENT, "decode.chain: " + why);
+  params.chain = named;
   params.planes = surface.plane_model() == v1::SurfaceOptions::PLANE_MODEL_PARALLEL
                       ? reconstruction::PlaneModelKind::kParallel
                       : reconstruction::PlaneModelKind::kPerspective;

@@ -70,6 +70,11 @@ struct TrackChainParams {
   // the smoothed frame the track followed) is dropped: it took another
   // stripe's light, > 0.
   double max_centre_shift = 0.5;
+  // px: a centre further than this from the curve through its track's
+  // centres within residual_rows rows (itself left out) is dropped: it took
+  // a segment's light beside a junction, > 0 and >= 2.
+  double max_centre_residual = 0.35;
+  int residual_rows = 4;
   // A row skipped beside a junction is refilled from the line's centres
   // within this many rows of the skipped ones on both sides, >= 1.
   int centre_fit_rows = 5;
@@ -192,6 +197,9 @@ struct DecodeResult {
   // for the track chain, the ridge points of its line and segment tracks.
   cv::Mat skeleton;
 };
+
+// The default parameters with the skeleton chain.
+DecodeParams SkeletonChainParams();
 
 // The chain that decodes with `params` when a caller names `named` (nullopt:
 // none): the one named; where none is, the default (the track chain) unless

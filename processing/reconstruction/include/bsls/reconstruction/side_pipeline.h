@@ -23,7 +23,16 @@
 namespace bsls::reconstruction {
 
 struct SidePipelineParams {
-  decoder::DecodeParams decode;  // q_offset must stay unset: the calibration fixes it
+  // q_offset must stay unset: the calibration fixes it. Its `chain` is
+  // replaced by the one below.
+  decoder::DecodeParams decode;
+  // The chain that decodes (decoder::ChainFor). nullopt: the skeleton chain
+  // where a surface is reconstructed, the track chain where only the labels
+  // are wanted. On the thesis's lesions the skeleton chain keeps more of the
+  // steep lines on a lump's skirts (86 % of its region covered against
+  // 80 %) and places junctions closer (0.04-0.18 px RMS against 0.07-0.29
+  // px on the plane, ramp and ball): docs/decoding.md, "Which chain".
+  std::optional<decoder::DecodeChain> chain;
   ReconstructionParams reconstruction;
   PlaneModelKind planes = PlaneModelKind::kPerspective;
   SlideRowParams rows;
