@@ -5,15 +5,16 @@
 // and the median time of each stage (extraction_ms, interpretation_ms,
 // subpixel_ms, from DecodeResult::times).
 //
-// BM_Decode runs with OpenCV's default thread count (the decoder's parallel
-// stages use cv::parallel_for_); BM_DecodeSingleThread sets
-// cv::setNumThreads(1) for both the baseline and the decode, so its ratio
-// compares single-threaded code with single-threaded OpenCV.
-// BM_DecodeTracks and BM_DecodeTracksSingleThread are the same for the
-// track chain (DecodeChain::kTracks).
-// BM_DecodeNothingAhead is BM_Decode with DecodeParams::measure_ahead off:
-// the sub-pixel centres measured after the interpretation instead of on the
-// second thread during it (counter ahead: centres measured ahead).
+// BM_Decode decodes with the default parameters (the track chain) and
+// OpenCV's default thread count (the decoder's parallel stages use
+// cv::parallel_for_); BM_DecodeSingleThread sets cv::setNumThreads(1) for
+// both the baseline and the decode, so its ratio compares single-threaded
+// code with single-threaded OpenCV. BM_DecodeSkeleton and
+// BM_DecodeSkeletonSingleThread are the same for the skeleton chain
+// (DecodeChain::kSkeleton), and BM_DecodeSkeletonNothingAhead the skeleton
+// chain with DecodeParams::measure_ahead off: the sub-pixel centres measured
+// after the interpretation instead of on the second thread during it
+// (counter ahead: centres measured ahead).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -112,35 +113,33 @@ void BM_Decode(benchmark::State& state) { DecodeWithThreads(state, 0); }
 
 void BM_DecodeSingleThread(benchmark::State& state) { DecodeWithThreads(state, 1); }
 
-void BM_DecodeNothingAhead(benchmark::State& state) {
-  bsls::decoder::DecodeParams params;
+// The skeleton chain: the same as BM_Decode and BM_DecodeSingleThread with
+// DecodeChain::kSkeleton.
+void BM_DecodeSkeleton(benchmark::State& state) {
+  DecodeWithThreads(state, 0, bsls::decoder::SkeletonChainParams());
+}
+
+void BM_DecodeSkeletonSingleThread(benchmark::State& state) {
+  DecodeWithThreads(state, 1, bsls::decoder::SkeletonChainParams());
+}
+
+void BM_DecodeSkeletonNothingAhead(benchmark::State& state) {
+  bsls::decoder::DecodeParams params = bsls::decoder::SkeletonChainParams();
   params.measure_ahead = false;
   DecodeWithThreads(state, 0, params);
-}
-
-// The track chain: the same as BM_Decode and BM_DecodeSingleThread with
-// DecodeChain::kTracks.
-void BM_DecodeTracks(benchmark::State& state) {
-  bsls::decoder::DecodeParams params;
-  params.chain = bsls::decoder::DecodeChain::kTracks;
-  DecodeWithThreads(state, 0, params);
-}
-
-void BM_DecodeTracksSingleThread(benchmark::State& state) {
-  bsls::decoder::DecodeParams params;
-  params.chain = bsls::decoder::DecodeChain::kTracks;
-  DecodeWithThreads(state, 1, params);
 }
 
 }  // namespace
 
 BENCHMARK(BM_GaussianBlurCanny)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Decode)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_DecodeNothingAhead)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_Decode)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_Decode)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(20);
 BENCHMARK(BM_DecodeSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_DecodeTracks)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_DecodeTracksSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
-BENCHMARK(BM_DecodeSingleThread)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_DecodeSingleThread)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(20);
+BENCHMARK(BM_DecodeSkeleton)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_DecodeSkeleton)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_DecodeSkeletonNothingAhead)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_DecodeSkeletonSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_DecodeSkeletonSingleThread)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(5);
 
 BENCHMARK_MAIN();
