@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <opencv2/imgproc.hpp>
 
 #include "bsls/testing/synthetic_brick.h"
@@ -121,6 +123,66 @@ TEST(RidgeTracks, AGapInALineIsBridged) {
   EXPECT_EQ(net.line_above[lower], upper);
 }
 
+TEST(RidgeTracks, ASegmentTrackClimbingAlongASlantedLineIsCut) {
+  // Column points (x: row, y: column): a segment at row 10 over columns
+  // 0-9, then a line slanted 45 degrees from (10, 10) to (21, 21), then the
+  // next row's segment at row 22 over columns 22-31; and a segment that
+  // climbs 0.3 rows per column over 20 columns, which stays whole.
+  std::vector<std::pair<float, int>> at;
+  for (int c = 0; c < 32; ++c) {
+    at.push_back({c < 10 ? 10.0f : c < 22 ? static_cast<float>(c) : 22.0f, c});
+    if (c < 20) at.push_back({40.0f + 0.3f * c, c});
+  }
+  std::sort(at.begin(), at.end(), [](auto a, auto b) {
+    return a.second != b.second ? a.second < b.second : a.first < b.first;
+  });
+  const RidgePoints columns = Points(32, at);
+  const std::vector<Track> linked = LinkTracks(columns, {});
+  ASSERT_EQ(linked.size(), 2u);
+  const std::vector<Track> cut = CutSteepStretches(columns, linked, {});
+  ASSERT_EQ(cut.size(), 3u);
+  std::vector<std::tuple<float, int, int>> spans;  // (first row, first column, last column)
+  for (const Track& t : cut)
+    spans.emplace_back(columns.points[t.points.front()].x, columns.points[t.points.front()].y,
+                       columns.points[t.points.back()].y);
+  std::sort(spans.begin(), spans.end());
+  const auto& [first_row, first_from, first_to] = spans[0];  // the first segment
+  EXPECT_EQ(first_row, 10.0f);
+  EXPECT_EQ(first_from, 0);
+  EXPECT_GE(first_to, 5);  // its steep end cut away
+  EXPECT_LE(first_to, 9);
+  const auto& [next_row, next_from, next_to] = spans[1];  // the next row's segment
+  EXPECT_EQ(next_row, 22.0f);
+  EXPECT_GE(next_from, 22);
+  EXPECT_LE(next_from, 26);
+  EXPECT_EQ(next_to, 31);
+  const auto& [gentle_row, gentle_from, gentle_to] = spans[2];  // whole
+  EXPECT_EQ(gentle_row, 40.0f);
+  EXPECT_EQ(gentle_from, 0);
+  EXPECT_EQ(gentle_to, 19);
+}
+
+TEST(RidgeTracks, ASegmentWhoseEndsMeetOneLineMakesNoJunction) {
+  // Lines at x = 20 and x = 35 over rows 0-29; a speck of light across the
+  // first at row 10 (columns 18-22), a segment between both at row 20.
+  std::vector<std::pair<float, int>> line_points;
+  for (int y = 0; y < 30; ++y) {
+    line_points.push_back({20.0f, y});
+    line_points.push_back({35.0f, y});
+  }
+  std::vector<std::pair<float, int>> column_points;  // (row, column)
+  for (int c = 18; c <= 22; ++c) column_points.push_back({10.0f, c});
+  for (int c = 21; c <= 34; ++c) column_points.push_back({20.0f, c});
+  std::sort(column_points.begin(), column_points.end(), [](auto a, auto b) {
+    return a.second != b.second ? a.second < b.second : a.first < b.first;
+  });
+  const TrackNetwork net = BuildTrackNetwork(Points(30, line_points), Points(40, column_points),
+                                             pattern::Side::kLeft);
+  ASSERT_EQ(net.junctions.size(), 2u);  // the segment's two ends, none of the speck's
+  for (const TrackJunction& j : net.junctions) EXPECT_NEAR(j.position.y, 20.0, 1.0);
+  EXPECT_NE(net.junctions[0].line, net.junctions[1].line);
+}
+
 TEST(RidgeTracks, InvalidParamsAreRejected) {
   TrackParams bad;
   bad.max_step = 0;
@@ -130,6 +192,10 @@ TEST(RidgeTracks, InvalidParamsAreRejected) {
   std::string why;
   EXPECT_FALSE(bad.IsValid(&why));
   EXPECT_NE(why.find("bridge_rows"), std::string::npos);
+  bad = {};
+  bad.steep_columns = 1;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("steep_columns"), std::string::npos);
 }
 
 }  // namespace

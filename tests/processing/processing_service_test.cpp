@@ -117,18 +117,19 @@ TEST(ProcessingService, ProcessFrameDecodesByTheChainAskedFor) {
   const nlohmann::json skeleton = local(decoder::DecodeChain::kSkeleton, ExtractionMethod::kModern);
   const nlohmann::json thesis = local(decoder::DecodeChain::kSkeleton, ExtractionMethod::kThesis);
   ASSERT_NE(tracks["junctions"], skeleton["junctions"]);
-  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_UNSPECIFIED, v1::DecodeOptions::METHOD_UNSPECIFIED)
-                ["junctions"],
-            tracks["junctions"]);
-  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_TRACKS, v1::DecodeOptions::METHOD_MODERN)
-                ["junctions"],
-            tracks["junctions"]);
-  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_SKELETON, v1::DecodeOptions::METHOD_UNSPECIFIED)
-                ["junctions"],
-            skeleton["junctions"]);
-  EXPECT_EQ(junctions_of(v1::DecodeOptions::CHAIN_UNSPECIFIED, v1::DecodeOptions::METHOD_THESIS)
-                ["junctions"],
-            thesis["junctions"]);
+  const struct {
+    v1::DecodeOptions::Chain chain;
+    v1::DecodeOptions::Method method;
+    const nlohmann::json& expected;
+  } cases[] = {
+      {v1::DecodeOptions::CHAIN_UNSPECIFIED, v1::DecodeOptions::METHOD_UNSPECIFIED, tracks},
+      {v1::DecodeOptions::CHAIN_TRACKS, v1::DecodeOptions::METHOD_MODERN, tracks},
+      {v1::DecodeOptions::CHAIN_SKELETON, v1::DecodeOptions::METHOD_UNSPECIFIED, skeleton},
+      {v1::DecodeOptions::CHAIN_UNSPECIFIED, v1::DecodeOptions::METHOD_THESIS, thesis},
+  };
+  for (const auto& c : cases)
+    EXPECT_EQ(junctions_of(c.chain, c.method)["junctions"], c.expected["junctions"])
+        << "chain " << c.chain << ", method " << c.method;
 }
 
 TEST(ProcessingService, ProcessFrameWithoutCalibrationDecodesOnly) {
