@@ -87,8 +87,15 @@ struct TrackChainParams {
 
 struct DecodeParams {
   pattern::PatternSpec spec;
+  // The track chain: 3x the cost of a blur and Canny at 512 x 512 against
+  // the skeleton chain's 30x, the same labels; the skeleton chain places
+  // junctions closer and keeps more of steeply leaning lines
+  // (docs/decoding.md, "Which chain").
   DecodeChain chain = DecodeChain::kTracks;
   TrackChainParams track_chain;
+  // The skeleton chain's parameters from here to region_margin, but for
+  // spec, junction_clearance, junction_fit_rows, fold_slope_change, pitch,
+  // max_binning and binning, which the track chain reads as well.
   extraction::ExtractionParams extraction;
   interpretation::InterpretationParams interpretation;
   // Pixel lengths below and in `centre` are for the working resolution (see
@@ -134,8 +141,8 @@ struct DecodeParams {
   // contrast window).
   double region_rise = 6.0;  // grey levels, >= 0
   int region_margin = 32;    // working px, >= 0
-  // Where OpenCV has a second thread (cv::getNumThreads() > 1) and the frame
-  // is not binned, the sub-pixel centres across the extraction's skeleton
+  // The skeleton chain: where OpenCV has a second thread
+  // (cv::getNumThreads() > 1) and the frame is not binned, the sub-pixel centres across the extraction's skeleton
   // runs are measured on a thread of their own while the interpretation runs
   // (docs/decoding.md, "Centres measured ahead"); the output is the same
   // either way. Off where the caller already keeps every core busy (both
