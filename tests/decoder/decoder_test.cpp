@@ -363,6 +363,7 @@ TEST(Decoder, ChainForAnswersTheCallersChoice) {
   no_repair.interpretation.enable_repair = false;
   std::string why;
   EXPECT_EQ(ChainFor(std::nullopt, plain, &why), DecodeChain::kTracks);
+  EXPECT_EQ(ChainFor(std::nullopt, SkeletonChainParams(), &why), DecodeChain::kSkeleton);
   EXPECT_EQ(ChainFor(std::nullopt, thesis, &why), DecodeChain::kSkeleton);
   EXPECT_EQ(ChainFor(std::nullopt, no_repair, &why), DecodeChain::kSkeleton);
   EXPECT_EQ(ChainFor(DecodeChain::kSkeleton, plain, &why), DecodeChain::kSkeleton);

@@ -679,7 +679,7 @@ std::optional<DecodeChain> ChainFor(std::optional<DecodeChain> named, const Deco
   const bool no_repair = !params.interpretation.enable_repair;
   if (!named) {
     if (thesis_extraction || no_repair) return DecodeChain::kSkeleton;
-    return DecodeParams{}.chain;
+    return params.chain;
   }
   if (*named == DecodeChain::kTracks && (thesis_extraction || no_repair)) {
     if (why)

@@ -80,10 +80,6 @@ std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
   std::vector<char> steep;
   for (Track& t : segments) {
     const int n = static_cast<int>(t.points.size());
-    if (n <= w) {
-      out.push_back(std::move(t));
-      continue;
-    }
     // Every point of a window of w + 1 points (w columns) that climbs too
     // steeply belongs to a steep stretch.
     steep.assign(n, 0);

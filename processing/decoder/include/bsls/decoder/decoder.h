@@ -209,9 +209,9 @@ struct DecodeResult {
 DecodeParams SkeletonChainParams();
 
 // The chain that decodes with `params` when a caller names `named` (nullopt:
-// none): the one named; where none is, the default (the track chain) unless
-// params ask for what only the skeleton chain does (the thesis's feature
-// extraction, no repair), then the skeleton chain. nullopt, with the reason
+// none): the one named; where none is, params.chain unless params ask for
+// what only the skeleton chain does (the thesis's feature extraction, no
+// repair), then the skeleton chain. nullopt, with the reason
 // in `why`, when the track chain is named with such options.
 std::optional<DecodeChain> ChainFor(std::optional<DecodeChain> named, const DecodeParams& params,
                                     std::string* why);
