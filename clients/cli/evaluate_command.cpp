@@ -1,5 +1,8 @@
 // bsls evaluate: scores a decode (contracts section 5 JSON) against the
-// ground truth `bsls simulate --truth` wrote for the same frame.
+// ground truth `bsls simulate --truth` wrote for the same frame, or against
+// an outside renderer's truth of the same layout (junctions with "q" for the
+// slide row, lines with "samples" of [x, row, ...], as in
+// shared/data/outside-corpus).
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -32,36 +35,42 @@ nlohmann::json ReadJson(const std::string& path) {
   }
 }
 
-// Junctions and lines of a decode or a truth file; `row_key` is "q" or "v".
-void ReadLabels(const std::string& path, const char* row_key,
-                std::vector<simulator::PointLabel>* junctions,
-                std::vector<simulator::LinePoints>* lines) {
+// Junctions and lines of a decode or a truth file. A junction's slide row
+// is its "q" (a decode, an outside truth) or "v" (the simulator's truth); a
+// line's centre points are its "points" or its "samples" (whose first two
+// values are x and the row). `what` names the kind of file in errors.
+void ReadLabels(const std::string& path, const char* what,
+                          std::vector<simulator::PointLabel>* junctions,
+                          std::vector<simulator::LinePoints>* lines) {
   const nlohmann::json j = ReadJson(path);
   try {
-    for (const auto& k : j.at("junctions"))
-      junctions->push_back({k.at("p").get<int>(), k.at(row_key).get<int>(),
+    for (const auto& k : j.at("junctions")) {
+      const int row = k.contains("q") ? k.at("q").get<int>() : k.at("v").get<int>();
+      junctions->push_back({k.at("p").get<int>(), row,
                             {k.at("x").get<double>(), k.at("y").get<double>()}});
+    }
     for (const auto& l : j.at("lines")) {
       simulator::LinePoints line{l.at("p").get<int>(), {}};
-      for (const auto& pt : l.at("points")) line.points.emplace_back(pt.at(0).get<double>(), pt.at(1).get<double>());
+      for (const auto& pt : l.contains("points") ? l.at("points") : l.at("samples"))
+        line.points.emplace_back(pt.at(0).get<double>(), pt.at(1).get<double>());
       lines->push_back(std::move(line));
     }
   } catch (const nlohmann::json::exception& e) {
-    throw io::InputError(path + ": not a " + (row_key[0] == 'q' ? "junctions" : "truth") +
-                         " file: " + e.what());
+    throw io::InputError(path + ": not a " + what + " file: " + e.what());
   }
 }
 
 void RunEvaluate(const EvaluateOptions& o) {
   std::vector<simulator::PointLabel> decoded, truth;
   std::vector<simulator::LinePoints> decoded_lines, truth_lines;
-  ReadLabels(o.junctions, "q", &decoded, &decoded_lines);
-  ReadLabels(o.truth, "v", &truth, &truth_lines);
+  ReadLabels(o.junctions, "junctions", &decoded, &decoded_lines);
+  ReadLabels(o.truth, "truth", &truth, &truth_lines);
   const simulator::LabelScore score = simulator::ScoreLabels(truth, decoded, o.reach);
   const simulator::LineScore lines = simulator::ScoreLines(truth_lines, decoded_lines);
   if (o.json) {
     const nlohmann::json out = {{"truth", score.truth},       {"found", score.found},
-                                {"recall", score.Recall()},   {"wrong_p", score.wrong_p},
+                                {"recall", score.Recall()},   {"right", score.Right()},
+                                {"right_recall", score.RightRecall()}, {"wrong_p", score.wrong_p},
                                 {"wrong_q", score.wrong_v},   {"unmatched", score.unmatched},
                                 {"q_offset", score.v_offset}, {"junction_rms_px", score.position_rms},
                                 {"line_points", lines.points}, {"line_rms_px", lines.rms}};

@@ -121,6 +121,7 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
                         {"side", o.side},
                         {"junctions", s.junctions()},
                         {"interpolated", s.interpolated_junctions()},
+                        {"unlabelled", s.unlabelled_junctions()},
                         {"lines", s.lines()},
                         {"q_absolute", s.q_absolute()},
                         {"repairs", s.repairs()},
@@ -132,10 +133,10 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
                       {"bridged", s.bridged_samples()}};
     std::cout << j.dump() << "\n";
   } else {
-    std::printf("%s (%s): %u junctions (%u interpolated) on %u lines, %u repairs, q %s, %.1f ms "
-                "on %s\n",
+    std::printf("%s (%s): %u junctions (%u interpolated, %u unlabelled) on %u lines, %u repairs, "
+                "q %s, %.1f ms on %s\n",
                 o.image.c_str(), o.side.c_str(), s.junctions(), s.interpolated_junctions(),
-                s.lines(), s.repairs(), s.q_absolute() ? "absolute" : "relative", total_ms,
+                s.unlabelled_junctions(), s.lines(), s.repairs(), s.q_absolute() ? "absolute" : "relative", total_ms,
                 out.result.replica().c_str());
     if (!o.surface.empty())
       std::printf("%s: %u vertices (%u bridged), %u triangles\n", o.surface.c_str(), s.vertices(),
@@ -200,6 +201,7 @@ void RunProcess(const ProcessOptions& o) {
                         {"side", o.side},
                         {"junctions", result.junctions.size()},
                         {"interpolated", interpolated},
+                        {"unlabelled", result.unlabelled.size()},
                         {"lines", result.lines.size()},
                         {"q_absolute", result.q_absolute},
                         {"repairs", result.repairs},
@@ -215,9 +217,10 @@ void RunProcess(const ProcessOptions& o) {
                       {"time_ms", r.time_ms}};
     std::cout << s.dump() << "\n";
   } else {
-    std::printf("%s (%s): %zu junctions (%d interpolated) on %zu lines, %d repairs, q %s, %.1f ms\n",
+    std::printf("%s (%s): %zu junctions (%d interpolated, %zu unlabelled) on %zu lines, %d repairs, "
+                "q %s, %.1f ms\n",
                 o.image.c_str(), o.side.c_str(), result.junctions.size(), interpolated,
-                result.lines.size(), result.repairs, result.q_absolute ? "absolute" : "relative",
+                result.unlabelled.size(), result.lines.size(), result.repairs, result.q_absolute ? "absolute" : "relative",
                 result.times.total_ms);
     if (outcome.surface)
       std::printf("%s: %d vertices (%d bridged), %d triangles, %.1f ms\n", o.surface.c_str(),

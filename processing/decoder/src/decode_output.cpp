@@ -30,6 +30,12 @@ nlohmann::json ToJson(const DecodeResult& r) {
     junctions.push_back(std::move(e));
   }
   j["junctions"] = std::move(junctions);
+  nlohmann::json unlabelled = nlohmann::json::array();
+  for (const UnlabelledJunction& u : r.unlabelled)
+    unlabelled.push_back({{"x", Round3(u.position.x)},
+                          {"y", Round3(u.position.y)},
+                          {"kind", std::string(pattern::ToString(u.kind))}});
+  j["unlabelled"] = std::move(unlabelled);
   nlohmann::json lines = nlohmann::json::array();
   for (const DecodedLine& l : r.lines) {
     nlohmann::json points = nlohmann::json::array();
@@ -83,6 +89,13 @@ cv::Mat RenderOverlay(const cv::Mat& grey, const DecodeResult& r) {
     } else {
       cv::circle(out, c, static_cast<int>(2.2 * kScale), colour, 1, cv::LINE_AA, kShift);
     }
+  }
+  // Unlabelled junctions: a red square each, so that what was seen but not
+  // proven shows.
+  for (const UnlabelledJunction& u : r.unlabelled) {
+    const cv::Point c = fixed(u.position);
+    const int k = static_cast<int>(2 * kScale);
+    cv::rectangle(out, c - cv::Point(k, k), c + cv::Point(k, k), {0, 0, 255}, 1, cv::LINE_AA, kShift);
   }
   return out;
 }

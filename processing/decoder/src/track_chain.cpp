@@ -124,6 +124,41 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
   return c;
 }
 
+// Drops the centres of line track t that do not belong to its line p: those
+// more than half a row spacing beyond its first and last junction labelled
+// p, those past a junction of the track labelled with another p (where the
+// track went on across an occluding edge into another line), and those
+// past an unlabelled junction beyond its last (or before its first)
+// junction of p (a region whose labels could not be proven).
+void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
+                       const interpretation::TrackLabels& labels, int t, TrackCentres* c) {
+  const int p = labels.line_p[t];
+  const double reach = labels.row_spacing > 0 ? 0.5 * labels.row_spacing : 0.0;
+  double from = INFINITY, to = -INFINITY;  // rows of its own
+  const std::vector<int>& on = net.junctions_on_line[t];
+  for (int j : on)
+    if (labels.p[j] == p) {
+      from = std::min(from, net.junctions[j].position.y - reach);
+      to = std::max(to, net.junctions[j].position.y + reach);
+    }
+  // A junction of another p inside the range ends it on the side away from
+  // the most junctions of p; an unlabelled one only outside them.
+  for (int j : on) {
+    if (labels.p[j] == p) continue;
+    const double y = net.junctions[j].position.y;
+    if (y <= from || y >= to) continue;
+    int above = 0, below = 0;
+    for (int k : on)
+      if (labels.p[k] == p) ++(net.junctions[k].position.y < y ? above : below);
+    if (labels.p[j] == interpretation::kUnlabelled && above > 0 && below > 0) continue;
+    if (above >= below) to = y; else from = y;
+  }
+  for (size_t k = 0; k < c->output.size(); ++k) {
+    const double y = c->first_row + static_cast<double>(k);
+    if (y < from || y > to) c->output[k] = c->measured[k] = NAN;
+  }
+}
+
 // Where junction j lies: the segment's centres near the line fitted as a
 // straight line y(x) and met with the line's centres fitted as x(y).
 cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwork& net, int j,
@@ -306,8 +341,10 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     if (labels.line_p[i] >= 0) labelled.push_back(static_cast<int>(i));
   std::vector<TrackCentres> centres(net.lines.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(labelled.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i)
+    for (int i = r.start; i < r.end; ++i) {
       centres[labelled[i]] = MeasureTrack(working, net, labelled[i], params);
+      KeepRowsOfItsLine(net, labels, labelled[i], &centres[labelled[i]]);
+    }
   });
 
   // Junctions: one per label; where two claim one, the one on a track of
@@ -342,6 +379,17 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
           PlaceJunction(working, net, j, centres[net.junctions[j].line], params), n);
     }
   });
+
+  // Junctions seen whose label could not be proven: reported at their ridge
+  // points, not placed.
+  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
+    if (labels.p[j] == interpretation::kUnlabelled)
+      result->unlabelled.push_back(
+          {ToFullFrame(net.junctions[j].position, n), net.junctions[j].kind});
+  std::sort(result->unlabelled.begin(), result->unlabelled.end(),
+            [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
+              return a.position.y < b.position.y;
+            });
 
   // Lines: the centres of all tracks of one p, one per row (the first
   // labelled track's where two hold one row).

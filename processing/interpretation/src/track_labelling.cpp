@@ -5,15 +5,18 @@
 #include <limits>
 #include <map>
 #include <optional>
-#include <queue>
 #include <stdexcept>
 #include <tuple>
 
+#include "label_consensus.h"
 #include "label_votes.h"
 
 namespace bsls::interpretation {
 namespace {
 
+using internal::Consensus;
+using internal::ConsensusLink;
+using internal::LabelByConsensus;
 using internal::Median;
 using pattern::JunctionKind;
 
@@ -21,17 +24,10 @@ struct Link {
   int to = -1;
   int dp = 0;
   int dv = 0;
-  double weight = 1.0;
 };
 
-constexpr double kTrusted = 0.01;  // a link of a brick that closes (thesis: a complete loop)
-constexpr double kLineZeroGap = 1.0;  // rows of line 0 counted across a gap between its tracks
 constexpr double kSpacingSpread = 1.6;  // a line's own row spacing lies within this factor
                                         // of the frame's
-constexpr double kPlain = 10.0;    // any other step of one or two rows, or segment: a path
-                                   // through closed bricks beats any path with one such link;
-                                   // a longer step costs this per row
-
 // The row spacing along a line: the dy of a step between junctions of
 // alternating kinds, half of one between junctions of the same kind.
 double RowSpacing(const TrackJunction& a, const TrackJunction& b) {
@@ -144,6 +140,8 @@ bool TrackLabellingParams::IsValid(std::string* error) const {
   if (!(follow_distance > 0)) return fail("follow_distance must be positive");
   if (max_rows < 1) return fail("max_rows must be at least 1");
   if (min_own_spacings < 1) return fail("min_own_spacings must be at least 1");
+  if (min_support < 1) return fail("min_support must be at least 1");
+  if (!(max_dissent >= 0 && max_dissent < 1)) return fail("max_dissent must lie in [0, 1)");
   return true;
 }
 
@@ -185,6 +183,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     all_spacing.insert(all_spacing.end(), samples[t].begin(), samples[t].end());
   }
   const double frame_spacing = Median(all_spacing);
+  out.row_spacing = frame_spacing;
   std::vector<double> own_spacing(net.lines.size(), 0.0);
   for (size_t t = 0; t < net.lines.size(); ++t) {
     std::erase_if(samples[t], [&](double s) {
@@ -259,26 +258,36 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
       for (int j : *path) trusted_down[j] = 1;
   }
   std::vector<std::vector<Link>> adj(n);
+  std::vector<ConsensusLink> links;
+  auto link = [&](int a, int b, int dp, int dv, bool trusted) {
+    adj[a].push_back({b, dp, dv});
+    adj[b].push_back({a, -dp, -dv});
+    links.push_back({a, b, dp, dv, trusted});
+  };
   for (int j = 0; j < n; ++j) {
-    if (const Step st = down[j]; st.to >= 0) {
-      const double w = trusted_down[j] ? kTrusted
-                       : st.rows <= 2          ? kPlain
-                                               : kPlain * st.rows;
-      adj[j].push_back({st.to, 0, st.rows, w});
-      adj[st.to].push_back({j, 0, -st.rows, w});
-    }
-    if (const int c = across[j]; c >= 0) {
-      const double w = trusted_across[j] ? kTrusted : kPlain;
-      adj[j].push_back({c, +1, 0, w});
-      adj[c].push_back({j, -1, 0, w});
-    }
+    if (const Step st = down[j]; st.to >= 0) link(j, st.to, 0, st.rows, trusted_down[j]);
+    if (const int c = across[j]; c >= 0) link(j, c, +1, 0, trusted_across[j]);
+  }
+  // A line broken by a gap (net.line_below): its last junction above and
+  // first below, a whole number of rows apart at the line's spacing.
+  auto gap_step = [&](int a, int b) {
+    const TrackJunction& ja = net.junctions[a];
+    const TrackJunction& jb = net.junctions[b];
+    const double s = spacing_of(ja.line);
+    if (!(s > 0)) return;
+    const internal::RowCount step = internal::NearestRowCount(
+        jb.position.y - ja.position.y, s, ja.kind != jb.kind, params.max_rows);
+    if (step.miss <= params.max_row_miss * s) link(a, b, 0, step.rows, false);
+  };
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    const int b = net.line_below[t];
+    if (b < 0 || net.junctions_on_line[t].empty() || net.junctions_on_line[b].empty()) continue;
+    gap_step(net.junctions_on_line[t].back(), net.junctions_on_line[b].front());
   }
 
   // Seeds: line 0's direct junctions in order down the image, two rows per
-  // step of their spacing. Only the one nearest the centre row starts free;
-  // each other starts at the cost of a long step from it, so that it keeps
-  // the row counted from the spacing only where no path through the links
-  // reaches it (a gap in line 0 that no neighbour bridges).
+  // step of their spacing; two closer than one step cannot both be line
+  // 0's junctions (a stray segment's end at a fold): neither seeds.
   std::vector<int> seeds;
   for (int t : out.reference)
     for (int j : net.junctions_on_line[t])
@@ -286,9 +295,6 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   std::sort(seeds.begin(), seeds.end(), [&](int a, int b) {
     return net.junctions[a].position.y < net.junctions[b].position.y;
   });
-  // Two rows per step of line 0's row spacing between consecutive seeds.
-  // Two seeds closer than one step cannot both be line 0's junctions (a
-  // stray segment's end at a fold): neither seeds.
   auto steps_between = [&](int a, int b) {
     const double gap = net.junctions[b].position.y - net.junctions[a].position.y;
     const double s = spacing_of(net.junctions[b].line);
@@ -307,56 +313,37 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
                 " junctions that number its rows";
     return out;
   }
-  std::vector<int> seed_v{0};
-  for (size_t i = 1; i < seeds.size(); ++i)
-    seed_v.push_back(seed_v.back() + 2 * steps_between(seeds[i - 1], seeds[i]));
-
-  const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
-  size_t centre_seed = 0;
-  for (size_t i = 1; i < seeds.size(); ++i)
-    if (std::abs(net.junctions[seeds[i]].position.y - centre_row) <
-        std::abs(net.junctions[seeds[centre_seed]].position.y - centre_row))
-      centre_seed = i;
-  // Along one track the rows are counted step by step; across a gap
-  // between two of line 0's tracks they are estimated from its length. A
-  // seed starts at a cost for each such gap between it and the central one:
-  // more than a path through closed bricks, less than one plain link.
-  std::vector<double> seed_cost(seeds.size(), 0.0);
-  for (size_t i = centre_seed + 1; i < seeds.size(); ++i) {
-    const bool same_track = net.junctions[seeds[i]].line == net.junctions[seeds[i - 1]].line;
-    seed_cost[i] = seed_cost[i - 1] + (same_track ? 0.0 : kLineZeroGap);
-  }
-  for (size_t i = centre_seed; i-- > 0;) {
-    const bool same_track = net.junctions[seeds[i]].line == net.junctions[seeds[i + 1]].line;
-    seed_cost[i] = seed_cost[i + 1] + (same_track ? 0.0 : kLineZeroGap);
+  // Line 0 followed across a gap between two of its tracks that no bridge
+  // joins (thesis 5.2.1): the rows counted from the gap's length.
+  for (size_t i = 1; i < seeds.size(); ++i) {
+    const int above = net.junctions[seeds[i - 1]].line, below = net.junctions[seeds[i]].line;
+    if (above != below && net.line_below[above] != below)
+      gap_step(seeds[i - 1], seeds[i]);
   }
 
-  // Propagation, cheapest paths first (Dijkstra over the link weights).
-  std::vector<double> cost(n, std::numeric_limits<double>::infinity());
-  std::vector<char> done(n, 0);
-  using Item = std::tuple<double, int, int, int>;  // cost, junction, p, v
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-  for (size_t i = 0; i < seeds.size(); ++i) {
-    cost[seeds[i]] = seed_cost[i];
-    queue.push({seed_cost[i], seeds[i], 0, seed_v[i]});
+  // Labels proven by agreement (label_consensus.h): only the component of
+  // line 0 is labelled, every other junction left unlabelled.
+  std::vector<char> odd_kind(n);
+  for (int j = 0; j < n; ++j) odd_kind[j] = net.junctions[j].kind == JunctionKind::kCorresponding;
+  const Consensus consensus = LabelByConsensus(odd_kind, links, seeds,
+                                               params.min_reference_junctions,
+                                               {params.min_support, params.max_dissent});
+  if (consensus.p.empty() ||
+      std::none_of(consensus.p.begin(), consensus.p.end(), [](int p) { return p != kUnlabelled; })) {
+    out.error = "no reference line (line 0): its junctions do not agree on their labels";
+    return out;
   }
-  while (!queue.empty()) {
-    const auto [c, j, p, v] = queue.top();
-    queue.pop();
-    if (done[j]) continue;
-    done[j] = 1;
-    out.p[j] = p;
-    out.v[j] = v;
-    for (const Link& l : adj[j]) {
-      if (done[l.to]) continue;
-      const int np = p + l.dp, nv = v + l.dv;
-      if (pattern::JunctionOnRowParity(spec, np, nv) != net.junctions[l.to].kind) continue;
-      if (c + l.weight < cost[l.to]) {
-        cost[l.to] = c + l.weight;
-        queue.push({c + l.weight, l.to, np, nv});
-      }
+  for (int j = 0; j < n; ++j) {
+    if (consensus.p[j] == kUnlabelled) continue;
+    // A label outside the slide, or of the other kind, is not reported.
+    if (pattern::JunctionOnRowParity(spec, consensus.p[j], consensus.v[j]) != net.junctions[j].kind) {
+      ++out.conflicts;
+      continue;
     }
+    out.p[j] = consensus.p[j];
+    out.v[j] = consensus.v[j];
   }
+  const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
 
   // A label most of whose neighbours disagree is dropped, not guessed.
   out.conflicts += internal::DropDisagreeingLabels(

@@ -35,8 +35,13 @@ struct LabelScore {
   std::vector<PointLabel> missed;  // truth junctions not found
   std::vector<PointLabel> wrong;   // truth junctions found with a wrong label
 
+  // Share of truth junctions found, whatever their labels.
   double Recall() const { return truth ? static_cast<double>(found) / truth : 0.0; }
   int Wrong() const { return wrong_p + wrong_v; }
+  // Found with the right label.
+  int Right() const { return found - Wrong(); }
+  // Share of truth junctions found with the right label.
+  double RightRecall() const { return truth ? static_cast<double>(Right()) / truth : 0.0; }
   // One line for test failure messages.
   std::string Summary() const;
 };

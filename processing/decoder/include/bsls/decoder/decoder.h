@@ -168,6 +168,13 @@ struct DecodedJunction {
   bool interpolated = false;  // placed from relative junctions (thesis 5.1.4.6), not seen
 };
 
+// A junction seen but not labelled: no label could be proven for it (it is
+// cut off from line 0, or its links disagree). Reported, never guessed.
+struct UnlabelledJunction {
+  cv::Point2d position;  // image pixels, where its segment's end meets its line
+  pattern::JunctionKind kind = pattern::JunctionKind::kDirect;
+};
+
 struct DecodedLine {
   int p = 0;
   std::vector<cv::Point2d> points;  // sub-pixel centres, one per image row, ordered by y
@@ -189,6 +196,7 @@ struct DecodeResult {
   bool q_absolute = false;
   std::vector<DecodedJunction> junctions;  // ordered by p, then q
   std::vector<DecodedLine> lines;          // ordered by p
+  std::vector<UnlabelledJunction> unlabelled;  // ordered by y
   StageTimes times;
   // Diagnostics.
   double pitch = 0.0;  // measured stripe pitch, px of the frame (0: none found)

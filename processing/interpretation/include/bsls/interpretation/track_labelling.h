@@ -54,6 +54,11 @@ struct TrackLabellingParams {
   // Spacing samples a line track needs to judge its steps by its own row
   // spacing instead of the frame's, >= 1.
   int min_own_spacings = 3;
+  // Labels spread from line 0 only between groups of closed bricks that at
+  // least min_support links join with the same shift of labels (>= 1), and
+  // at most max_dissent links per agreeing one join otherwise, [0, 1).
+  int min_support = 2;
+  double max_dissent = 0.34;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
@@ -69,6 +74,7 @@ struct TrackLabels {
   std::vector<int> line_p;  // per line track: the p most of its labelled junctions carry, or -1
   std::vector<int> reference;  // the line tracks taken for line 0
   int conflicts = 0;     // labels dropped because their neighbours disagreed
+  double row_spacing = 0;  // px between rows along a line: the median over the frame
 };
 
 // Labels the junctions and line tracks of `network` for the brick slide of

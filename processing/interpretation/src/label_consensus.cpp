@@ -1,0 +1,347 @@
+#include "label_consensus.h"
+
+#include <algorithm>
+#include <climits>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <queue>
+#include <tuple>
+#include <utility>
+
+namespace bsls::interpretation::internal {
+namespace {
+
+constexpr int kNone = INT_MIN;  // kUnlabelled of track_labelling.h
+// Rounds of dropping contradicting trusted links before a patch that still
+// contradicts itself loses all of them (each round drops at least one).
+constexpr int kPatchRounds = 16;
+
+struct Label {
+  int p = 0;
+  int v = 0;
+  Label operator+(const Label& o) const { return {p + o.p, v + o.v}; }
+  Label operator-(const Label& o) const { return {p - o.p, v - o.v}; }
+  bool operator==(const Label& o) const = default;
+  auto operator<=>(const Label& o) const = default;
+};
+
+bool OddSum(const Label& l) { return ((l.p + l.v) % 2 + 2) % 2 == 1; }
+
+// Patches: the junctions joined by trusted links, each labelled relative to
+// its first junction. A trusted link its patch contradicts is dropped and
+// the patches are made again.
+struct Patches {
+  std::vector<int> of;      // per junction: its patch
+  std::vector<Label> rel;   // per junction: its label within its patch
+  int count = 0;
+};
+
+Patches MakePatches(const std::vector<char>& odd_kind, const std::vector<ConsensusLink>& links,
+                    std::vector<char>* trusted, int* contradicted) {
+  const int n = static_cast<int>(odd_kind.size());
+  Patches out;
+  for (int round = 0;; ++round) {
+    std::vector<std::vector<std::pair<int, int>>> adj(n);  // (link, +1 forwards / -1 backwards)
+    for (int k = 0; k < static_cast<int>(links.size()); ++k)
+      if ((*trusted)[k]) {
+        adj[links[k].a].emplace_back(k, +1);
+        adj[links[k].b].emplace_back(k, -1);
+      }
+    out.of.assign(n, -1);
+    out.rel.assign(n, {});
+    out.count = 0;
+    std::vector<int> queue;
+    for (int root = 0; root < n; ++root) {
+      if (out.of[root] >= 0) continue;
+      out.of[root] = out.count;
+      out.rel[root] = {0, odd_kind[root] ? 1 : 0};
+      queue.assign(1, root);
+      for (size_t i = 0; i < queue.size(); ++i) {
+        const int j = queue[i];
+        for (const auto& [k, dir] : adj[j]) {
+          const ConsensusLink& l = links[k];
+          const int to = dir > 0 ? l.b : l.a;
+          if (out.of[to] >= 0) continue;
+          out.of[to] = out.count;
+          out.rel[to] = out.rel[j] + Label{dir * l.dp, dir * l.dv};
+          queue.push_back(to);
+        }
+      }
+      ++out.count;
+    }
+    // Contradictions: a trusted link whose ends' labels differ from its
+    // change, or that gives a junction a label of the other kind.
+    std::vector<int> bad;
+    for (int k = 0; k < static_cast<int>(links.size()); ++k) {
+      if (!(*trusted)[k]) continue;
+      const ConsensusLink& l = links[k];
+      const Label want = out.rel[l.a] + Label{l.dp, l.dv};
+      if (!(want == out.rel[l.b]) || OddSum(want) != static_cast<bool>(odd_kind[l.b])) bad.push_back(k);
+    }
+    if (bad.empty()) return out;
+    if (round + 1 >= kPatchRounds) {
+      // Still contradicting: every trusted link of those patches goes.
+      std::vector<char> doubtful(out.count, 0);
+      for (int k : bad) doubtful[out.of[links[k].a]] = 1;
+      for (int k = 0; k < static_cast<int>(links.size()); ++k)
+        if ((*trusted)[k] && doubtful[out.of[links[k].a]]) bad.push_back(k);
+    }
+    for (int k : bad) {
+      *contradicted += (*trusted)[k] ? 1 : 0;
+      (*trusted)[k] = 0;
+    }
+  }
+}
+
+// Components of patches joined with a shift: a label in a patch's own frame
+// plus the shift found here is its label in its component's frame.
+class Components {
+ public:
+  // One component per patch; sizes[x]: patch x's junctions.
+  explicit Components(std::vector<int> sizes)
+      : parent_(sizes.size()), shift_(sizes.size()), size_(std::move(sizes)) {
+    std::iota(parent_.begin(), parent_.end(), 0);
+  }
+
+  // The component of patch x, and the shift from x's frame to its frame.
+  std::pair<int, Label> Find(int x) {
+    Label total{};
+    int r = x;
+    while (parent_[r] != r) {
+      total = total + shift_[r];
+      r = parent_[r];
+    }
+    // Path compression: every patch on the way points at r directly.
+    Label rest = total;
+    for (int y = x; parent_[y] != y;) {
+      const int next = parent_[y];
+      const Label own = shift_[y];
+      parent_[y] = r;
+      shift_[y] = rest;
+      rest = rest - own;
+      y = next;
+    }
+    return {r, total};
+  }
+
+  // Joins the components of x and y so that a label in y's frame plus h is
+  // its label in x's frame.
+  void Join(int x, int y, Label h) {
+    auto [rx, sx] = Find(x);
+    auto [ry, sy] = Find(y);
+    if (rx == ry) return;
+    // ry's frame -> y's frame (-sy) -> x's frame (+h) -> rx's frame (+sx).
+    Label ry_to_rx = sx + h - sy;
+    if (size_[ry] > size_[rx]) {
+      std::swap(rx, ry);
+      ry_to_rx = Label{} - ry_to_rx;
+    }
+    parent_[ry] = rx;
+    shift_[ry] = ry_to_rx;
+    size_[rx] += size_[ry];
+  }
+
+ private:
+  std::vector<int> parent_;
+  std::vector<Label> shift_;  // to the parent's frame
+  std::vector<int> size_;     // junctions, at a component's root
+};
+
+// Junctions in no closed brick (a patch of their own) at the pattern's
+// edges (the last row of bricks, a line's end at the outline) join the
+// labelled ones when two of their links agree: a link to a labelled
+// junction is one vote, a link to another lone junction is one vote for
+// what that junction's own links to labelled ones agree on. Two votes
+// through different links close a cycle whose labels agree. Rounds until
+// none is added; each round adds all it finds at once, so the order of the
+// junctions does not matter.
+void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<ConsensusLink>& links,
+                         const std::vector<int>& patch_of, const std::vector<int>& patch_size,
+                         const ConsensusParams& params, std::vector<char>* labelled,
+                         std::vector<Label>* label) {
+  const int n = static_cast<int>(odd_kind.size());
+  std::vector<std::vector<std::pair<int, Label>>> adj(n);  // (neighbour, label change towards it)
+  for (const ConsensusLink& l : links) {
+    adj[l.a].push_back({l.b, {l.dp, l.dv}});
+    adj[l.b].push_back({l.a, {-l.dp, -l.dv}});
+  }
+  auto lone = [&](int j) { return !(*labelled)[j] && patch_size[patch_of[j]] == 1; };
+  // What the labelled neighbours of lone junction m agree on for m itself.
+  auto own_label = [&](int m) -> std::optional<Label> {
+    std::optional<Label> agreed;
+    for (const auto& [k, d] : adj[m]) {
+      if (!(*labelled)[k]) continue;
+      const Label here = (*label)[k] - d;
+      if (agreed && !(*agreed == here)) return std::nullopt;
+      agreed = here;
+    }
+    return agreed;
+  };
+  std::vector<std::pair<int, Label>> found;
+  std::map<Label, int> votes;
+  for (bool added = true; added;) {
+    found.clear();
+    for (int j = 0; j < n; ++j) {
+      if (!lone(j)) continue;
+      votes.clear();
+      int total = 0;
+      for (const auto& [k, d] : adj[j]) {
+        std::optional<Label> via;
+        if ((*labelled)[k]) via = (*label)[k];
+        else if (lone(k)) via = own_label(k);
+        if (!via) continue;
+        ++votes[*via - d];
+        ++total;
+      }
+      int best = 0;
+      Label best_label{};
+      for (const auto& [l, count] : votes)
+        if (count > best && OddSum(l) == static_cast<bool>(odd_kind[j])) {
+          best = count;
+          best_label = l;
+        }
+      if (best >= params.min_support && total - best <= params.max_dissent * best)
+        found.emplace_back(j, best_label);
+    }
+    for (const auto& [j, l] : found) {
+      (*labelled)[j] = 1;
+      (*label)[j] = l;
+    }
+    added = !found.empty();
+  }
+}
+
+}  // namespace
+
+Consensus LabelByConsensus(const std::vector<char>& odd_kind,
+                           const std::vector<ConsensusLink>& links, const std::vector<int>& seeds,
+                           int min_seeds, const ConsensusParams& params) {
+  const int n = static_cast<int>(odd_kind.size());
+  Consensus out;
+  out.p.assign(n, kNone);
+  out.v.assign(n, kNone);
+  std::vector<char> trusted(links.size());
+  for (size_t k = 0; k < links.size(); ++k) trusted[k] = links[k].trusted;
+  const Patches patches = MakePatches(odd_kind, links, &trusted, &out.contradicted_links);
+
+  // Sizes in junctions, so that the larger component keeps its frame.
+  std::vector<int> sizes(patches.count, 0);
+  for (int j = 0; j < n; ++j) ++sizes[patches.of[j]];
+  Components comps(std::move(sizes));
+  auto label_of = [&](int j) {
+    const auto [c, shift] = comps.Find(patches.of[j]);
+    return std::make_pair(c, patches.rel[j] + shift);
+  };
+
+  // Rounds of joining: the evidence between the components as they stand,
+  // the best supported joins first; again while any join was made.
+  struct Evidence {
+    int x, y;
+    Label h;
+  };
+  std::vector<Evidence> evidence;
+  for (bool joined = true; joined;) {
+    joined = false;
+    evidence.clear();
+    for (size_t k = 0; k < links.size(); ++k) {
+      if (trusted[k]) continue;
+      const ConsensusLink& l = links[k];
+      auto [ca, la] = label_of(l.a);
+      auto [cb, lb] = label_of(l.b);
+      if (ca == cb) continue;
+      // b's label in a's frame is la + d: the shift from b's frame to a's.
+      Label h = la + Label{l.dp, l.dv} - lb;
+      if (ca > cb) {
+        std::swap(ca, cb);
+        h = Label{} - h;
+      }
+      evidence.push_back({ca, cb, h});
+    }
+    std::sort(evidence.begin(), evidence.end(), [](const Evidence& a, const Evidence& b) {
+      return std::tie(a.x, a.y, a.h) < std::tie(b.x, b.y, b.h);
+    });
+    struct Candidate {
+      int support, x, y;
+      Label h;
+    };
+    std::vector<Candidate> candidates;
+    for (size_t i = 0; i < evidence.size();) {
+      size_t end = i;
+      int best = 0, total = 0;
+      Label best_h{};
+      while (end < evidence.size() && evidence[end].x == evidence[i].x &&
+             evidence[end].y == evidence[i].y) {
+        size_t run = end;
+        while (run < evidence.size() && evidence[run].x == evidence[end].x &&
+               evidence[run].y == evidence[end].y && evidence[run].h == evidence[end].h)
+          ++run;
+        const int count = static_cast<int>(run - end);
+        total += count;
+        // A shift that changes the parity of p + v is impossible: dissent.
+        if (!OddSum(evidence[end].h) && count > best) {
+          best = count;
+          best_h = evidence[end].h;
+        }
+        end = run;
+      }
+      const int dissent = total - best;
+      if (best >= params.min_support && dissent <= params.max_dissent * best)
+        candidates.push_back({best, evidence[i].x, evidence[i].y, best_h});
+      i = end;
+    }
+    std::sort(candidates.begin(), candidates.end(), [&](const Candidate& a, const Candidate& b) {
+      return a.support > b.support;
+    });
+    for (const Candidate& c : candidates) {
+      if (comps.Find(c.x).first == comps.Find(c.y).first) continue;
+      comps.Join(c.x, c.y, c.h);
+      joined = true;
+    }
+  }
+
+  // Line 0: each seed says its component's p is shifted by minus its p there.
+  std::map<std::pair<int, int>, int> votes;  // (component, p shift) -> seeds
+  for (int s : seeds) {
+    const auto [c, l] = label_of(s);
+    ++votes[{c, -l.p}];
+  }
+  std::map<int, int> seeds_of;  // component -> seeds
+  for (const auto& [key, count] : votes) seeds_of[key.first] += count;
+  int best_c = -1, best_shift = 0, best_votes = 0;
+  for (const auto& [key, count] : votes)
+    if (count > best_votes) {
+      best_votes = count;
+      best_c = key.first;
+      best_shift = key.second;
+    }
+  std::vector<int> roots;
+  for (int x = 0; x < patches.count; ++x) roots.push_back(comps.Find(x).first);
+  std::sort(roots.begin(), roots.end());
+  out.components = static_cast<int>(std::unique(roots.begin(), roots.end()) - roots.begin());
+  // The seeds of the chosen component must agree: those that do not are
+  // stray junctions beside line 0, and may not outnumber a third of them.
+  if (best_c < 0 || best_votes < min_seeds ||
+      seeds_of[best_c] - best_votes > params.max_dissent * best_votes)
+    return out;
+  const Label shift{best_shift, (best_shift % 2 + 2) % 2};  // keeps p + v's parity
+  std::vector<char> labelled(n, 0);
+  std::vector<Label> label(n);
+  for (int j = 0; j < n; ++j) {
+    const auto [c, l] = label_of(j);
+    if (c != best_c) continue;
+    labelled[j] = 1;
+    label[j] = l + shift;
+  }
+  std::vector<int> patch_size(patches.count, 0);
+  for (int j = 0; j < n; ++j) ++patch_size[patches.of[j]];
+  AttachLoneJunctions(odd_kind, links, patches.of, patch_size, params, &labelled, &label);
+  for (int j = 0; j < n; ++j)
+    if (labelled[j]) {
+      out.p[j] = label[j].p;
+      out.v[j] = label[j].v;
+    }
+  return out;
+}
+
+}  // namespace bsls::interpretation::internal
