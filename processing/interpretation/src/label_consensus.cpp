@@ -153,7 +153,9 @@ class Components {
 // labelled ones when two of their links agree: a link to a labelled
 // junction is one vote, a link to another lone junction is one vote for
 // what that junction's own links to labelled ones agree on. Two votes
-// through different links close a cycle whose labels agree. Rounds until
+// through different links close a cycle whose labels agree; one vote
+// through a smooth step along its line (ConsensusLink::smooth) is enough
+// where no other link disagrees. Rounds until
 // none is added; each round adds all it finds at once, so the order of the
 // junctions does not matter.
 void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<ConsensusLink>& links,
@@ -161,16 +163,21 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
                          const ConsensusParams& params, std::vector<char>* labelled,
                          std::vector<Label>* label) {
   const int n = static_cast<int>(odd_kind.size());
-  std::vector<std::vector<std::pair<int, Label>>> adj(n);  // (neighbour, label change towards it)
+  struct Arc {
+    int to;
+    Label d;  // label change towards `to`
+    bool smooth;
+  };
+  std::vector<std::vector<Arc>> adj(n);
   for (const ConsensusLink& l : links) {
-    adj[l.a].push_back({l.b, {l.dp, l.dv}});
-    adj[l.b].push_back({l.a, {-l.dp, -l.dv}});
+    adj[l.a].push_back({l.b, {l.dp, l.dv}, l.smooth});
+    adj[l.b].push_back({l.a, {-l.dp, -l.dv}, l.smooth});
   }
   auto lone = [&](int j) { return !(*labelled)[j] && patch_size[patch_of[j]] == 1; };
   // What the labelled neighbours of lone junction m agree on for m itself.
   auto own_label = [&](int m) -> std::optional<Label> {
     std::optional<Label> agreed;
-    for (const auto& [k, d] : adj[m]) {
+    for (const auto& [k, d, smooth] : adj[m]) {
       if (!(*labelled)[k]) continue;
       const Label here = (*label)[k] - d;
       if (agreed && !(*agreed == here)) return std::nullopt;
@@ -186,13 +193,15 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
       if (!lone(j)) continue;
       votes.clear();
       int total = 0;
-      for (const auto& [k, d] : adj[j]) {
+      bool smooth_vote = false;
+      for (const auto& [k, d, smooth] : adj[j]) {
         std::optional<Label> via;
         if ((*labelled)[k]) via = (*label)[k];
         else if (lone(k)) via = own_label(k);
         if (!via) continue;
         ++votes[*via - d];
         ++total;
+        smooth_vote = smooth_vote || (smooth && (*labelled)[k]);
       }
       int best = 0;
       Label best_label{};
@@ -201,7 +210,8 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
           best = count;
           best_label = l;
         }
-      if (best >= params.min_support && total - best <= params.max_dissent * best)
+      if ((best >= params.min_support && total - best <= params.max_dissent * best) ||
+          (best == 1 && total == 1 && smooth_vote))
         found.emplace_back(j, best_label);
     }
     for (const auto& [j, l] : found) {

@@ -33,6 +33,9 @@ struct ConsensusLink {
   int dp = 0;  // label of b minus label of a
   int dv = 0;
   bool trusted = false;  // a link of a closed brick
+  // A step along a line whose row spacing the step before or after it on
+  // the same unbroken line repeats: alone, enough for a lone junction.
+  bool smooth = false;
 };
 
 struct ConsensusParams {
@@ -42,6 +45,9 @@ struct ConsensusParams {
   // link, [0, 1).
   double max_dissent = 0.34;
 };
+// A lone junction (in no closed brick) at the pattern's edge joins the
+// labelled ones through two agreeing links, or through one smooth step
+// along its line and no link disagreeing.
 
 struct Consensus {
   std::vector<int> p;  // per junction: line relative to line 0, or kUnlabelled

@@ -26,6 +26,9 @@ struct Link {
   int dv = 0;
 };
 
+constexpr double kSmoothSpread = 1.2;  // a smooth step's row spacing against its neighbour's
+constexpr double kPitchSpread = 1.4;   // and the pitch beside its two ends
+constexpr double kOwnLine = 2.0;       // px: ridge points this close to a junction are its line's
 constexpr double kSpacingSpread = 1.6;  // a line's own row spacing lies within this factor
                                         // of the frame's
 // The row spacing along a line: the dy of a step between junctions of
@@ -259,13 +262,43 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   }
   std::vector<std::vector<Link>> adj(n);
   std::vector<ConsensusLink> links;
-  auto link = [&](int a, int b, int dp, int dv, bool trusted) {
+  auto link = [&](int a, int b, int dp, int dv, bool trusted, bool smooth = false) {
     adj[a].push_back({b, dp, dv});
     adj[b].push_back({a, -dp, -dv});
-    links.push_back({a, b, dp, dv, trusted});
+    links.push_back({a, b, dp, dv, trusted, smooth});
+  };
+  // A step is smooth where the step before or after it on its track has a
+  // row spacing within kSmoothSpread of its own, and the lines beside its
+  // two ends lie as far apart within kPitchSpread (an occluding edge
+  // crossed by the track changes the spacing or the pitch).
+  auto pitch_at = [&](int j) {  // px to the nearest other line in j's row, or 0
+    const cv::Point2d at = net.junctions[j].position;
+    double nearest = 0;
+    for (const extraction::RidgePoint& r : net.rows.Row(static_cast<int>(std::lround(at.y)))) {
+      const double d = std::abs(r.x - at.x);
+      if (d > kOwnLine && (nearest == 0 || d < nearest)) nearest = d;
+    }
+    return nearest;
+  };
+  std::vector<double> pitch(n);
+  for (int j = 0; j < n; ++j) pitch[j] = pitch_at(j);
+  auto within = [](double a, double b, double spread) { return a > b / spread && a < b * spread; };
+  std::vector<int> up(n, -1);  // the junction whose step down reaches j
+  for (int j = 0; j < n; ++j)
+    if (down[j].to >= 0) up[down[j].to] = j;
+  auto per_row = [&](int j) {
+    return (net.junctions[down[j].to].position.y - net.junctions[j].position.y) / down[j].rows;
+  };
+  auto smooth_step = [&](int j) {
+    const double s = per_row(j);
+    const int k = down[j].to;
+    if (!(pitch[j] > 0 && pitch[k] > 0 && within(pitch[j], pitch[k], kPitchSpread))) return false;
+    return (up[j] >= 0 && within(per_row(up[j]), s, kSmoothSpread)) ||
+           (down[k].to >= 0 && within(per_row(k), s, kSmoothSpread));
   };
   for (int j = 0; j < n; ++j) {
-    if (const Step st = down[j]; st.to >= 0) link(j, st.to, 0, st.rows, trusted_down[j]);
+    if (const Step st = down[j]; st.to >= 0)
+      link(j, st.to, 0, st.rows, trusted_down[j], smooth_step(j));
     if (const int c = across[j]; c >= 0) link(j, c, +1, 0, trusted_across[j]);
   }
   // A line broken by a gap (net.line_below): its last junction above and
