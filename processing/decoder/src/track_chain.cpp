@@ -126,10 +126,11 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
 
 // Drops the centres of line track t that do not belong to its line p: those
 // more than half a row spacing beyond its first and last junction labelled
-// p, those past a junction of the track labelled with another p (where the
-// track went on across an occluding edge into another line), and those
-// past an unlabelled junction beyond its last (or before its first)
-// junction of p (a region whose labels could not be proven).
+// p, and those past a junction of the track not labelled p that lies
+// beyond its last (or before its first) junction of p: there the track went
+// on across an occluding edge into another line or into a region whose
+// labels could not be proven. (Such a junction between two of p is a
+// stray segment end, and cuts nothing.)
 void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
                        const interpretation::TrackLabels& labels, int t, TrackCentres* c) {
   const int p = labels.line_p[t];
@@ -141,8 +142,6 @@ void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
       from = std::min(from, net.junctions[j].position.y - reach);
       to = std::max(to, net.junctions[j].position.y + reach);
     }
-  // A junction of another p inside the range ends it on the side away from
-  // the most junctions of p; an unlabelled one only outside them.
   for (int j : on) {
     if (labels.p[j] == p) continue;
     const double y = net.junctions[j].position.y;
@@ -150,8 +149,8 @@ void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
     int above = 0, below = 0;
     for (int k : on)
       if (labels.p[k] == p) ++(net.junctions[k].position.y < y ? above : below);
-    if (labels.p[j] == interpretation::kUnlabelled && above > 0 && below > 0) continue;
-    if (above >= below) to = y; else from = y;
+    if (below == 0) to = y;
+    if (above == 0) from = y;
   }
   for (size_t k = 0; k < c->output.size(); ++k) {
     const double y = c->first_row + static_cast<double>(k);

@@ -203,7 +203,7 @@ void FillSide(const reconstruction::SideOutcome& o, pattern::Side side, v1::Side
   std::uint32_t interpolated = 0;
   for (const auto& j : d.junctions) interpolated += j.interpolated;
   out->set_interpolated_junctions(interpolated);
-  out->set_unlabelled_junctions(static_cast<uint32_t>(decode.unlabelled.size()));
+  out->set_unlabelled_junctions(static_cast<std::uint32_t>(d.unlabelled.size()));
   out->set_lines(static_cast<std::uint32_t>(d.lines.size()));
   out->set_q_absolute(d.q_absolute);
   out->set_rows_note(o.rows_note);
