@@ -494,8 +494,7 @@ TEST(SideCalibrationErrors, TooFewCameraViewsLeftNamesTheDroppedOnes) {
   EXPECT_NE(what.find("2 of 6 camera views usable, at least 3 are needed"), std::string::npos)
       << what;
   for (int i = 1; i <= 4; ++i)
-    EXPECT_NE(what.find("(camera view " + std::to_string(i) + ", z = "), std::string::npos)
-        << what;
+    EXPECT_NE(what.find("(camera view " + std::to_string(i) + ", z = "), std::string::npos) << what;
   EXPECT_NE(what.find("target not found"), std::string::npos) << what;
 }
 
@@ -508,8 +507,7 @@ TEST(SideCalibrationErrors, TooFewCrossViewsLeftNamesTheDroppedOnes) {
   const std::string what = e.what();
   EXPECT_NE(what.find("1 of 3 reference views usable, at least 2 are needed"), std::string::npos)
       << what;
-  EXPECT_NE(what.find("(reference view 1, z = 0 mm): reference cross not found"),
-            std::string::npos)
+  EXPECT_NE(what.find("(reference view 1, z = 0 mm): reference cross not found"), std::string::npos)
       << what;
   EXPECT_NE(what.find("(reference view 3, z = 120 mm): reference cross not found"),
             std::string::npos)

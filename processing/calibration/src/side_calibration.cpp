@@ -33,8 +33,7 @@ std::string Number(double value) {
 }
 
 // "target_z010.png (camera view 2, z = 10 mm)"
-std::string ViewName(const std::filesystem::path& image, ViewKind kind, size_t index,
-                     double z_mm) {
+std::string ViewName(const std::filesystem::path& image, ViewKind kind, size_t index, double z_mm) {
   return image.string() + " (" + std::string(ToString(kind)) + " view " +
          std::to_string(index + 1) + ", z = " + Number(z_mm) + " mm)";
 }
@@ -484,10 +483,9 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
       }
       const size_t worst = std::max_element(off.begin(), off.end()) - off.begin();
       const size_t best = std::min_element(rest.begin(), rest.end()) - rest.begin();
-      const std::string off_text =
-          "the cross centre lies " + Number(off[best]) +
-          " mm off the line through the other cross centres (limit " + Number(limit) +
-          " mm): a misread cross or a wrong z_mm";
+      const std::string off_text = "the cross centre lies " + Number(off[best]) +
+                                   " mm off the line through the other cross centres (limit " +
+                                   Number(limit) + " mm): a misread cross or a wrong z_mm";
       if (crosses.size() < 4 || rest[best] > limit) {
         const size_t named = crosses.size() < 4 ? worst : best;
         Throw(CalibrationErrorReason::kInvalidInput,
@@ -496,8 +494,8 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
                            cross_index[named]) +
                   ": the cross centre lies " + Number(off[named]) +
                   " mm off the line through the other cross centres (limit " + Number(limit) +
-                  " mm): a misread cross or a wrong z_mm; with " +
-                  std::to_string(crosses.size()) + " crosses, " +
+                  " mm): a misread cross or a wrong z_mm; with " + std::to_string(crosses.size()) +
+                  " crosses, " +
                   (crosses.size() < 4 ? "fewer than three others cannot tell which is wrong"
                                       : "no three of them agree on a line"));
       }

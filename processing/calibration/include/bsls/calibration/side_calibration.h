@@ -89,9 +89,9 @@ struct SideCalibrationParams {
   // (all at distinct z): two depths determine each light plane (two lines of
   // it), a third gives it a residual. Cross views, when any are listed: two
   // determine the reference ray, which fixes every screen view's rows.
-  int min_camera_views = 3;     // >= 2
-  int min_screen_views = 3;     // >= 2
-  int min_reference_views = 2;  // >= 2
+  int min_camera_views = 3;                 // >= 2
+  int min_screen_views = 3;                 // >= 2
+  int min_reference_views = 2;              // >= 2
   int stripe_sample_step = 1;               // use every n-th line-centre sample (rows), >= 1
   bool use_interpolated_junctions = false;  // step 5: also junctions the decoder placed unseen
   // Step 4: the decoded line-0 junction must lie this close (px) to the image
