@@ -26,6 +26,13 @@ struct CalibrateOptions {
   ServiceAddress server;  // target empty: calibrated here
 };
 
+// One summary line for a view the calibration left out.
+void PrintDropped(const std::string& kind, const std::string& image, double z_mm,
+                  const std::string& reason) {
+  std::printf("dropped %s view %s (z = %g mm): %s\n", kind.c_str(), image.c_str(), z_mm,
+              reason.c_str());
+}
+
 // The same calibration on the processing service: the manifest and every
 // image it names are uploaded; the calibration file and report come back.
 void RunCalibrateRemote(const CalibrateOptions& o) {
@@ -74,6 +81,9 @@ void RunCalibrateRemote(const CalibrateOptions& o) {
               report.at("camera").at("rms_px").get<double>(),
               report.at("camera").at("rms_mm").get<double>(),
               report.at("planes").at("perspective_rms_mm").get<double>());
+  for (const nlohmann::json& d : report.value("dropped_views", nlohmann::json::array()))
+    PrintDropped(d.at("kind").get<std::string>(), d.at("image").get<std::string>(),
+                 d.at("z_mm").get<double>(), d.at("reason").get<std::string>());
 }
 
 // Input problems (a file missing or unusable) are exit 3; images that were
@@ -124,6 +134,8 @@ void RunCalibrate(const CalibrateOptions& o) {
   std::printf("light planes: perspective RMS %.4f mm (parallel %.4f mm), %d points, %d dropped\n",
               result.perspective.report.rms_mm, result.parallel.report.rms_mm,
               result.perspective.report.points_used, result.perspective.report.points_dropped);
+  for (const calibration::DroppedView& d : result.dropped_views)
+    PrintDropped(std::string(calibration::ToString(d.kind)), d.image.string(), d.z_mm, d.reason);
   const auto& p = result.projector;
   if (p.matrix_centre_mm) {
     std::printf(

@@ -272,16 +272,18 @@ class CalibrationCliTest(unittest.TestCase):
         return os.path.join(self.dir.name, name)
 
     def write_manifest(self, name, camera_zs, screen_image="screen_z000.png",
-                       camera_image=None, missing=None):
-        """A manifest in the session folder listing its images; camera views at camera_zs."""
+                       camera_image=None, missing=None, screen_zs=(0, 60, 120)):
+        """A manifest in the session folder listing its images; camera views at camera_zs,
+        screen views at screen_zs (the first one's image is screen_image)."""
         lines = ["side: left", "target: {rows: 8, cols: 8, pitch_mm: 6.5, square_mm: 4}",
                  "camera_views:"]
         for z in camera_zs:
             image = camera_image or "target_z%03d.png" % z
             lines.append("  - {image: %s, z_mm: %d}" % (image, z))
         lines.append("screen_views:")
-        lines.append("  - {image: %s, z_mm: 0}" % (missing or screen_image))
-        lines.append("  - {image: screen_z060.png, z_mm: 60}")
+        lines.append("  - {image: %s, z_mm: %d}" % (missing or screen_image, screen_zs[0]))
+        for z in screen_zs[1:]:
+            lines.append("  - {image: screen_z%03d.png, z_mm: %d}" % (z, z))
         lines.append("pattern: {lines: 20, rows: 24}")
         path = os.path.join(self.session, name)
         with open(path, "w") as f:
@@ -357,8 +359,47 @@ class CalibrationCliTest(unittest.TestCase):
                                        camera_image="screen_z030.png")
         r = run("calibrate", manifest, "-o", out)
         self.assertEqual(r.returncode, EXIT_NOT_PROCESSED)
+        self.assertIn("0 of 3 camera views usable", r.stderr)
         self.assertIn("screen_z030.png (camera view 1", r.stderr)
         self.assertIn("target not found", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
+        self.assertFalse(os.path.exists(out))
+
+    def test_undecodable_screen_view_is_dropped_and_named(self):
+        # The target where a screen view should be: no bricks to decode. Camera views over
+        # the screens' depths: three close to z = 0 leave the camera too loose for them.
+        out, report = self.path("dropped.yaml"), self.path("dropped.json")
+        manifest = self.write_manifest("m_dropped.yaml", [0, 20, 40, 60, 80, 100],
+                                       screen_image="target_z000.png", screen_zs=(0, 30, 60, 90))
+        r = run("calibrate", manifest, "-o", out, "--report", report)
+        self.assertEqual(r.returncode, EXIT_OK, r.stderr)
+        self.assertIn("dropped screen view", r.stdout)
+        self.assertIn("target_z000.png", r.stdout)
+        with open(report) as f:
+            rep = json.load(f)
+        self.assertEqual(len(rep["dropped_views"]), 1)
+        dropped = rep["dropped_views"][0]
+        self.assertEqual((dropped["image"], dropped["kind"], dropped["z_mm"]),
+                         ("target_z000.png", "screen", 0))
+        self.assertIn("could not be decoded", dropped["reason"])
+        self.assertEqual([v["z_mm"] for v in rep["screens"]], [30, 60, 90])
+        for v in rep["screens"]:
+            self.assertLess(v["plane_rms_mm"], 0.1)
+        for v in rep["camera"]["views"]:
+            self.assertLess(v["rms_px"], 0.3)
+        with open(out) as f:
+            self.assertIn("dropped_views:", f.read())
+
+    def test_too_few_screen_views_left_names_them(self):
+        out = self.path("fewscreens.yaml")
+        manifest = self.write_manifest("m_fewscreens.yaml", [0, 20, 40],
+                                       screen_image="target_z000.png")
+        r = run("calibrate", manifest, "-o", out)
+        self.assertEqual(r.returncode, EXIT_NOT_PROCESSED)
+        self.assertIn("2 of 3 screen views usable, at least 3", r.stderr)
+        self.assertIn("target_z000.png (screen view 1, z = 0 mm): the brick pattern could not "
+                      "be decoded", r.stderr)
+        self.assertEqual(len(r.stderr.strip().splitlines()), 1)
         self.assertFalse(os.path.exists(out))
 
     def test_unwritable_calibration_leaves_nothing_behind(self):

@@ -475,10 +475,11 @@ Corpus ProcessdCorpus(const SessionInputs& inputs, const std::string& binary_ply
     c.flip_tail["ReconstructSession"] = rest.ByteSizeLong();
   }
 
-  // An upload: a manifest naming five images, then five blank 512 x 512 PNGs
-  // (readable, the right size, no target in them).
+  // An upload: a manifest naming six images (the fewest views a calibration
+  // takes), then six blank 512 x 512 PNGs (readable, the right size, no
+  // target in them).
   const std::vector<std::string> camera = {"t0.png", "t1.png", "t2.png"};
-  const std::vector<std::string> screen = {"s0.png", "s1.png"};
+  const std::vector<std::string> screen = {"s0.png", "s1.png", "s2.png"};
   std::vector<unsigned char> png;
   cv::imencode(".png", cv::Mat(512, 512, CV_8UC1, cv::Scalar(200)), png);
   const std::string blank(png.begin(), png.end());

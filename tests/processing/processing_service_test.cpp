@@ -488,6 +488,50 @@ TEST(ProcessingService, CalibrateFromAnUploadedSession) {
   fs::remove_all(scratch);
 }
 
+// A screen view that does not decode is dropped and named in the report, as
+// the client named it; two of them leave too few, and the refusal names them.
+TEST(ProcessingService, CalibrateDropsAViewThatGivesNothing) {
+  const fs::path scratch =
+      fs::path(::testing::TempDir()) / ("scratch-drop-" + std::to_string(getpid()));
+  fs::create_directories(scratch);
+  ProcessingServiceOptions options;
+  options.scratch_dir = scratch;
+  InProcessService s(options);
+  std::string manifest;
+  std::vector<UploadFile> files =
+      SessionFiles(calibration::testing::SessionFolder(SessionKind::kRightClean), &manifest);
+  auto bytes_of = [&files](const std::string& path) -> std::string& {
+    for (UploadFile& f : files)
+      if (f.path == path) return f.bytes;
+    throw std::logic_error("the session has no " + path);
+  };
+  // The target where the 40 mm screen should be: nothing to decode.
+  bytes_of("screen_z040.png") = bytes_of("target_z000.png");
+  WorkOutcome out = s.Client().Calibrate(manifest, files);
+  ASSERT_TRUE(out.status.ok()) << out.status.error_message();
+  const nlohmann::json report = nlohmann::json::parse(out.files.at("calibration-report.json"));
+  ASSERT_EQ(report.at("dropped_views").size(), 1u) << report.at("dropped_views").dump();
+  EXPECT_EQ(report.at("dropped_views")[0].at("image"), "screen_z040.png");
+  EXPECT_EQ(report.at("dropped_views")[0].at("kind"), "screen");
+  EXPECT_EQ(report.at("screens").size(), 3u);
+  const std::string& yaml = out.files.at("calibration.yaml");
+  EXPECT_NE(yaml.find("dropped_views:"), std::string::npos);
+  EXPECT_EQ(yaml.find(scratch.string()), std::string::npos);
+
+  bytes_of("screen_z080.png") = bytes_of("target_z000.png");
+  out = s.Client().Calibrate(manifest, files);
+  EXPECT_EQ(out.status.error_code(), StatusCode::FAILED_PRECONDITION);
+  const std::string& message = out.status.error_message();
+  EXPECT_NE(message.find("2 of 4 screen views usable"), std::string::npos) << message;
+  EXPECT_NE(message.find("screen_z040.png (screen view 2, z = 40 mm): the brick pattern"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("screen_z080.png (screen view 3"), std::string::npos) << message;
+  EXPECT_EQ(message.find(scratch.string()), std::string::npos) << message;
+  EXPECT_TRUE(ScratchIsEmpty(scratch));
+  fs::remove_all(scratch);
+}
+
 TEST(ProcessingService, DrainingRefusesNewWork) {
   InProcessService s;
   s.service().BeginDrain();

@@ -365,9 +365,24 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
     KeyValue(out, "plane_rms_mm", v.plane_rms_mm);
     if (v.q_offset) KeyValue(out, "q_offset", *v.q_offset);
     KeyValue(out, "matrix_junctions", v.matrix_junctions);
+    if (v.matrix_rms_d) KeyValue(out, "matrix_rms_d", *v.matrix_rms_d);
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
+  // Listed views left out, so the file says what it was made from.
+  if (!c.dropped_views.empty()) {
+    out << YAML::Key << "dropped_views" << YAML::Value << YAML::BeginSeq;
+    for (const DroppedView& v : c.dropped_views) {
+      out << YAML::Flow << YAML::BeginMap;
+      KeyValue(out, "image", v.image.string());
+      KeyValue(out, "kind", std::string(ToString(v.kind)));
+      KeyValue(out, "index", v.index);
+      KeyValue(out, "z_mm", v.z_mm);
+      KeyValue(out, "reason", v.reason);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
 
   out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
   KeyValue(out, "stripe_centre_px", c.sigmas.stripe_centre_px);
@@ -570,7 +585,32 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
       if (*v.q_offset % 2 != 0) r.Fail(w + ".q_offset", "must be even");
     }
     v.matrix_junctions = r.Get<int>(screens[i], "matrix_junctions", w);
+    if (screens[i]["matrix_rms_d"]) v.matrix_rms_d = r.Get<double>(screens[i], "matrix_rms_d", w);
     c.screen_views.push_back(std::move(v));
+  }
+  if (root["dropped_views"]) {
+    const YAML::Node dropped = r.Child(root, "dropped_views", "", false);
+    if (!dropped.IsSequence()) r.Fail("dropped_views", "must be a list");
+    for (size_t i = 0; i < dropped.size(); ++i) {
+      const std::string w = "dropped_views[" + std::to_string(i) + "]";
+      DroppedView v;
+      v.image = r.Get<std::string>(dropped[i], "image", w);
+      const std::string kind = r.Get<std::string>(dropped[i], "kind", w);
+      if (kind == ToString(ViewKind::kCamera)) {
+        v.kind = ViewKind::kCamera;
+      } else if (kind == ToString(ViewKind::kScreen)) {
+        v.kind = ViewKind::kScreen;
+      } else if (kind == ToString(ViewKind::kReference)) {
+        v.kind = ViewKind::kReference;
+      } else {
+        r.Fail(w + ".kind", "must be camera, screen or reference, not \"" + kind + "\"");
+      }
+      v.index = r.Get<int>(dropped[i], "index", w);
+      if (v.index < 0) r.Fail(w + ".index", "must not be negative");
+      v.z_mm = r.Get<double>(dropped[i], "z_mm", w);
+      v.reason = r.Get<std::string>(dropped[i], "reason", w);
+      c.dropped_views.push_back(std::move(v));
+    }
   }
 
   const YAML::Node u = r.Child(root, "uncertainty", "");

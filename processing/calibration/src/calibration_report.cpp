@@ -27,7 +27,8 @@ nlohmann::json CalibrationReport(const SideCalibration& c) {
     camera_views.push_back({{"image", v.image.filename().string()},
                             {"z_mm", v.z_mm},
                             {"rms_px", v.rms_px},
-                            {"rms_mm", v.rms_mm}});
+                            {"rms_mm", v.rms_mm},
+                            {"max_grid_residual", v.max_grid_residual}});
   json screens = json::array();
   for (const auto& v : c.screen_views) {
     json s = {{"image", v.image.filename().string()},
@@ -38,8 +39,23 @@ nlohmann::json CalibrationReport(const SideCalibration& c) {
               {"plane_rms_mm", v.plane_rms_mm},
               {"matrix_junctions", v.matrix_junctions}};
     s["q_offset"] = v.q_offset ? json(*v.q_offset) : json(nullptr);
+    s["matrix_rms_d"] = v.matrix_rms_d ? json(*v.matrix_rms_d) : json(nullptr);
     screens.push_back(s);
   }
+  json crosses = json::array();
+  for (const auto& v : c.reference_views)
+    crosses.push_back({{"image", v.image.filename().string()},
+                       {"z_mm", v.z_mm},
+                       {"centre_px", {v.centre_px.x(), v.centre_px.y()}},
+                       {"world_mm", Vec(v.world_mm)},
+                       {"ray_residual_mm", v.ray_residual_mm}});
+  json dropped = json::array();
+  for (const auto& v : c.dropped_views)
+    dropped.push_back({{"image", v.image.filename().string()},
+                       {"kind", std::string(ToString(v.kind))},
+                       {"index", v.index},
+                       {"z_mm", v.z_mm},
+                       {"reason", v.reason}});
   const auto& cr = c.camera.report;
   json out = {{"side", std::string(pattern::ToString(c.side))},
               {"width", c.width},
@@ -65,6 +81,8 @@ nlohmann::json CalibrationReport(const SideCalibration& c) {
                 {"plane_axis", Vec(c.projector.plane_axis)},
                 {"plane_centre_distance_mm", c.projector.plane_centre_distance_mm}}},
               {"screens", screens},
+              {"crosses", crosses},
+              {"dropped_views", dropped},
               {"uncertainty",
                {{"stripe_centre_px", c.sigmas.stripe_centre_px},
                 {"target_point_px", c.sigmas.target_point_px},
@@ -85,6 +103,9 @@ nlohmann::json CalibrationReport(const SideCalibration& c) {
     p["model"] = DeviceJson(c.projector_matrix->model);
     p["matrix_junctions"] = c.projector_matrix->report.points_used;
   }
+  if (c.reference_ray)
+    out["reference_ray"] = {{"point_mm", Vec(c.reference_ray->point_mm)},
+                            {"direction", Vec(c.reference_ray->direction)}};
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include "bsls/io/frame_file.h"
 #include "point_set_geometry.h"
@@ -32,9 +33,27 @@ std::string Number(double value) {
 }
 
 // "target_z010.png (camera view 2, z = 10 mm)"
-std::string ViewName(const ManifestView& view, const char* kind, size_t index) {
-  return view.image.string() + " (" + kind + " view " + std::to_string(index + 1) +
-         ", z = " + Number(view.z_mm) + " mm)";
+std::string ViewName(const std::filesystem::path& image, ViewKind kind, size_t index, double z_mm) {
+  return image.string() + " (" + std::string(ToString(kind)) + " view " +
+         std::to_string(index + 1) + ", z = " + Number(z_mm) + " mm)";
+}
+
+std::string ViewName(const ManifestView& view, ViewKind kind, size_t index) {
+  return ViewName(view.image, kind, index, view.z_mm);
+}
+
+// Why a kind needs its minimum (SideCalibrationParams::min_*_views).
+std::string WhyMinimum(ViewKind kind) {
+  switch (kind) {
+    case ViewKind::kCamera:
+      return "two target planes at distinct z make the points non-coplanar for Tsai's method, a "
+             "third gives the depth a residual";
+    case ViewKind::kScreen:
+      return "two depths determine each light plane, a third gives it a residual";
+    case ViewKind::kReference:
+      return "two cross centres determine the reference ray that fixes the slide rows";
+  }
+  return "";
 }
 
 bool Fail(std::string* error, const std::string& why) {
@@ -74,6 +93,13 @@ void CheckManifest(const Manifest& manifest, const SideCalibrationParams& params
     Throw(CalibrationErrorReason::kInvalidInput,
           "calibration: " + file + " lists " + std::to_string(manifest.screen_views.size()) +
               " screen views; at least " + std::to_string(params.min_screen_views) + " are needed");
+  // Cross views are optional; listed, they must be able to fix the rows.
+  if (!manifest.reference_views.empty() &&
+      static_cast<int>(manifest.reference_views.size()) < params.min_reference_views)
+    Throw(CalibrationErrorReason::kInvalidInput,
+          "calibration: " + file + " lists " + std::to_string(manifest.reference_views.size()) +
+              " reference views; none or at least " + std::to_string(params.min_reference_views) +
+              " are needed (" + WhyMinimum(ViewKind::kReference) + ")");
   // Contracts section 3: the target is moved along +z only, from z = 0.
   for (size_t i = 0; i < manifest.camera_views.size(); ++i) {
     const double z = manifest.camera_views[i].z_mm;
@@ -94,13 +120,9 @@ void CheckManifest(const Manifest& manifest, const SideCalibrationParams& params
         Throw(CalibrationErrorReason::kInvalidInput,
               "calibration: " + file + ": two " + what + " views at z = " + Number(v.z_mm) + " mm");
   };
+  // Distinct z: the minimum counts are counts of depths.
   distinct(manifest.screen_views, "screen");
   distinct(manifest.reference_views, "reference");
-  std::set<double> screens;
-  for (const ManifestView& v : manifest.screen_views) screens.insert(v.z_mm);
-  if (screens.size() < 2)
-    Throw(CalibrationErrorReason::kInvalidInput,
-          "calibration: " + file + ": screen views need at least two distinct z_mm");
 }
 
 // Pooled scatter (px) of line centres about a polynomial x(y) per run of
@@ -154,6 +176,22 @@ double DistanceToLine(const ReferenceRay& ray, const Eigen::Vector3d& p) {
   return (d - d.dot(ray.direction) * ray.direction).norm();
 }
 
+// The points but the one at `skip`.
+std::vector<Eigen::Vector3d> AllBut(const std::vector<ReferenceViewReport>& crosses, size_t skip) {
+  std::vector<Eigen::Vector3d> points;
+  for (size_t i = 0; i < crosses.size(); ++i)
+    if (i != skip) points.push_back(crosses[i].world_mm);
+  return points;
+}
+
+// Largest distance of `points` from their own fitted ray.
+double WorstOffRay(const std::vector<Eigen::Vector3d>& points) {
+  const ReferenceRay ray = FitRay(points);
+  double worst = 0.0;
+  for (const auto& p : points) worst = std::max(worst, DistanceToLine(ray, p));
+  return worst;
+}
+
 }  // namespace
 
 bool SideCalibrationParams::IsValid(std::string* error) const {
@@ -167,6 +205,7 @@ bool SideCalibrationParams::IsValid(std::string* error) const {
   if (!matrix.IsValid(&why)) return Fail(error, "matrix: " + why);
   if (min_camera_views < 2) return Fail(error, "min_camera_views must be at least 2");
   if (min_screen_views < 2) return Fail(error, "min_screen_views must be at least 2");
+  if (min_reference_views < 2) return Fail(error, "min_reference_views must be at least 2");
   if (stripe_sample_step < 1) return Fail(error, "stripe_sample_step must be at least 1");
   if (!(max_origin_junction_px > 0.0))
     return Fail(error, "max_origin_junction_px must be positive");
@@ -177,6 +216,18 @@ bool SideCalibrationParams::IsValid(std::string* error) const {
   if (min_centre_run <= centre_fit_degree + 1)
     return Fail(error, "min_centre_run must exceed centre_fit_degree + 1");
   return true;
+}
+
+std::string_view ToString(ViewKind kind) {
+  switch (kind) {
+    case ViewKind::kCamera:
+      return "camera";
+    case ViewKind::kScreen:
+      return "screen";
+    case ViewKind::kReference:
+      return "reference";
+  }
+  return "unknown";
 }
 
 std::optional<Eigen::Vector3d> ReferenceRay::AtZ(double z_mm) const {
@@ -235,19 +286,42 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
   out.target = manifest.target;
   int width = 0, height = 0;
 
+  // A view that gives nothing is left out with its reason; a kind with fewer
+  // usable views than its minimum refuses the calibration, naming the views
+  // it lost and why.
+  auto drop = [&](const ManifestView& view, ViewKind kind, size_t index,
+                  const std::string& reason) {
+    out.dropped_views.push_back({view.image, kind, static_cast<int>(index), view.z_mm, reason});
+  };
+  auto require = [&](ViewKind kind, size_t used, size_t listed, int minimum) {
+    if (static_cast<int>(used) >= minimum) return;
+    std::string text = "calibration: " + file + ": " + std::to_string(used) + " of " +
+                       std::to_string(listed) + " " + std::string(ToString(kind)) +
+                       " views usable, at least " + std::to_string(minimum) + " are needed (" +
+                       WhyMinimum(kind) + "); dropped:";
+    std::string separator = " ";
+    for (const DroppedView& d : out.dropped_views) {
+      if (d.kind != kind) continue;
+      text += separator + ViewName(d.image, d.kind, d.index, d.z_mm) + ": " + d.reason;
+      separator = "; ";
+    }
+    Throw(CalibrationErrorReason::kNotFound, text);
+  };
+
   // 1. Thesis 6.1: target squares' centres of gravity in every camera view,
-  // then Tsai's two-stage calibration.
+  // then Tsai's two-stage calibration on the views whose grid was found.
   auto t = Clock::now();
   std::vector<TargetView> views;
   for (size_t i = 0; i < manifest.camera_views.size(); ++i) {
     const ManifestView& view = manifest.camera_views[i];
-    const std::string name = ViewName(view, "camera", i);
+    const std::string name = ViewName(view, ViewKind::kCamera, i);
     begin_view(name);
     const cv::Mat grey = LoadView(view, name, &width, &height);
     const TargetDetection detection = DetectTarget(grey, manifest.target, params.target);
-    if (!detection.ok)
-      Throw(CalibrationErrorReason::kNotFound,
-            "calibration: " + name + ": target not found: " + detection.error);
+    if (!detection.ok) {
+      drop(view, ViewKind::kCamera, i, "target not found: " + detection.error);
+      continue;
+    }
     TargetView target_view;
     for (const TargetSquare& square : detection.squares) {
       TargetPoint point;
@@ -262,6 +336,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
     report.max_grid_residual = detection.max_grid_residual;
     out.camera_views.push_back(report);
   }
+  require(ViewKind::kCamera, views.size(), manifest.camera_views.size(), params.min_camera_views);
   out.width = width;
   out.height = height;
   try {
@@ -287,38 +362,52 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
   t = Clock::now();
   decoder::DecodeParams decode = params.decode;
   decode.spec = manifest.pattern;
-  std::vector<decoder::DecodeResult> decoded;
-  std::vector<size_t> view_begin;  // first stripe point of each screen view
+  std::vector<decoder::DecodeResult> decoded;  // one per used screen view
+  std::vector<size_t> view_begin;              // first stripe point of each used screen view
   double centre_sum2 = 0.0, centre_dof = 0.0;
   for (size_t i = 0; i < manifest.screen_views.size(); ++i) {
     const ManifestView& view = manifest.screen_views[i];
-    const std::string name = ViewName(view, "screen", i);
+    const std::string name = ViewName(view, ViewKind::kScreen, i);
     begin_view(name);
     const cv::Mat grey = LoadView(view, name, &width, &height);
     decoder::DecodeResult result = decoder::Decode(grey, manifest.side, decode);
-    if (!result.ok)
-      Throw(CalibrationErrorReason::kNotFound,
-            "calibration: " + name + ": the brick pattern could not be decoded: " + result.error);
+    if (!result.ok) {
+      drop(view, ViewKind::kScreen, i, "the brick pattern could not be decoded: " + result.error);
+      continue;
+    }
     ScreenViewReport report;
     report.image = view.image;
     report.z_mm = view.z_mm;
     report.lines = static_cast<int>(result.lines.size());
     report.junctions = static_cast<int>(result.junctions.size());
-    view_begin.push_back(out.diagnostics.stripe_points.size());
+    std::vector<StripePoint> points;
+    double sum2 = 0.0, dof = 0.0;
     for (const decoder::DecodedLine& line : result.lines) {
-      AccumulateCentreScatter(line.points, params.centre_fit_degree, params.min_centre_run,
-                              &centre_sum2, &centre_dof);
+      AccumulateCentreScatter(line.points, params.centre_fit_degree, params.min_centre_run, &sum2,
+                              &dof);
       for (size_t k = 0; k < line.points.size(); k += params.stripe_sample_step) {
         const Eigen::Vector2d image(line.points[k].x, line.points[k].y);
         const auto world = internal::IntersectZPlane(camera.BackProject(image), view.z_mm);
-        if (!world) continue;
-        out.diagnostics.stripe_points.push_back({*world, line.p});
-        ++report.stripe_points;
+        if (world) points.push_back({*world, line.p});
       }
     }
+    if (points.empty()) {
+      drop(view, ViewKind::kScreen, i,
+           "no decoded line-centre sample back-projects onto the screen (" +
+               std::to_string(report.lines) + " lines decoded)");
+      continue;
+    }
+    centre_sum2 += sum2;
+    centre_dof += dof;
+    report.stripe_points = static_cast<int>(points.size());
+    view_begin.push_back(out.diagnostics.stripe_points.size());
+    out.diagnostics.stripe_points.insert(out.diagnostics.stripe_points.end(), points.begin(),
+                                         points.end());
     out.screen_views.push_back(report);
     decoded.push_back(std::move(result));
   }
+  require(ViewKind::kScreen, out.screen_views.size(), manifest.screen_views.size(),
+          params.min_screen_views);
   view_begin.push_back(out.diagnostics.stripe_points.size());
   out.sigmas.stripe_centre_px = centre_dof > 0.0 ? std::sqrt(centre_sum2 / centre_dof) : 0.0;
   out.diagnostics.times.stripes_ms = MsSince(t);
@@ -348,54 +437,84 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
 
   // 4. Slide 1: the cross centre is slide point (0, 0) = brick line 0, row 0.
   t = Clock::now();
+  std::vector<size_t> cross_index;  // manifest index of each used cross view
   for (size_t i = 0; i < manifest.reference_views.size(); ++i) {
     const ManifestView& view = manifest.reference_views[i];
-    const std::string name = ViewName(view, "reference", i);
+    const std::string name = ViewName(view, ViewKind::kReference, i);
     begin_view(name);
     const cv::Mat grey = LoadView(view, name, &width, &height);
     std::string cross_why;
     const auto cross = FindReferenceCross(grey, params.cross, &cross_why);
-    if (!cross)
-      Throw(CalibrationErrorReason::kNotFound,
-            "calibration: " + name + ": reference cross not found: " + cross_why);
+    if (!cross) {
+      drop(view, ViewKind::kReference, i, "reference cross not found: " + cross_why);
+      continue;
+    }
     ReferenceViewReport report;
     report.image = view.image;
     report.z_mm = view.z_mm;
     report.centre_px = {cross->centre.x, cross->centre.y};
     const auto world = internal::IntersectZPlane(camera.BackProject(report.centre_px), view.z_mm);
-    if (!world)
-      Throw(CalibrationErrorReason::kDegenerate,
-            "calibration: " + name + ": the camera ray of the cross centre misses the screen");
+    if (!world) {
+      drop(view, ViewKind::kReference, i, "the camera ray of the cross centre misses the screen");
+      continue;
+    }
     report.world_mm = *world;
     out.reference_views.push_back(report);
+    cross_index.push_back(i);
   }
-  if (out.reference_views.size() >= 2) {
+  if (!manifest.reference_views.empty()) {
+    require(ViewKind::kReference, out.reference_views.size(), manifest.reference_views.size(),
+            params.min_reference_views);
+    // A centre off the line through the others is a misread cross or a wrong
+    // z. It can be told from the rest only when at least three others remain
+    // to agree on a line; it is the one whose removal leaves them on one.
+    const double limit = params.max_reference_ray_residual_mm;
+    for (;;) {
+      std::vector<ReferenceViewReport>& crosses = out.reference_views;
+      std::vector<Eigen::Vector3d> centres;
+      for (const auto& r : crosses) centres.push_back(r.world_mm);
+      if (crosses.size() < 3 || WorstOffRay(centres) <= limit) break;
+      // Each cross against the line through the others.
+      std::vector<double> off(crosses.size()), rest(crosses.size());
+      for (size_t k = 0; k < crosses.size(); ++k) {
+        const std::vector<Eigen::Vector3d> others = AllBut(crosses, k);
+        off[k] = DistanceToLine(FitRay(others), crosses[k].world_mm);
+        rest[k] = WorstOffRay(others);
+      }
+      const size_t worst = std::max_element(off.begin(), off.end()) - off.begin();
+      const size_t best = std::min_element(rest.begin(), rest.end()) - rest.begin();
+      const std::string off_text = "the cross centre lies " + Number(off[best]) +
+                                   " mm off the line through the other cross centres (limit " +
+                                   Number(limit) + " mm): a misread cross or a wrong z_mm";
+      if (crosses.size() < 4 || rest[best] > limit) {
+        const size_t named = crosses.size() < 4 ? worst : best;
+        Throw(CalibrationErrorReason::kInvalidInput,
+              "calibration: " +
+                  ViewName(manifest.reference_views[cross_index[named]], ViewKind::kReference,
+                           cross_index[named]) +
+                  ": the cross centre lies " + Number(off[named]) +
+                  " mm off the line through the other cross centres (limit " + Number(limit) +
+                  " mm): a misread cross or a wrong z_mm; with " + std::to_string(crosses.size()) +
+                  " crosses, " +
+                  (crosses.size() < 4 ? "fewer than three others cannot tell which is wrong"
+                                      : "no three of them agree on a line"));
+      }
+      drop(manifest.reference_views[cross_index[best]], ViewKind::kReference, cross_index[best],
+           off_text);
+      crosses.erase(crosses.begin() + static_cast<std::ptrdiff_t>(best));
+      cross_index.erase(cross_index.begin() + static_cast<std::ptrdiff_t>(best));
+    }
     std::vector<Eigen::Vector3d> centres;
     for (const auto& r : out.reference_views) centres.push_back(r.world_mm);
     out.reference_ray = FitRay(centres);
-    for (size_t i = 0; i < out.reference_views.size(); ++i) {
-      ReferenceViewReport& r = out.reference_views[i];
+    for (ReferenceViewReport& r : out.reference_views)
       r.ray_residual_mm = DistanceToLine(*out.reference_ray, r.world_mm);
-      if (r.ray_residual_mm > params.max_reference_ray_residual_mm)
-        Throw(CalibrationErrorReason::kInvalidInput,
-              "calibration: " + ViewName(manifest.reference_views[i], "reference", i) +
-                  ": the cross centre lies " + Number(r.ray_residual_mm) +
-                  " mm off the line through the other cross centres (limit " +
-                  Number(params.max_reference_ray_residual_mm) +
-                  " mm): a misread cross or a wrong z_mm");
-    }
   }
-  // The q offset of each screen view: image of slide point (0, 0) on its
-  // plane, from the reference ray or a cross view at the same z.
-  for (size_t i = 0; i < out.screen_views.size(); ++i) {
+  // The q offset of each screen view: the image of slide point (0, 0) on its
+  // plane, where the reference ray meets it.
+  for (size_t i = 0; i < out.screen_views.size() && out.reference_ray; ++i) {
     ScreenViewReport& report = out.screen_views[i];
-    std::optional<Eigen::Vector3d> origin;
-    if (out.reference_ray) {
-      origin = out.reference_ray->AtZ(report.z_mm);
-    } else {
-      for (const auto& r : out.reference_views)
-        if (r.z_mm == report.z_mm) origin = r.world_mm;
-    }
+    const std::optional<Eigen::Vector3d> origin = out.reference_ray->AtZ(report.z_mm);
     if (!origin) continue;
     const auto image = camera.Project(*origin);
     if (!image) continue;
@@ -416,8 +535,10 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
   // 5. Thesis eq. 2.16: the projector matrix from the junctions of the views
   // whose rows are absolute (decoder::DecodeParams::q_offset added, as the
   // decoder would).
+  std::vector<size_t> junction_begin;  // first junction point of each used screen view
   for (size_t i = 0; i < out.screen_views.size(); ++i) {
     ScreenViewReport& report = out.screen_views[i];
+    junction_begin.push_back(out.diagnostics.junction_points.size());
     if (!report.q_offset) continue;
     for (const decoder::DecodedJunction& j : decoded[i].junctions) {
       if (j.interpolated && !params.use_interpolated_junctions) continue;
@@ -429,12 +550,13 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
       ++report.matrix_junctions;
     }
   }
+  junction_begin.push_back(out.diagnostics.junction_points.size());
   if (!manifest.reference_views.empty()) {
     if (out.diagnostics.junction_points.empty())
       Throw(CalibrationErrorReason::kNotFound,
             "calibration: " + file + ": no screen view's line-0 junction lies within " +
                 Number(params.max_origin_junction_px) +
-                " px of the reference cross centre: the slide rows cannot be fixed");
+                " px of the reference ray's image: the slide rows cannot be fixed");
     try {
       out.projector_matrix = FitProjectorMatrix(out.diagnostics.junction_points, params.matrix);
     } catch (const CalibrationError& e) {
@@ -444,7 +566,25 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
       Throw(CalibrationErrorReason::kNotConverged,
             "calibration: " + file + ": projector matrix did not converge in " +
                 std::to_string(out.projector_matrix->report.iterations) + " iterations");
+    const ProjectorMatrixFit& matrix = *out.projector_matrix;
+    for (size_t i = 0; i < out.screen_views.size(); ++i) {
+      double sum2 = 0.0;
+      int count = 0;
+      for (size_t k = junction_begin[i]; k < junction_begin[i + 1]; ++k) {
+        if (!matrix.report.inlier[k]) continue;
+        const JunctionPoint& j = out.diagnostics.junction_points[k];
+        const auto slide = matrix.model.Project(j.world_mm);
+        if (!slide) continue;
+        sum2 += (*slide - j.slide_st).squaredNorm();
+        ++count;
+      }
+      if (count > 0) out.screen_views[i].matrix_rms_d = std::sqrt(sum2 / count);
+    }
   }
+  std::stable_sort(out.dropped_views.begin(), out.dropped_views.end(),
+                   [](const DroppedView& a, const DroppedView& b) {
+                     return std::tie(a.kind, a.index) < std::tie(b.kind, b.index);
+                   });
   out.projector = PoseOfProjector(out.perspective, out.projector_matrix, camera);
   out.diagnostics.times.reference_ms = MsSince(t);
   out.diagnostics.times.total_ms = MsSince(start);

@@ -674,6 +674,10 @@ Status ProcessingService::Calibrate(
     for (auto& v : result.camera_views) v.image = fs::relative(v.image, folder.path());
     for (auto& v : result.screen_views) v.image = fs::relative(v.image, folder.path());
     for (auto& v : result.reference_views) v.image = fs::relative(v.image, folder.path());
+    for (auto& v : result.dropped_views) {
+      v.image = fs::relative(v.image, folder.path());
+      v.reason = strip(v.reason);
+    }
     const std::string yaml = calibration::CalibrationToYaml(result, options_.software_version);
     const auto cached = calibrations_.Put(yaml, "the new calibration");
     nlohmann::json report = calibration::CalibrationReport(result);

@@ -1,9 +1,11 @@
 // The figures of a side calibration as JSON (`bsls calibrate --report`, the
 // processing service's calibration-report.json): per-view and overall
-// residuals, the planes' fit, the projector's pose, the uncertainties and
-// the stage times. Devices are laid out as the simulator's truth.json
-// (intrinsics, row-major world -> device rotation, translation in mm), so a
-// calibration can be compared with the truth directly.
+// residuals (camera RMS per target view, plane and projector-matrix RMS per
+// screen view, ray residual per cross view), the views dropped and why, the
+// planes' fit, the projector's pose, the uncertainties and the stage times.
+// Devices are laid out as the simulator's truth.json (intrinsics, row-major
+// world -> device rotation, translation in mm), so a calibration can be
+// compared with the truth directly.
 #ifndef BSLS_CALIBRATION_CALIBRATION_REPORT_H_
 #define BSLS_CALIBRATION_CALIBRATION_REPORT_H_
 

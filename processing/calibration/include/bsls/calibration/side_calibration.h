@@ -1,13 +1,15 @@
 // The calibration of one side (one camera + its brick slide) from a session
 // manifest (contracts section 4; thesis chapter 6):
 //
-//   1. camera     DetectTarget in every camera view (all or nothing), then
-//                 CalibrateCamera (thesis 6.1, Tsai two-stage).
+//   1. camera     DetectTarget in every camera view, then CalibrateCamera
+//                 (thesis 6.1, Tsai two-stage) on the views whose full grid
+//                 was found.
 //   2. stripes    Decode every screen view with the side's brick slide; every
-//                 labelled line-centre sample is back-projected onto its screen
-//                 z (camera ray ∩ plane z = z_mm): a StripePoint of line p
-//                 (thesis 6.2: "the intersection of the corresponding camera
-//                 rays with the appropriate reference plane").
+//                 labelled line-centre sample of a decoded view is
+//                 back-projected onto its screen z (camera ray ∩ plane
+//                 z = z_mm): a StripePoint of line p (thesis 6.2: "the
+//                 intersection of the corresponding camera rays with the
+//                 appropriate reference plane").
 //   3. planes     FitParallelPlaneModel (thesis 6.2.1) and
 //                 FitPerspectivePlaneModel (6.2.2) on those points, each with
 //                 the two-pass outlier rejection.
@@ -23,16 +25,25 @@
 //                 back-projected onto their screens, give FitProjectorMatrix
 //                 (thesis eq. 2.16) in slide units.
 //
+// A view that gives nothing usable is dropped, not fatal: a camera view whose
+// target grid is not fully found (a view is never used in part), a screen view
+// that does not decode, a cross view whose cross is not found or whose centre
+// lies off the line through the others (when enough others agree to tell which
+// is wrong). Each is named in SideCalibration::dropped_views with the reason,
+// and the calibration goes on while enough views of its kind remain
+// (SideCalibrationParams::min_*_views; docs/calibration.md says why those
+// numbers).
+//
 // Frames and units: world millimetres of contracts section 3 (fixed by the
 // target), image pixels with the origin at the centre of the top-left pixel,
 // slide coordinates in line pitches d (bsls/pattern/brick_pattern.h).
 //
 // Errors: every failure throws CalibrationError whose what() names the input
 // (manifest file, view image) and the reason: listed views out of z order or
-// too few, an image that cannot be read or has another size, the target grid
-// not fully found in a camera view (a view is never used in part), a screen
-// view that does not decode, a cross not found, a fit that is degenerate or
-// does not converge.
+// fewer than the minimum, an image that cannot be read or has another size,
+// fewer usable views of a kind than its minimum once the bad ones are dropped
+// (naming every dropped view and why), a fit that is degenerate or does not
+// converge.
 //
 // Thread-safety: CalibrateSide is a pure function of its arguments (it reads
 // the listed image files); decoding runs on OpenCV's thread pool.
@@ -44,6 +55,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "bsls/calibration/calibration_error.h"
@@ -69,16 +81,28 @@ struct SideCalibrationParams {
   StripeFitParams stripes;                  // step 3, both plane models
   CrossParams cross;                        // step 4
   ProjectorMatrixParams matrix;             // step 5
-  int min_camera_views = 3;                 // >= 2: Tsai needs depth, 3 leave redundancy
-  int min_screen_views = 2;                 // >= 2: the tilt of the light planes needs depth
+  // The fewest usable views of each kind (listed, and left once the views
+  // that give nothing are dropped) that still calibrate; docs/calibration.md,
+  // "Views that fail", says why. Camera views: two planes at distinct z make
+  // the target points non-coplanar (Tsai's method needs that), a third checks
+  // the depth direction so a view's residual means something. Screen views
+  // (all at distinct z): two depths determine each light plane (two lines of
+  // it), a third gives it a residual. Cross views, when any are listed: two
+  // determine the reference ray, which fixes every screen view's rows.
+  int min_camera_views = 3;                 // >= 2
+  int min_screen_views = 3;                 // >= 2
+  int min_reference_views = 2;              // >= 2
   int stripe_sample_step = 1;               // use every n-th line-centre sample (rows), >= 1
   bool use_interpolated_junctions = false;  // step 5: also junctions the decoder placed unseen
   // Step 4: the decoded line-0 junction must lie this close (px) to the image
   // of the reference ray on a screen, else that view's offset stays unknown.
   // Line-0 junctions are 2 d apart (about 50 px in the thesis rig).
   double max_origin_junction_px = 8.0;  // > 0
-  // Step 4: a cross centre further (mm) from the line fitted through all of
-  // them fails the calibration (a cross misread or a screen z misreported).
+  // Step 4: a cross centre further (mm) from the line fitted through the
+  // others is a cross misread or a screen z misreported. With four or more
+  // crosses, the one whose removal leaves the rest within this limit is
+  // dropped; with fewer, nothing tells which is wrong and the calibration is
+  // refused.
   double max_reference_ray_residual_mm = 1.0;  // > 0
   // Stripe-centre noise estimate: per line and view, a polynomial x(y) of
   // this degree is fitted to the centres; runs shorter than
@@ -88,6 +112,25 @@ struct SideCalibrationParams {
 
   // True when every part is usable; otherwise names the field and why.
   bool IsValid(std::string* error) const;
+};
+
+// The three kinds of view a manifest lists (contracts section 4).
+enum class ViewKind {
+  kCamera,     // camera_views: the target
+  kScreen,     // screen_views: the brick slide on a blank screen
+  kReference,  // reference_views: slide 1 (the cross) on a blank screen
+};
+
+// "camera", "screen" or "reference": the manifest's names.
+std::string_view ToString(ViewKind kind);
+
+// A listed view left out of the calibration, and why.
+struct DroppedView {
+  std::filesystem::path image;
+  ViewKind kind = ViewKind::kCamera;
+  int index = 0;  // 0-based, in the manifest's list of its kind
+  double z_mm = 0.0;
+  std::string reason;  // e.g. "the brick pattern could not be decoded: reference line not found"
 };
 
 // How one camera view fed step 1.
@@ -109,6 +152,9 @@ struct ScreenViewReport {
   double plane_rms_mm = 0.0;    // perspective model, this view's kept points
   std::optional<int> q_offset;  // even; added to the decode's relative q (step 4)
   int matrix_junctions = 0;     // junctions that fed step 5
+  // RMS slide reprojection error (line pitches d) of this view's junctions
+  // that the projector matrix kept; nullopt without a matrix or junctions.
+  std::optional<double> matrix_rms_d;
 };
 
 // A cross view of step 4.
@@ -117,7 +163,9 @@ struct ReferenceViewReport {
   double z_mm = 0.0;
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();  // image of slide point (0, 0)
   Eigen::Vector3d world_mm = Eigen::Vector3d::Zero();   // back-projected onto z_mm
-  double ray_residual_mm = 0.0;                         // distance from the fitted reference ray
+  // Distance from the fitted reference ray; 0 by construction with only two
+  // crosses (the ray goes through both).
+  double ray_residual_mm = 0.0;
 };
 
 // The projector ray of slide point (0, 0) (brick line 0, row 0): a world line.
@@ -184,6 +232,9 @@ struct SideCalibration {
   std::vector<CameraViewReport> camera_views;        // manifest order
   std::vector<ScreenViewReport> screen_views;        // manifest order
   std::vector<ReferenceViewReport> reference_views;  // manifest order
+  // Listed views left out (kind by kind in the order above, manifest order
+  // within a kind); the *_views above hold only the views that were used.
+  std::vector<DroppedView> dropped_views;
   ProjectorPose projector;
   UncertaintySigmas sigmas;
 
