@@ -15,19 +15,23 @@
 // tolerance class, and the worst frames with every drawn parameter.
 //
 //   heldout_report [--set tuning|heldout] [--count N] [--first I] [--worst K]
-//                  [--json FILE] [--quiet]
+//                  [--json FILE] [--images DIR] [--quiet]
 //     --count  frames (default 200); --first  index of the first seed in the
 //     set (default 0); --worst  frames listed in full (default 10); --json
-//     per-frame figures and draws as JSON; --quiet  totals only.
+//     per-frame figures and draws as JSON; --images  write each frame to
+//     DIR/<seed>.png; --quiet  totals only.
 // Exit status 0 when every frame ran, 2 on bad arguments, 1 on an error.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -42,6 +46,7 @@ namespace sim = bsls::simulator;
 
 constexpr double kMatchReach = 2.5;   // px, as tests/decoder and the outside corpus
 constexpr int kLineZeroJunctions = 3;  // visible junctions on line 0 that make it visible
+constexpr double kBasePlaneBand = 0.5;  // mm: junctions this close to z = 0 are on the base plane
 
 struct Options {
   sim::SeedSet set = sim::SeedSet::kHeldOut;
@@ -49,6 +54,7 @@ struct Options {
   int first = 0;
   int worst = 10;
   std::string json;
+  std::string images;  // folder for the rendered frames; empty: none
   bool quiet = false;
 };
 
@@ -59,14 +65,18 @@ struct FrameResult {
   bool line_zero_visible = false;
   double measured_pitch = 0.0;  // the decoder's, px (0: none)
   sim::LabelScore score;
+  sim::LabelScore object, base;  // the truth on the object, on the base plane (unmatched: n/a)
   int right = 0;  // found with the right label
   double render_ms = 0.0, decode_ms = 0.0;
 
   double Recall() const { return score.truth ? static_cast<double>(right) / score.truth : 0.0; }
+  // Right labels among a part's truth.
+  static int Right(const sim::LabelScore& s) { return s.found - s.Wrong(); }
 };
 
 struct Totals {
   int frames = 0, truth = 0, right = 0, wrong_p = 0, wrong_q = 0, unmatched = 0;
+  int object_truth = 0, object_right = 0, base_truth = 0, base_right = 0;
   int refused = 0, refused_rightly = 0, labelled_without_line_zero = 0, frames_with_wrong_p = 0;
   double sum_recall = 0.0, worst_recall = 1.0;
 
@@ -74,6 +84,10 @@ struct Totals {
     ++frames;
     truth += f.score.truth;
     right += f.right;
+    object_truth += f.object.truth;
+    object_right += FrameResult::Right(f.object);
+    base_truth += f.base.truth;
+    base_right += FrameResult::Right(f.base);
     wrong_p += f.score.wrong_p;
     wrong_q += f.score.wrong_v;
     unmatched += f.score.unmatched;
@@ -90,16 +104,18 @@ struct Totals {
 };
 
 void PrintTotalsHeader() {
-  std::printf("%-16s %6s %7s %8s %8s %7s %7s %9s %8s %9s %9s\n", "group", "frames", "truth",
-              "recall", "mean", "worst", "wrong p", "(frames)", "wrong q", "unmatched",
-              "refused");
+  std::printf("%-16s %6s %7s %8s %8s %7s %8s %8s %7s %9s %8s %9s %9s\n", "group", "frames",
+              "truth", "recall", "mean", "worst", "object", "base", "wrong p", "(frames)",
+              "wrong q", "unmatched", "refused");
 }
 
 void PrintTotals(const std::string& name, const Totals& t) {
   if (t.frames == 0) return;
-  std::printf("%-16s %6d %7d %7.2f%% %7.2f%% %6.2f%% %7d %9d %8d %9d %5d (%d)\n", name.c_str(),
-              t.frames, t.truth, t.truth ? 100.0 * t.right / t.truth : 0.0,
-              100.0 * t.sum_recall / t.frames, 100.0 * t.worst_recall, t.wrong_p,
+  auto percent = [](int part, int whole) { return whole ? 100.0 * part / whole : 0.0; };
+  std::printf("%-16s %6d %7d %7.2f%% %7.2f%% %6.2f%% %7.2f%% %7.2f%% %7d %9d %8d %9d %5d (%d)\n",
+              name.c_str(), t.frames, t.truth, percent(t.right, t.truth),
+              100.0 * t.sum_recall / t.frames, 100.0 * t.worst_recall,
+              percent(t.object_right, t.object_truth), percent(t.base_right, t.base_truth), t.wrong_p,
               t.frames_with_wrong_p, t.wrong_q, t.unmatched, t.refused, t.refused_rightly);
 }
 
@@ -118,13 +134,17 @@ std::string PitchBand(const sim::RandomSceneDraw& d) {
   return "pitch 32-64";
 }
 
-FrameResult RunFrame(std::uint32_t seed) {
+FrameResult RunFrame(std::uint32_t seed, const Options& o) {
   FrameResult f;
   const auto t0 = std::chrono::steady_clock::now();
   const sim::RandomScene random = sim::MakeRandomScene(seed);
   f.draw = random.draw;
   const sim::Frame frame = sim::Renderer(random.scene, random.render).Render();
   const auto t1 = std::chrono::steady_clock::now();
+  if (!o.images.empty()) {
+    const std::string path = o.images + "/" + std::to_string(seed) + ".png";
+    if (!cv::imwrite(path, frame.image)) throw std::runtime_error("could not write " + path);
+  }
   const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame.image, random.scene.side);
   const auto t2 = std::chrono::steady_clock::now();
   f.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
@@ -142,17 +162,31 @@ FrameResult RunFrame(std::uint32_t seed) {
     f.refusal = r.error;
   }
   f.score = sim::ScoreLabels(truth, decoded, kMatchReach);
+  // Recall on the object and on the base plane around it, apart.
+  std::vector<sim::PointLabel> on_object, on_base;
+  for (const sim::TruthJunction& j : frame.truth.junctions) {
+    if (!j.visible) continue;
+    const bool base = f.draw.object != sim::RandomObject::kPlane && std::abs(j.world.z()) < kBasePlaneBand;
+    (base ? on_base : on_object).push_back({j.p, j.v, {j.image.x(), j.image.y()}});
+  }
+  for (const auto& [part, score] : {std::pair{&on_object, &f.object}, std::pair{&on_base, &f.base}}) {
+    *score = sim::ScoreLabels(*part, decoded, kMatchReach);
+  }
   f.right = f.score.found - f.score.Wrong();
   return f;
 }
 
 void PrintFrame(const FrameResult& f) {
   const sim::RandomSceneDraw& d = f.draw;
-  std::printf("%6u %-8s %-5s %4dx%-4d pitch %5.1f/%5.1f  truth %4d recall %6.2f%%  wrong p %3d q %3d"
-              "  unmatched %3d%s%s  %6.0f + %5.0f ms\n",
+  auto percent = [](const sim::LabelScore& s) {
+    return s.truth ? 100.0 * FrameResult::Right(s) / s.truth : 0.0;
+  };
+  std::printf("%6u %-8s %-5s %4dx%-4d pitch %5.1f/%5.1f  truth %4d recall %6.2f%% (object %6.2f%%"
+              " base %6.2f%%)  wrong p %3d q %3d  unmatched %3d%s%s  %6.0f + %5.0f ms\n",
               d.seed, std::string(sim::ToString(d.object)).c_str(),
               std::string(bsls::pattern::ToString(d.side)).c_str(), d.width, d.height,
               d.stripe_pitch_px, f.measured_pitch, f.score.truth, 100.0 * f.Recall(),
+              percent(f.object), percent(f.base),
               f.score.wrong_p, f.score.wrong_v, f.score.unmatched, f.refused ? "  REFUSED" : "",
               f.line_zero_visible ? "" : "  (line 0 hidden)", f.render_ms, f.decode_ms);
 }
@@ -177,7 +211,7 @@ nlohmann::json FrameJson(const FrameResult& f) {
 int Usage(const char* argv0) {
   std::fprintf(stderr,
                "usage: %s [--set tuning|heldout] [--count N] [--first I] [--worst K] "
-               "[--json FILE] [--quiet]\n",
+               "[--json FILE] [--images DIR] [--quiet]\n",
                argv0);
   return 2;
 }
@@ -205,6 +239,8 @@ int main(int argc, char** argv) {
       o.worst = std::atoi(argv[++i]);
     } else if (a == "--json" && has_value) {
       o.json = argv[++i];
+    } else if (a == "--images" && has_value) {
+      o.images = argv[++i];
     } else if (a == "--quiet") {
       o.quiet = true;
     } else {
@@ -226,7 +262,7 @@ int main(int argc, char** argv) {
       std::printf("%6s %-8s %-5s %-9s %s\n", "seed", "object", "side", "size",
                   "pitch target/measured ...");
     for (int i = 0; i < o.count; ++i) {
-      frames.push_back(RunFrame(sim::SeedOf(o.set, o.first + i)));
+      frames.push_back(RunFrame(sim::SeedOf(o.set, o.first + i), o));
       if (!o.quiet) PrintFrame(frames.back());
       std::fflush(stdout);
     }
@@ -250,8 +286,10 @@ int main(int argc, char** argv) {
     decode_ms += f.decode_ms;
   }
   std::printf("\nrecall = right labels / lit and visible junctions (refused frames count 0); "
-              "mean = mean of the frames' recalls;\nrefused (n) = frames the decoder refused "
-              "(n of them without a visible line 0, rightly)\n");
+              "mean = mean of the frames' recalls;\nobject / base = recall on the object's "
+              "junctions / on the base plane's (|z| < %.1f mm; plane frames: all object);\n"
+              "refused (n) = frames the decoder refused (n of them without a visible line 0, "
+              "rightly)\n", kBasePlaneBand);
   PrintTotalsHeader();
   PrintTotals("all", all);
   for (const auto* group : {&by_object, &by_size, &by_pitch, &by_class})

@@ -27,8 +27,12 @@ constexpr double kFaceShare = 0.5;
 // Image aspects (width / height) and their chances: square, landscape 4:3, portrait 3:4.
 constexpr double kLandscapeChance = 0.2;
 constexpr double kPortraitChance = 0.2;
-// The pattern's strokes are w = d / 8: supersample thin strokes more.
+// The pattern's strokes are w = d / 8: supersample thin strokes more (3 x 3
+// below 1.25 px, 2 x 2 below 3 px, else 1: wide strokes gain little from it,
+// and the largest frames would cost 4-9 times as much).
 constexpr double kStrokePerPitch = 0.125;
+// The exposure assumes blurred strokes peak at no less than this of an open slide.
+constexpr double kMinStrokePeak = 0.3;
 // Camera blur never drops below this (px): a real lens and sensor always blur.
 constexpr double kMinCameraBlurPx = 0.3;
 // Faces are subdivided this often (898 x 4^2 triangles, as the thesis scenes).
@@ -469,7 +473,7 @@ RandomSceneDraw DrawRandomScene(std::uint32_t seed, const RandomSceneRanges& ran
   // Light, defocus, noise.
   RenderParams& r = d.render;
   const double stroke_px = kStrokePerPitch * d.stripe_pitch_px;
-  r.supersampling = stroke_px < 1.5 ? 3 : stroke_px < 3.0 ? 2 : 1;
+  r.supersampling = stroke_px < 1.25 ? 3 : stroke_px < 3.0 ? 2 : 1;
   r.projector_blur_sigma_d = rng.Uniform(ranges.projector_blur_d);
   r.projector_aperture_mm = rng.Uniform(ranges.projector_aperture_mm);
   const double aim_depth = (projector.pose().rotation * aim + projector.pose().translation).z();
@@ -481,8 +485,21 @@ RandomSceneDraw DrawRandomScene(std::uint32_t seed, const RandomSceneRanges& ran
   r.shot_noise = rng.Uniform(ranges.shot_noise);
   r.ambient = rng.Uniform(ranges.ambient);
   r.black_level = rng.Uniform(ranges.black_level);
+  // Exposure: the operator sets the gain so that the strokes at the aim point
+  // peak at `peak` grey levels. A stroke of width w blurred by sigma (slide
+  // and camera blur, defocus at the aim point; in d) peaks at erf(w / (2
+  // sqrt(2) sigma)) of an open slide.
   const double peak = rng.Uniform(ranges.peak_grey);
-  r.gain = (peak - r.black_level) / (d.albedo.base * (1.0 + r.ambient));
+  const double focal_d = d.projector_focal_d;
+  const double defocus_d = 0.25 * r.projector_aperture_mm * focal_d *
+                           std::abs(aim_depth - r.projector_focus_distance_mm) /
+                           (r.projector_focus_distance_mm * aim_depth);
+  const double camera_blur_d = r.camera_blur_sigma_px / d.stripe_pitch_px;
+  const double sigma_d = std::sqrt(r.projector_blur_sigma_d * r.projector_blur_sigma_d +
+                                   defocus_d * defocus_d + camera_blur_d * camera_blur_d);
+  const double stroke_peak = std::max(
+      kMinStrokePeak, std::erf(kStrokePerPitch / (2.0 * std::sqrt(2.0) * std::max(sigma_d, 1e-9))));
+  r.gain = (peak - r.black_level) / (d.albedo.base * (stroke_peak + r.ambient));
   r.seed = seed;
   return d;
 }

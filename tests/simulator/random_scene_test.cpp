@@ -26,6 +26,9 @@ constexpr int kTracedScenes = 10;
 constexpr double kPitchTolerance = 0.3;  // relative
 // Visible junctions on line 0 that make it visible (bench/decoder/heldout_report).
 constexpr int kLineZeroJunctions = 3;
+// Neighbouring junctions farther apart than this (mm; the projected pitch is
+// 4-8 mm) lie across an occluding edge.
+constexpr double kSameSurfaceMm = 12.0;
 
 RandomSceneData TestData() {
   return {kDataDir / "canonical_face_model.obj", kDataDir / "stanford_bunny.json"};
@@ -61,8 +64,9 @@ TEST(RandomScene, IsReproducibleFromItsSeed) {
     EXPECT_NE(ToJson(DrawRandomScene(seed)), ToJson(DrawRandomScene(seed + 1))) << seed;
   }
   // Rendered twice, a frame is the same to the last grey level.
-  const RandomScene a = MakeRandomScene(kHeldOutFirstSeed + 4, TestData(), SmallImages());
-  const RandomScene b = MakeRandomScene(kHeldOutFirstSeed + 4, TestData(), SmallImages());
+  RandomScene a = MakeRandomScene(kHeldOutFirstSeed + 4, TestData(), SmallImages());
+  RandomScene b = MakeRandomScene(kHeldOutFirstSeed + 4, TestData(), SmallImages());
+  a.render.supersampling = b.render.supersampling = 1;  // the draws are what is tested
   const cv::Mat image_a = Renderer(a.scene, a.render).RenderImage(a.render.seed);
   const cv::Mat image_b = Renderer(b.scene, b.render).RenderImage(b.render.seed);
   ASSERT_EQ(image_a.size(), image_b.size());
@@ -161,11 +165,12 @@ TEST(RandomScene, LineZeroIsVisibleAndTheSidesFollowTheContracts) {
     SCOPED_TRACE(random.draw.Describe());
     const GroundTruth truth = ComputeGroundTruth(random.scene);
     const bool left = random.draw.side == Side::kLeft;
-    std::map<std::pair<int, int>, double> image_x;  // (p, v) -> x of the visible junctions
+    // (p, v) -> the visible junction there.
+    std::map<std::pair<int, int>, const TruthJunction*> visible;
     int line_zero = 0, line_zero_raised = 0;
     for (const TruthJunction& j : truth.junctions) {
       if (!j.visible) continue;
-      image_x[{j.p, j.v}] = j.image.x();
+      visible[{j.p, j.v}] = &j;
       if (j.p == 0) {
         ++line_zero;
         line_zero_raised += j.world.z() > random.draw.face_lift_mm + 10.0;
@@ -179,14 +184,16 @@ TEST(RandomScene, LineZeroIsVisibleAndTheSidesFollowTheContracts) {
     if (random.draw.object == RandomObject::kFace) {
       EXPECT_GE(line_zero_raised, kLineZeroJunctions);
     }
-    // Junctions p and p + 1 on one row: the segment between them runs
-    // towards smaller image x on the left side.
+    // Junctions p and p + 1 on one row of one surface (their world points
+    // about a pitch apart, not across an occluding edge): the segment between
+    // them runs towards smaller image x on the left side.
     int pairs = 0;
-    for (const auto& [pv, x] : image_x) {
-      const auto next = image_x.find({pv.first + 1, pv.second});
-      if (next == image_x.end()) continue;
+    for (const auto& [pv, j] : visible) {
+      const auto next = visible.find({pv.first + 1, pv.second});
+      if (next == visible.end()) continue;
+      if ((next->second->world - j->world).norm() > kSameSurfaceMm) continue;
       ++pairs;
-      EXPECT_EQ(next->second < x, left) << "p " << pv.first << " v " << pv.second;
+      EXPECT_EQ(next->second->image.x() < j->image.x(), left) << "p " << pv.first << " v " << pv.second;
     }
     EXPECT_GT(pairs, 20);
   }
@@ -197,7 +204,7 @@ TEST(RandomScene, LineZeroIsVisibleAndTheSidesFollowTheContracts) {
 TEST(RandomScene, RenderedStripePitchSpansTheRange) {
   std::uint32_t smallest = 0, largest = 0;
   double small_pitch = 1e9, large_pitch = 0.0;
-  for (int i = 0; i < 200; ++i) {
+  for (int i = 0; i < kDrawnScenes; ++i) {
     const RandomSceneDraw d = DrawRandomScene(SeedOf(SeedSet::kHeldOut, i));
     if (d.stripe_pitch_px < small_pitch) {
       small_pitch = d.stripe_pitch_px;
@@ -209,7 +216,7 @@ TEST(RandomScene, RenderedStripePitchSpansTheRange) {
     }
   }
   ASSERT_LT(small_pitch, 10.0);
-  ASSERT_GT(large_pitch, 48.0);
+  ASSERT_GT(large_pitch, 50.0);
   for (const std::uint32_t seed : {smallest, largest}) {
     RandomScene random = MakeRandomScene(seed, TestData());
     SCOPED_TRACE(random.draw.Describe());
