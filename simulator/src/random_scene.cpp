@@ -39,8 +39,9 @@ constexpr double kMinCameraBlurPx = 0.3;
 // the image width (a share of the width).
 constexpr int kFramingTries = 32;
 constexpr double kLineZeroBand = 0.8;
-// The bundled face's nose tip stands about this share of its height above its back.
-constexpr double kNoseHeightPerFaceHeight = 0.55;
+// The bundled face's nose tip stands this share of its height above its back
+// (0.567), a little more for a face pitched by 10 degrees.
+constexpr double kNoseHeightPerFaceHeight = 0.6;
 // Faces are subdivided this often (898 x 4^2 triangles, as the thesis scenes).
 constexpr int kFaceSubdivision = 2;
 
@@ -275,7 +276,8 @@ std::string RandomSceneDraw::Describe() const {
   out.precision(1);
   out << "seed " << seed << " (" << ToString(set) << ") " << ToString(object) << " "
       << pattern::ToString(side) << " " << width << "x" << height << " pitch " << stripe_pitch_px
-      << " px fill " << subject_fill << (beyond_tolerance ? " beyond" : " within")
+      << " px fill " << subject_fill << (line_zero_framed ? "" : " (line 0 not framed)")
+      << (beyond_tolerance ? " beyond" : " within")
       << ": projector dp " << projector_centre_mm.z() << " f " << projector_focal_d << " d tilt ("
       << projector_tilt_x_deg << ", " << projector_tilt_y_deg << ") roll " << projector_roll_deg
       << "; camera at (" << camera_centre_mm.x() << ", " << camera_centre_mm.y() << ", "
@@ -421,13 +423,16 @@ RandomSceneDraw DrawRandomScene(std::uint32_t seed, const RandomSceneRanges& ran
     // Line 0 on the base plane and at a face's nose height, over the subject's height.
     const geometry::PinholeModel camera = d.Camera();
     bool framed = true;
-    for (const double z : {0.0, kNoseHeightPerFaceHeight * d.subject_height_mm}) {
+    const double nose_mm = kNoseHeightPerFaceHeight * d.subject_height_mm + ranges.face_lift_mm.max;
+    for (const double z : {0.0, nose_mm}) {
       for (const double dy : {-0.3, 0.0, 0.3}) {
         const double y = d.subject_centre_y_mm + dy * d.subject_height_mm;
         const auto image = camera.Project({LineZeroX(projector, y, z), y, z});
         framed = framed && image && std::abs(image->x() / d.width - 0.5) <= kLineZeroBand / 2.0;
       }
     }
+    d.framing_tries = attempt + 1;
+    d.line_zero_framed = framed;
     if (framed) break;
   }
 
@@ -674,6 +679,8 @@ nlohmann::json ToJson(const RandomSceneDraw& d) {
         {"k1", d.camera_k1},
         {"k2", d.camera_k2},
         {"stripe_pitch_px", d.stripe_pitch_px},
+        {"framing_tries", d.framing_tries},
+        {"line_zero_framed", d.line_zero_framed},
         {"subject_fill", d.subject_fill}}},
       {"subject",
        {{"height_mm", d.subject_height_mm},

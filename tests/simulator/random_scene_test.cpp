@@ -78,7 +78,7 @@ TEST(RandomScene, DrawsFallInTheirRanges) {
   const RandomSceneRanges r;
   std::map<RandomObject, int> objects;
   std::set<Side> sides;
-  int beyond = 0;
+  int beyond = 0, framed = 0;
   double min_pitch = 1e9, max_pitch = 0.0, min_size = 1e9, max_size = 0.0;
   for (int i = 0; i < kDrawnScenes; ++i) {
     const std::uint32_t seed = SeedOf(i % 2 ? SeedSet::kTuning : SeedSet::kHeldOut, i);
@@ -87,6 +87,7 @@ TEST(RandomScene, DrawsFallInTheirRanges) {
     ++objects[d.object];
     sides.insert(d.side);
     beyond += d.beyond_tolerance;
+    framed += d.line_zero_framed;
     for (const int size : {d.width, d.height}) {
       EXPECT_TRUE(r.image_size_px.Contains(size));
       min_size = std::min<double>(min_size, size);
@@ -133,6 +134,8 @@ TEST(RandomScene, DrawsFallInTheirRanges) {
   for (const auto& [object, count] : objects) EXPECT_GE(count, 20) << ToString(object);
   EXPECT_GE(objects[RandomObject::kFace], kDrawnScenes / 3);
   EXPECT_EQ(sides.size(), 2u);
+  // Nearly every draw frames line 0 in the central 80 % of the width.
+  EXPECT_GE(framed, kDrawnScenes * 95 / 100);
   EXPECT_GT(beyond, kDrawnScenes / 2);
   EXPECT_LT(beyond, kDrawnScenes * 9 / 10);
   // The set spans the ranges.

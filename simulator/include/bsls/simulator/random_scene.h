@@ -185,6 +185,8 @@ struct RandomSceneDraw {
   double camera_k2 = 0.0;
   double stripe_pitch_px = 16.0;  // target at the aim point, what the focal length was chosen for
   double subject_fill = 0.7;      // subject height / image height that follows
+  int framing_tries = 1;          // aim points drawn until line 0 was framed
+  bool line_zero_framed = true;   // false: no try framed it; the last one is kept
 
   // Subject (the face's size and pose; the objects' region).
   double subject_height_mm = 150.0;
