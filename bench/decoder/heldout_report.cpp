@@ -44,8 +44,8 @@ namespace {
 
 namespace sim = bsls::simulator;
 
-constexpr double kMatchReach = 2.5;   // px, as tests/decoder and the outside corpus
-constexpr int kLineZeroJunctions = 3;  // visible junctions on line 0 that make it visible
+constexpr double kMatchReach = 2.5;     // px, as tests/decoder and the outside corpus
+constexpr int kLineZeroJunctions = 3;   // visible junctions on line 0 that make it visible
 constexpr double kBasePlaneBand = 0.5;  // mm: junctions this close to z = 0 are on the base plane
 
 struct Options {
@@ -66,7 +66,7 @@ struct FrameResult {
   double measured_pitch = 0.0;  // the decoder's, px (0: none)
   sim::LabelScore score;
   sim::LabelScore object, base;  // the truth on the object, on the base plane (unmatched: n/a)
-  int right = 0;  // found with the right label
+  int right = 0;                 // found with the right label
   double render_ms = 0.0, decode_ms = 0.0;
 
   double Recall() const { return score.truth ? static_cast<double>(right) / score.truth : 0.0; }
@@ -104,9 +104,9 @@ struct Totals {
 };
 
 void PrintTotalsHeader() {
-  std::printf("%-16s %6s %7s %8s %8s %7s %8s %8s %7s %9s %8s %9s %9s\n", "group", "frames",
-              "truth", "recall", "mean", "worst", "object", "base", "wrong p", "(frames)",
-              "wrong q", "unmatched", "refused");
+  std::printf("%-16s %6s %7s %8s %8s %7s %8s %8s %7s %9s %8s %9s %9s\n", "group", "frames", "truth",
+              "recall", "mean", "worst", "object", "base", "wrong p", "(frames)", "wrong q",
+              "unmatched", "refused");
 }
 
 void PrintTotals(const std::string& name, const Totals& t) {
@@ -115,8 +115,9 @@ void PrintTotals(const std::string& name, const Totals& t) {
   std::printf("%-16s %6d %7d %7.2f%% %7.2f%% %6.2f%% %7.2f%% %7.2f%% %7d %9d %8d %9d %5d (%d)\n",
               name.c_str(), t.frames, t.truth, percent(t.right, t.truth),
               100.0 * t.sum_recall / t.frames, 100.0 * t.worst_recall,
-              percent(t.object_right, t.object_truth), percent(t.base_right, t.base_truth), t.wrong_p,
-              t.frames_with_wrong_p, t.wrong_q, t.unmatched, t.refused, t.refused_rightly);
+              percent(t.object_right, t.object_truth), percent(t.base_right, t.base_truth),
+              t.wrong_p, t.frames_with_wrong_p, t.wrong_q, t.unmatched, t.refused,
+              t.refused_rightly);
 }
 
 std::string SizeBand(const sim::RandomSceneDraw& d) {
@@ -151,9 +152,8 @@ FrameResult RunFrame(std::uint32_t seed, const Options& o) {
   f.decode_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   f.measured_pitch = r.pitch;
   const std::vector<sim::PointLabel> truth = sim::VisibleJunctions(frame.truth);
-  f.line_zero_visible =
-      std::count_if(truth.begin(), truth.end(), [](const auto& j) { return j.p == 0; }) >=
-      kLineZeroJunctions;
+  f.line_zero_visible = std::count_if(truth.begin(), truth.end(),
+                                      [](const auto& j) { return j.p == 0; }) >= kLineZeroJunctions;
   std::vector<sim::PointLabel> decoded;
   if (r.ok) {
     for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
@@ -166,10 +166,12 @@ FrameResult RunFrame(std::uint32_t seed, const Options& o) {
   std::vector<sim::PointLabel> on_object, on_base;
   for (const sim::TruthJunction& j : frame.truth.junctions) {
     if (!j.visible) continue;
-    const bool base = f.draw.object != sim::RandomObject::kPlane && std::abs(j.world.z()) < kBasePlaneBand;
+    const bool base =
+        f.draw.object != sim::RandomObject::kPlane && std::abs(j.world.z()) < kBasePlaneBand;
     (base ? on_base : on_object).push_back({j.p, j.v, {j.image.x(), j.image.y()}});
   }
-  for (const auto& [part, score] : {std::pair{&on_object, &f.object}, std::pair{&on_base, &f.base}}) {
+  for (const auto& [part, score] :
+       {std::pair{&on_object, &f.object}, std::pair{&on_base, &f.base}}) {
     *score = sim::ScoreLabels(*part, decoded, kMatchReach);
   }
   f.right = f.score.found - f.score.Wrong();
@@ -181,14 +183,14 @@ void PrintFrame(const FrameResult& f) {
   auto percent = [](const sim::LabelScore& s) {
     return s.truth ? 100.0 * FrameResult::Right(s) / s.truth : 0.0;
   };
-  std::printf("%6u %-8s %-5s %4dx%-4d pitch %5.1f/%5.1f  truth %4d recall %6.2f%% (object %6.2f%%"
-              " base %6.2f%%)  wrong p %3d q %3d  unmatched %3d%s%s  %6.0f + %5.0f ms\n",
-              d.seed, std::string(sim::ToString(d.object)).c_str(),
-              std::string(bsls::pattern::ToString(d.side)).c_str(), d.width, d.height,
-              d.stripe_pitch_px, f.measured_pitch, f.score.truth, 100.0 * f.Recall(),
-              percent(f.object), percent(f.base),
-              f.score.wrong_p, f.score.wrong_v, f.score.unmatched, f.refused ? "  REFUSED" : "",
-              f.line_zero_visible ? "" : "  (line 0 hidden)", f.render_ms, f.decode_ms);
+  std::printf(
+      "%6u %-8s %-5s %4dx%-4d pitch %5.1f/%5.1f  truth %4d recall %6.2f%% (object %6.2f%%"
+      " base %6.2f%%)  wrong p %3d q %3d  unmatched %3d%s%s  %6.0f + %5.0f ms\n",
+      d.seed, std::string(sim::ToString(d.object)).c_str(),
+      std::string(bsls::pattern::ToString(d.side)).c_str(), d.width, d.height, d.stripe_pitch_px,
+      f.measured_pitch, f.score.truth, 100.0 * f.Recall(), percent(f.object), percent(f.base),
+      f.score.wrong_p, f.score.wrong_v, f.score.unmatched, f.refused ? "  REFUSED" : "",
+      f.line_zero_visible ? "" : "  (line 0 hidden)", f.render_ms, f.decode_ms);
 }
 
 nlohmann::json FrameJson(const FrameResult& f) {
@@ -285,11 +287,13 @@ int main(int argc, char** argv) {
     render_ms += f.render_ms;
     decode_ms += f.decode_ms;
   }
-  std::printf("\nrecall = right labels / lit and visible junctions (refused frames count 0); "
-              "mean = mean of the frames' recalls;\nobject / base = recall on the object's "
-              "junctions / on the base plane's (|z| < %.1f mm; plane frames: all object);\n"
-              "refused (n) = frames the decoder refused (n of them without a visible line 0, "
-              "rightly)\n", kBasePlaneBand);
+  std::printf(
+      "\nrecall = right labels / lit and visible junctions (refused frames count 0); "
+      "mean = mean of the frames' recalls;\nobject / base = recall on the object's "
+      "junctions / on the base plane's (|z| < %.1f mm; plane frames: all object);\n"
+      "refused (n) = frames the decoder refused (n of them without a visible line 0, "
+      "rightly)\n",
+      kBasePlaneBand);
   PrintTotalsHeader();
   PrintTotals("all", all);
   for (const auto* group : {&by_object, &by_size, &by_pitch, &by_class})
@@ -309,8 +313,8 @@ int main(int argc, char** argv) {
   for (int i = 0; i < o.worst && i < static_cast<int>(order.size()); ++i) {
     const FrameResult& f = *order[i];
     std::printf("  recall %6.2f%% wrong p %d q %d%s%s\n    %s\n", 100.0 * f.Recall(),
-                f.score.wrong_p, f.score.wrong_v, f.refused ? " refused: " : "",
-                f.refusal.c_str(), f.draw.Describe().c_str());
+                f.score.wrong_p, f.score.wrong_v, f.refused ? " refused: " : "", f.refusal.c_str(),
+                f.draw.Describe().c_str());
   }
   if (!o.json.empty()) {
     nlohmann::json out = nlohmann::json::array();

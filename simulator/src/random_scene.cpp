@@ -61,9 +61,7 @@ class Draws {
   double Uniform(double lo, double hi) { return lo + (hi - lo) * Unit(); }
   double Uniform(const Interval& range) { return Uniform(range.min, range.max); }
   double Symmetric(double half) { return Uniform(-half, half); }
-  double LogUniform(double lo, double hi) {
-    return std::exp(Uniform(std::log(lo), std::log(hi)));
-  }
+  double LogUniform(double lo, double hi) { return std::exp(Uniform(std::log(lo), std::log(hi))); }
   bool Chance(double p) { return Unit() < p; }
   // Uniform integer in [lo, hi].
   int Integer(int lo, int hi) {
@@ -141,16 +139,16 @@ std::optional<Eigen::Vector3d> OnHorizontalPlane(const geometry::Ray& ray, doubl
   return ray.At(t);
 }
 
-bool Ordered(const Interval& r) { return std::isfinite(r.min) && std::isfinite(r.max) && r.min <= r.max; }
+bool Ordered(const Interval& r) {
+  return std::isfinite(r.min) && std::isfinite(r.max) && r.min <= r.max;
+}
 
 nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 nlohmann::json Vec(const Eigen::Vector2d& v) { return {v.x(), v.y()}; }
 
 }  // namespace
 
-std::string_view ToString(SeedSet set) {
-  return set == SeedSet::kTuning ? "tuning" : "heldout";
-}
+std::string_view ToString(SeedSet set) { return set == SeedSet::kTuning ? "tuning" : "heldout"; }
 
 SeedSet SetOfSeed(std::uint32_t seed) {
   if (seed == 0) throw std::invalid_argument("SetOfSeed: seed 0 belongs to no set");
@@ -165,7 +163,8 @@ std::uint32_t SeedOf(SeedSet set, int index) {
                                   std::to_string(kTuningLastSeed) + " seeds");
     return kTuningFirstSeed + static_cast<std::uint32_t>(index);
   }
-  if (static_cast<std::uint64_t>(index) + kHeldOutFirstSeed > std::numeric_limits<std::uint32_t>::max())
+  if (static_cast<std::uint64_t>(index) + kHeldOutFirstSeed >
+      std::numeric_limits<std::uint32_t>::max())
     throw std::invalid_argument("SeedOf: held-out index " + std::to_string(index) + " too large");
   return kHeldOutFirstSeed + static_cast<std::uint32_t>(index);
 }
@@ -192,42 +191,64 @@ bool RandomSceneRanges::IsValid(std::string* error) const {
   if (!(beyond_share >= 0.0 && beyond_share <= 1.0))
     return Fail(error, "random scene beyond_share must lie in [0, 1]");
   const std::pair<const char*, double> halves[] = {
-      {"within_position_mm", within_position_mm}, {"within_angle_deg", within_angle_deg},
-      {"within_focal_d", within_focal_d},         {"projector_offset_mm", projector_offset_mm},
-      {"projector_tilt_deg", projector_tilt_deg}, {"projector_roll_deg", projector_roll_deg},
-      {"projector_k1", projector_k1},             {"camera_offset_y_mm", camera_offset_y_mm},
-      {"camera_aim_deg", camera_aim_deg},         {"camera_roll_deg", camera_roll_deg},
+      {"within_position_mm", within_position_mm},
+      {"within_angle_deg", within_angle_deg},
+      {"within_focal_d", within_focal_d},
+      {"projector_offset_mm", projector_offset_mm},
+      {"projector_tilt_deg", projector_tilt_deg},
+      {"projector_roll_deg", projector_roll_deg},
+      {"projector_k1", projector_k1},
+      {"camera_offset_y_mm", camera_offset_y_mm},
+      {"camera_aim_deg", camera_aim_deg},
+      {"camera_roll_deg", camera_roll_deg},
       {"principal_point_fraction", principal_point_fraction},
-      {"aspect_error", aspect_error},             {"face_yaw_deg", face_yaw_deg},
-      {"face_pitch_deg", face_pitch_deg},         {"subject_offset_y_mm", subject_offset_y_mm},
+      {"aspect_error", aspect_error},
+      {"face_yaw_deg", face_yaw_deg},
+      {"face_pitch_deg", face_pitch_deg},
+      {"subject_offset_y_mm", subject_offset_y_mm},
       {"projector_focus_error_mm", projector_focus_error_mm}};
   for (const auto& [name, value] : halves)
     if (!(value >= 0.0 && std::isfinite(value)))
       return Fail(error, std::string("random scene ") + name + " must be non-negative and finite");
   const std::pair<const char*, Interval> ranges[] = {
-      {"projector_height_mm", projector_height_mm}, {"projector_focal_d", projector_focal_d},
-      {"camera_baseline_mm", camera_baseline_mm},   {"camera_height_mm", camera_height_mm},
-      {"camera_k1", camera_k1},                     {"camera_k2", camera_k2},
-      {"image_size_px", image_size_px},             {"stripe_pitch_px", stripe_pitch_px},
-      {"subject_fill", subject_fill},               {"face_height_mm", face_height_mm},
-      {"face_lift_mm", face_lift_mm},               {"aim_offset_mm", aim_offset_mm},
-      {"aim_height_mm", aim_height_mm},             {"albedo_base", albedo_base},
-      {"albedo_variation", albedo_variation},       {"albedo_wavelength_mm", albedo_wavelength_mm},
-      {"patch_albedo", patch_albedo},               {"projector_blur_d", projector_blur_d},
+      {"projector_height_mm", projector_height_mm},
+      {"projector_focal_d", projector_focal_d},
+      {"camera_baseline_mm", camera_baseline_mm},
+      {"camera_height_mm", camera_height_mm},
+      {"camera_k1", camera_k1},
+      {"camera_k2", camera_k2},
+      {"image_size_px", image_size_px},
+      {"stripe_pitch_px", stripe_pitch_px},
+      {"subject_fill", subject_fill},
+      {"face_height_mm", face_height_mm},
+      {"face_lift_mm", face_lift_mm},
+      {"aim_offset_mm", aim_offset_mm},
+      {"aim_height_mm", aim_height_mm},
+      {"albedo_base", albedo_base},
+      {"albedo_variation", albedo_variation},
+      {"albedo_wavelength_mm", albedo_wavelength_mm},
+      {"patch_albedo", patch_albedo},
+      {"projector_blur_d", projector_blur_d},
       {"projector_aperture_mm", projector_aperture_mm},
-      {"camera_blur_pitch", camera_blur_pitch},     {"read_noise", read_noise},
-      {"shot_noise", shot_noise},                   {"ambient", ambient},
-      {"black_level", black_level},                 {"peak_grey", peak_grey}};
+      {"camera_blur_pitch", camera_blur_pitch},
+      {"read_noise", read_noise},
+      {"shot_noise", shot_noise},
+      {"ambient", ambient},
+      {"black_level", black_level},
+      {"peak_grey", peak_grey}};
   for (const auto& [name, range] : ranges)
     if (!Ordered(range))
       return Fail(error, std::string("random scene ") + name + " must be finite with min <= max");
   if (projector_height_mm.min <= camera_height_mm.max)
     return Fail(error, "random scene projector_height_mm must lie above camera_height_mm");
-  if (!(projector_focal_d.min > 0.0)) return Fail(error, "random scene projector_focal_d must be > 0");
-  if (!(camera_baseline_mm.min > 0.0)) return Fail(error, "random scene camera_baseline_mm must be > 0");
+  if (!(projector_focal_d.min > 0.0))
+    return Fail(error, "random scene projector_focal_d must be > 0");
+  if (!(camera_baseline_mm.min > 0.0))
+    return Fail(error, "random scene camera_baseline_mm must be > 0");
   if (!(image_size_px.min >= 64.0 && image_size_px.max <= 8192.0))
     return Fail(error, "random scene image_size_px must lie within [64, 8192]");
-  if (!(stripe_pitch_px.min >= 2.0)) return Fail(error, "random scene stripe_pitch_px must be >= 2");
+  if (!(stripe_pitch_px.min >= 2.0))
+    return Fail(error, "random scene stripe_pitch_px must be >= 2");
   if (!(subject_fill.min > 0.0 && subject_fill.max <= 2.0))
     return Fail(error, "random scene subject_fill must lie within (0, 2]");
   if (!(face_height_mm.min > 0.0)) return Fail(error, "random scene face_height_mm must be > 0");
@@ -245,7 +266,8 @@ bool RandomSceneRanges::IsValid(std::string* error) const {
     return Fail(error, "random scene projector_blur_d must lie within [0, 0.6] d");
   if (!(projector_aperture_mm.min >= 0.0))
     return Fail(error, "random scene projector_aperture_mm must be >= 0");
-  if (!(camera_blur_pitch.min >= 0.0)) return Fail(error, "random scene camera_blur_pitch must be >= 0");
+  if (!(camera_blur_pitch.min >= 0.0))
+    return Fail(error, "random scene camera_blur_pitch must be >= 0");
   if (!(read_noise.min >= 0.0 && shot_noise.min >= 0.0 && ambient.min >= 0.0))
     return Fail(error, "random scene read_noise, shot_noise and ambient must be >= 0");
   if (!(black_level.min >= 0.0 && peak_grey.max <= 255.0 && peak_grey.min > black_level.max))
@@ -277,12 +299,12 @@ std::string RandomSceneDraw::Describe() const {
   out << "seed " << seed << " (" << ToString(set) << ") " << ToString(object) << " "
       << pattern::ToString(side) << " " << width << "x" << height << " pitch " << stripe_pitch_px
       << " px fill " << subject_fill << (line_zero_framed ? "" : " (line 0 not framed)")
-      << (beyond_tolerance ? " beyond" : " within")
-      << ": projector dp " << projector_centre_mm.z() << " f " << projector_focal_d << " d tilt ("
-      << projector_tilt_x_deg << ", " << projector_tilt_y_deg << ") roll " << projector_roll_deg
-      << "; camera at (" << camera_centre_mm.x() << ", " << camera_centre_mm.y() << ", "
-      << camera_centre_mm.z() << ") aim (" << camera_aim_x_deg << ", " << camera_aim_y_deg
-      << ") roll " << camera_roll_deg << " f " << camera_fx;
+      << (beyond_tolerance ? " beyond" : " within") << ": projector dp " << projector_centre_mm.z()
+      << " f " << projector_focal_d << " d tilt (" << projector_tilt_x_deg << ", "
+      << projector_tilt_y_deg << ") roll " << projector_roll_deg << "; camera at ("
+      << camera_centre_mm.x() << ", " << camera_centre_mm.y() << ", " << camera_centre_mm.z()
+      << ") aim (" << camera_aim_x_deg << ", " << camera_aim_y_deg << ") roll " << camera_roll_deg
+      << " f " << camera_fx;
   out.precision(3);
   out << " k1 " << camera_k1 << " k2 " << camera_k2;
   out.precision(1);
@@ -292,9 +314,8 @@ std::string RandomSceneDraw::Describe() const {
   out.precision(2);
   out << "; albedo " << albedo.base << " +-" << albedo.variation << ", " << albedo.patches.size()
       << " patches; blur proj " << render.projector_blur_sigma_d << " d aperture "
-      << render.projector_aperture_mm << " mm cam " << render.camera_blur_sigma_px
-      << " px; noise " << render.noise_sigma << " shot " << render.shot_noise << "; ss "
-      << render.supersampling;
+      << render.projector_aperture_mm << " mm cam " << render.camera_blur_sigma_px << " px; noise "
+      << render.noise_sigma << " shot " << render.shot_noise << "; ss " << render.supersampling;
   return out.str();
 }
 
@@ -379,8 +400,8 @@ RandomSceneDraw DrawRandomScene(std::uint32_t seed, const RandomSceneRanges& ran
   const double aspect = aspect_draw < kLandscapeChance                     ? 4.0 / 3.0
                         : aspect_draw < kLandscapeChance + kPortraitChance ? 3.0 / 4.0
                                                                            : 1.0;
-  d.width = static_cast<int>(std::clamp<double>(std::lround(d.height * aspect),
-                                                ranges.image_size_px.min, ranges.image_size_px.max));
+  d.width = static_cast<int>(std::clamp<double>(
+      std::lround(d.height * aspect), ranges.image_size_px.min, ranges.image_size_px.max));
   d.camera_k1 = rng.Uniform(ranges.camera_k1);
   d.camera_k2 = rng.Uniform(ranges.camera_k2);
   d.camera_cx = (d.width - 1) / 2.0 + rng.Symmetric(ranges.principal_point_fraction) * d.width;
@@ -652,81 +673,80 @@ nlohmann::json ToJson(const RandomSceneDraw& d) {
                        {"rotation_deg", p.rotation_deg},
                        {"albedo", p.albedo},
                        {"edge_mm", p.edge_mm}});
-  return {
-      {"seed", d.seed},
-      {"set", std::string(ToString(d.set))},
-      {"side", std::string(pattern::ToString(d.side))},
-      {"object", std::string(ToString(d.object))},
-      {"beyond_tolerance", d.beyond_tolerance},
-      {"projector",
-       {{"centre_mm", Vec(d.projector_centre_mm)},
-        {"tilt_deg", {d.projector_tilt_x_deg, d.projector_tilt_y_deg}},
-        {"roll_deg", d.projector_roll_deg},
-        {"focal_d", d.projector_focal_d},
-        {"k1", d.projector_k1},
-        {"world_shift_x_mm", d.world_shift_x_mm}}},
-      {"camera",
-       {{"centre_mm", Vec(d.camera_centre_mm)},
-        {"aim_point_mm", Vec(d.aim_point_mm)},
-        {"aim_error_deg", {d.camera_aim_x_deg, d.camera_aim_y_deg}},
-        {"roll_deg", d.camera_roll_deg},
-        {"width", d.width},
-        {"height", d.height},
-        {"fx", d.camera_fx},
-        {"fy", d.camera_fy},
-        {"cx", d.camera_cx},
-        {"cy", d.camera_cy},
-        {"k1", d.camera_k1},
-        {"k2", d.camera_k2},
-        {"stripe_pitch_px", d.stripe_pitch_px},
-        {"framing_tries", d.framing_tries},
-        {"line_zero_framed", d.line_zero_framed},
-        {"subject_fill", d.subject_fill}}},
-      {"subject",
-       {{"height_mm", d.subject_height_mm},
-        {"centre_y_mm", d.subject_centre_y_mm},
-        {"face_yaw_deg", d.face_yaw_deg},
-        {"face_pitch_deg", d.face_pitch_deg},
-        {"face_lift_mm", d.face_lift_mm}}},
-      {"plane",
-       {{"height_mm", d.plane_height_mm},
-        {"tilt_deg", d.plane_tilt_deg},
-        {"tilt_azimuth_deg", d.plane_tilt_azimuth_deg}}},
-      {"ramp",
-       {{"foot_xy_mm", Vec(d.ramp.foot_xy_mm)},
-        {"rise_azimuth_deg", d.ramp.rise_azimuth_deg},
-        {"slope_deg", d.ramp.slope_deg},
-        {"run_mm", d.ramp.run_mm},
-        {"width_mm", d.ramp.width_mm}}},
-      {"ball", {{"centre_mm", Vec(d.ball.centre_mm)}, {"radius_mm", d.ball.radius_mm}}},
-      {"bunny",
-       {{"mm_per_unit", d.bunny.mm_per_unit},
-        {"centre_xy_mm", Vec(d.bunny.centre_xy_mm)},
-        {"yaw_deg", d.bunny_yaw_deg}}},
-      {"cylinder",
-       {{"centre_mm", Vec(d.cylinder.centre_mm)},
-        {"axis", Vec(d.cylinder.axis)},
-        {"radius_mm", d.cylinder.radius_mm},
-        {"length_mm", d.cylinder.length_mm}}},
-      {"albedo",
-       {{"base", d.albedo.base},
-        {"variation", d.albedo.variation},
-        {"wavelength_mm", d.albedo.wavelength_mm},
-        {"seed", d.albedo.seed},
-        {"patches", patches},
-        {"eyebrow_albedo", d.eyebrow_albedo}}},
-      {"render",
-       {{"supersampling", r.supersampling},
-        {"projector_blur_sigma_d", r.projector_blur_sigma_d},
-        {"projector_aperture_mm", r.projector_aperture_mm},
-        {"projector_focus_distance_mm", r.projector_focus_distance_mm},
-        {"camera_blur_sigma_px", r.camera_blur_sigma_px},
-        {"noise_sigma", r.noise_sigma},
-        {"shot_noise", r.shot_noise},
-        {"ambient", r.ambient},
-        {"black_level", r.black_level},
-        {"gain", r.gain},
-        {"seed", r.seed}}}};
+  return {{"seed", d.seed},
+          {"set", std::string(ToString(d.set))},
+          {"side", std::string(pattern::ToString(d.side))},
+          {"object", std::string(ToString(d.object))},
+          {"beyond_tolerance", d.beyond_tolerance},
+          {"projector",
+           {{"centre_mm", Vec(d.projector_centre_mm)},
+            {"tilt_deg", {d.projector_tilt_x_deg, d.projector_tilt_y_deg}},
+            {"roll_deg", d.projector_roll_deg},
+            {"focal_d", d.projector_focal_d},
+            {"k1", d.projector_k1},
+            {"world_shift_x_mm", d.world_shift_x_mm}}},
+          {"camera",
+           {{"centre_mm", Vec(d.camera_centre_mm)},
+            {"aim_point_mm", Vec(d.aim_point_mm)},
+            {"aim_error_deg", {d.camera_aim_x_deg, d.camera_aim_y_deg}},
+            {"roll_deg", d.camera_roll_deg},
+            {"width", d.width},
+            {"height", d.height},
+            {"fx", d.camera_fx},
+            {"fy", d.camera_fy},
+            {"cx", d.camera_cx},
+            {"cy", d.camera_cy},
+            {"k1", d.camera_k1},
+            {"k2", d.camera_k2},
+            {"stripe_pitch_px", d.stripe_pitch_px},
+            {"framing_tries", d.framing_tries},
+            {"line_zero_framed", d.line_zero_framed},
+            {"subject_fill", d.subject_fill}}},
+          {"subject",
+           {{"height_mm", d.subject_height_mm},
+            {"centre_y_mm", d.subject_centre_y_mm},
+            {"face_yaw_deg", d.face_yaw_deg},
+            {"face_pitch_deg", d.face_pitch_deg},
+            {"face_lift_mm", d.face_lift_mm}}},
+          {"plane",
+           {{"height_mm", d.plane_height_mm},
+            {"tilt_deg", d.plane_tilt_deg},
+            {"tilt_azimuth_deg", d.plane_tilt_azimuth_deg}}},
+          {"ramp",
+           {{"foot_xy_mm", Vec(d.ramp.foot_xy_mm)},
+            {"rise_azimuth_deg", d.ramp.rise_azimuth_deg},
+            {"slope_deg", d.ramp.slope_deg},
+            {"run_mm", d.ramp.run_mm},
+            {"width_mm", d.ramp.width_mm}}},
+          {"ball", {{"centre_mm", Vec(d.ball.centre_mm)}, {"radius_mm", d.ball.radius_mm}}},
+          {"bunny",
+           {{"mm_per_unit", d.bunny.mm_per_unit},
+            {"centre_xy_mm", Vec(d.bunny.centre_xy_mm)},
+            {"yaw_deg", d.bunny_yaw_deg}}},
+          {"cylinder",
+           {{"centre_mm", Vec(d.cylinder.centre_mm)},
+            {"axis", Vec(d.cylinder.axis)},
+            {"radius_mm", d.cylinder.radius_mm},
+            {"length_mm", d.cylinder.length_mm}}},
+          {"albedo",
+           {{"base", d.albedo.base},
+            {"variation", d.albedo.variation},
+            {"wavelength_mm", d.albedo.wavelength_mm},
+            {"seed", d.albedo.seed},
+            {"patches", patches},
+            {"eyebrow_albedo", d.eyebrow_albedo}}},
+          {"render",
+           {{"supersampling", r.supersampling},
+            {"projector_blur_sigma_d", r.projector_blur_sigma_d},
+            {"projector_aperture_mm", r.projector_aperture_mm},
+            {"projector_focus_distance_mm", r.projector_focus_distance_mm},
+            {"camera_blur_sigma_px", r.camera_blur_sigma_px},
+            {"noise_sigma", r.noise_sigma},
+            {"shot_noise", r.shot_noise},
+            {"ambient", r.ambient},
+            {"black_level", r.black_level},
+            {"gain", r.gain},
+            {"seed", r.seed}}}};
 }
 
 }  // namespace bsls::simulator

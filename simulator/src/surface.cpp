@@ -175,8 +175,7 @@ CylinderSurface::CylinderSurface(const CylinderParams& params) : params_(params)
   axis_ = params_.axis.normalized();
 }
 
-std::optional<Hit> CylinderSurface::Intersect(const geometry::Ray& ray,
-                                              double max_distance) const {
+std::optional<Hit> CylinderSurface::Intersect(const geometry::Ray& ray, double max_distance) const {
   const Eigen::Vector3d w = ray.origin - params_.centre_mm;
   const double w_axial = w.dot(axis_);
   const double d_axial = ray.direction.dot(axis_);

@@ -74,8 +74,8 @@ TEST(HeldOutSample, DecoderNeverMislabelsALineAndMeetsTodaysFigures) {
     for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
     std::vector<PointLabel> on_object;
     for (const TruthJunction& j : frame.truth.junctions)
-      if (j.visible && (random.draw.object == RandomObject::kPlane ||
-                        std::abs(j.world.z()) >= kBasePlaneBand))
+      if (j.visible &&
+          (random.draw.object == RandomObject::kPlane || std::abs(j.world.z()) >= kBasePlaneBand))
         on_object.push_back({j.p, j.v, {j.image.x(), j.image.y()}});
     const LabelScore all = ScoreLabels(visible, decoded, kMatchReach);
     const LabelScore object = ScoreLabels(on_object, decoded, kMatchReach);

@@ -107,9 +107,8 @@ TEST(RandomScene, DrawsFallInTheirRanges) {
     EXPECT_LT(d.subject_fill, 1.0);
     // Set-up errors: the class decides their size.
     const double lateral = std::abs(d.camera_centre_mm.x() - d.projector_centre_mm.x());
-    const double angles[] = {d.projector_tilt_x_deg, d.projector_tilt_y_deg,
-                             d.projector_roll_deg,   d.camera_aim_x_deg,
-                             d.camera_aim_y_deg,     d.camera_roll_deg};
+    const double angles[] = {d.projector_tilt_x_deg, d.projector_tilt_y_deg, d.projector_roll_deg,
+                             d.camera_aim_x_deg,     d.camera_aim_y_deg,     d.camera_roll_deg};
     if (d.beyond_tolerance) {
       EXPECT_TRUE(r.projector_height_mm.Contains(d.projector_centre_mm.z()));
       EXPECT_TRUE(r.projector_focal_d.Contains(d.projector_focal_d));
@@ -196,7 +195,8 @@ TEST(RandomScene, LineZeroIsVisibleAndTheSidesFollowTheContracts) {
       if (next == visible.end()) continue;
       if ((next->second->world - j->world).norm() > kSameSurfaceMm) continue;
       ++pairs;
-      EXPECT_EQ(next->second->image.x() < j->image.x(), left) << "p " << pv.first << " v " << pv.second;
+      EXPECT_EQ(next->second->image.x() < j->image.x(), left)
+          << "p " << pv.first << " v " << pv.second;
     }
     EXPECT_GT(pairs, 20);
   }

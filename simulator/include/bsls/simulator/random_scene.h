@@ -172,8 +172,8 @@ struct RandomSceneDraw {
   double world_shift_x_mm = 0.0;  // added to every device x so line 0 meets x = 0
   Eigen::Vector3d camera_centre_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d aim_point_mm = Eigen::Vector3d::Zero();  // before the aim error
-  double camera_aim_x_deg = 0.0;  // aim error about the device x axis
-  double camera_aim_y_deg = 0.0;  // ... about the device y axis
+  double camera_aim_x_deg = 0.0;                           // aim error about the device x axis
+  double camera_aim_y_deg = 0.0;                           // ... about the device y axis
   double camera_roll_deg = 0.0;
   int width = 512;
   int height = 512;
@@ -205,7 +205,7 @@ struct RandomSceneDraw {
   CylinderParams cylinder;
 
   // Albedo, light, defocus, noise.
-  AlbedoParams albedo;         // dark patches included
+  AlbedoParams albedo;          // dark patches included
   double eyebrow_albedo = 0.3;  // faces
   RenderParams render;
 
