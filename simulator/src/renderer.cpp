@@ -53,6 +53,8 @@ bool RenderParams::IsValid(std::string* error) const {
     return Fail(error, "render camera_blur_sigma_px must be non-negative and finite");
   if (!NonNegativeFinite(noise_sigma))
     return Fail(error, "render noise_sigma must be non-negative and finite");
+  if (!NonNegativeFinite(shot_noise))
+    return Fail(error, "render shot_noise must be non-negative and finite");
   std::string why;
   if (!truth.IsValid(&why)) return Fail(error, "render " + why);
   return true;
@@ -132,7 +134,19 @@ cv::Mat Renderer::RenderNoiseless() const {
 
 cv::Mat Renderer::RenderImage(std::uint32_t seed) const {
   cv::Mat grey = RenderNoiseless();
-  if (params_.noise_sigma > 0.0) {
+  if (params_.shot_noise > 0.0) {
+    // Per-pixel sigma; the read-noise-only branch below keeps its exact draws.
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> unit(0.0f, 1.0f);
+    const double read_var = params_.noise_sigma * params_.noise_sigma;
+    for (int y = 0; y < grey.rows; ++y) {
+      float* row = grey.ptr<float>(y);
+      for (int x = 0; x < grey.cols; ++x) {
+        const double signal = std::max(0.0, row[x] - params_.black_level);
+        row[x] += static_cast<float>(std::sqrt(read_var + params_.shot_noise * signal)) * unit(rng);
+      }
+    }
+  } else if (params_.noise_sigma > 0.0) {
     std::mt19937 rng(seed);
     std::normal_distribution<float> noise(0.0f, static_cast<float>(params_.noise_sigma));
     for (int y = 0; y < grey.rows; ++y) {

@@ -157,4 +157,78 @@ std::string BallSurface::Name() const {
   return out.str();
 }
 
+bool CylinderParams::IsValid(std::string* error) const {
+  if (!centre_mm.allFinite()) return Fail(error, "cylinder centre_mm must be finite");
+  if (!axis.allFinite() || !(axis.norm() > 0.0))
+    return Fail(error, "cylinder axis must be finite and non-zero");
+  if (!(radius_mm > 0.0 && std::isfinite(radius_mm)))
+    return Fail(error, "cylinder radius_mm must be positive and finite");
+  if (!(length_mm > 0.0 && std::isfinite(length_mm)))
+    return Fail(error, "cylinder length_mm must be positive and finite");
+  if (std::isnan(cut_below_z_mm)) return Fail(error, "cylinder cut_below_z_mm must not be NaN");
+  return true;
+}
+
+CylinderSurface::CylinderSurface(const CylinderParams& params) : params_(params) {
+  std::string error;
+  if (!params.IsValid(&error)) throw std::invalid_argument("CylinderSurface: " + error);
+  axis_ = params_.axis.normalized();
+}
+
+std::optional<Hit> CylinderSurface::Intersect(const geometry::Ray& ray, double max_distance) const {
+  const Eigen::Vector3d w = ray.origin - params_.centre_mm;
+  const double w_axial = w.dot(axis_);
+  const double d_axial = ray.direction.dot(axis_);
+  const Eigen::Vector3d w_perp = w - w_axial * axis_;
+  const Eigen::Vector3d d_perp = ray.direction - d_axial * axis_;
+  const double half = params_.length_mm / 2.0;
+  const double r2 = params_.radius_mm * params_.radius_mm;
+  std::optional<Hit> best;
+  auto consider = [&](double t, const Eigen::Vector3d& normal) {
+    if (!(t > kMinHitDistanceMm && t < max_distance)) return;
+    const Eigen::Vector3d point = ray.At(t);
+    if (point.z() < params_.cut_below_z_mm) return;
+    Hit hit;
+    hit.distance = t;
+    hit.point = point;
+    hit.normal = normal;
+    hit.geometric_normal = normal;
+    best = hit;
+    max_distance = t;
+  };
+  // Mantle: |w_perp + t d_perp| = r with the axial coordinate within the caps.
+  const double a = d_perp.squaredNorm();
+  if (a > kParallelCos) {
+    const double b = w_perp.dot(d_perp);
+    const double c = w_perp.squaredNorm() - r2;
+    const double disc = b * b - a * c;
+    if (disc >= 0.0) {
+      const double root = std::sqrt(disc);
+      for (const double t : {(-b - root) / a, (-b + root) / a}) {
+        if (std::abs(w_axial + t * d_axial) > half) continue;
+        const Eigen::Vector3d radial = w_perp + t * d_perp;
+        consider(t, radial / params_.radius_mm);
+      }
+    }
+  }
+  // Caps: the discs at axial coordinates -+half.
+  if (params_.caps && std::abs(d_axial) > kParallelCos) {
+    for (const double end : {-half, half}) {
+      const double t = (end - w_axial) / d_axial;
+      if ((w_perp + t * d_perp).squaredNorm() > r2) continue;
+      consider(t, end > 0.0 ? axis_ : Eigen::Vector3d(-axis_));
+    }
+  }
+  return best;
+}
+
+std::string CylinderSurface::Name() const {
+  std::ostringstream out;
+  out << "cylinder radius " << params_.radius_mm << " mm, length " << params_.length_mm
+      << " mm at (" << params_.centre_mm.x() << ", " << params_.centre_mm.y() << ", "
+      << params_.centre_mm.z() << ") mm along (" << axis_.x() << ", " << axis_.y() << ", "
+      << axis_.z() << "), cut below z = " << params_.cut_below_z_mm << " mm";
+  return out.str();
+}
+
 }  // namespace bsls::simulator

@@ -269,6 +269,37 @@ TEST(Renderer, FaceLinePointsMostlyLieOnIntensityMaxima) {
   EXPECT_LT(errors[errors.size() * 9 / 10], kLineMaximumTolerancePx);
 }
 
+// Shot noise: variance noise_sigma^2 + shot_noise * (grey - black_level),
+// checked on dark (ground) and bright (stripe) pixels apart.
+TEST(Renderer, ShotNoiseGrowsWithTheSignal) {
+  const Scene scene = ThesisScene(Side::kLeft, SurfaceKind::kPlane, TestOptions());
+  RenderParams params;
+  params.supersampling = 1;
+  params.noise_sigma = 1.0;
+  params.shot_noise = 0.5;
+  const Renderer renderer(scene, params);
+  const cv::Mat clean = renderer.RenderNoiseless();
+  const cv::Mat noisy = renderer.RenderImage(23);
+  // Variance over pixels whose clean grey lies in [lo, hi), against the model's.
+  auto measured_over_model = [&](float lo, float hi) {
+    double sum2 = 0.0, model = 0.0;
+    int count = 0;
+    for (int y = 0; y < clean.rows; ++y)
+      for (int x = 0; x < clean.cols; ++x) {
+        const float c = clean.at<float>(y, x);
+        if (c < lo || c >= hi) continue;
+        const double d = noisy.at<uchar>(y, x) - c;
+        sum2 += d * d;
+        model += 1.0 + 0.5 * std::max(0.0, c - params.black_level) + 1.0 / 12.0;
+        ++count;
+      }
+    EXPECT_GT(count, 1000) << lo << ".." << hi;
+    return count ? sum2 / model : 0.0;
+  };
+  EXPECT_NEAR(measured_over_model(6.0f, 40.0f), 1.0, 0.08);
+  EXPECT_NEAR(measured_over_model(120.0f, 200.0f), 1.0, 0.08);
+}
+
 TEST(Renderer, NoiseHasTheRequestedStandardDeviation) {
   ThesisSceneOptions options = TestOptions();
   const Scene scene = ThesisScene(Side::kLeft, SurfaceKind::kPlane, options);

@@ -104,5 +104,76 @@ TEST(BallSurface, CutRemovesThePartBelowThePlane) {
   EXPECT_FALSE(ball.Intersect(RayFromTo({-100, 0, -5}, {100, 0, -5}), kInfinity).has_value());
 }
 
+TEST(CylinderSurface, HitsLieOnTheMantleOrACapAndFaceTheRay) {
+  CylinderParams params;
+  params.centre_mm = {-50.0, 10.0, 30.0};
+  params.axis = {1.0, 1.0, 0.0};
+  params.radius_mm = 40.0;
+  params.length_mm = 160.0;
+  params.cut_below_z_mm = -kInfinity;
+  const CylinderSurface cylinder(params);
+  const Eigen::Vector3d axis = params.axis.normalized();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> offset(-120.0, 120.0);
+  int mantle = 0, caps = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d origin(offset(rng) * 3.0, offset(rng) * 3.0, 400.0 + offset(rng));
+    const Eigen::Vector3d target = params.centre_mm + Eigen::Vector3d(offset(rng), offset(rng), 0);
+    const auto hit = cylinder.Intersect(RayFromTo(origin, target), kInfinity);
+    if (!hit) continue;
+    const Eigen::Vector3d rel = hit->point - params.centre_mm;
+    const double axial = rel.dot(axis);
+    const double radial = (rel - axial * axis).norm();
+    EXPECT_LE(std::abs(axial), params.length_mm / 2.0 + kDistanceTolerance);
+    EXPECT_LE(radial, params.radius_mm + kDistanceTolerance);
+    if (std::abs(radial - params.radius_mm) < 1e-6) {
+      ++mantle;
+    } else {
+      EXPECT_NEAR(std::abs(axial), params.length_mm / 2.0, 1e-6);
+      ++caps;
+    }
+    // The first hit from outside faces the ray's origin.
+    EXPECT_GT(hit->normal.dot(origin - hit->point), 0.0);
+  }
+  EXPECT_GT(mantle, 300);
+  EXPECT_GT(caps, 20);
+}
+
+TEST(CylinderSurface, CutAndOpenEndsLetRaysThrough) {
+  CylinderParams params;
+  params.centre_mm = {0.0, 0.0, 0.0};
+  params.axis = {0.0, 1.0, 0.0};
+  params.radius_mm = 10.0;
+  params.length_mm = 50.0;
+  params.cut_below_z_mm = 0.0;
+  // From straight above: the top of the mantle.
+  const CylinderSurface cut(params);
+  const auto top = cut.Intersect(RayFromTo({0, 0, 100}, {0, 0, 0}), kInfinity);
+  ASSERT_TRUE(top.has_value());
+  EXPECT_NEAR(top->point.z(), 10.0, kDistanceTolerance);
+  // Below the cut nothing is hit.
+  EXPECT_FALSE(cut.Intersect(RayFromTo({-100, 0, -5}, {100, 0, -5}), kInfinity).has_value());
+  // Along the axis: the cap closes it; without caps the ray passes through.
+  const geometry::Ray along = RayFromTo({0, -100, 5}, {0, 0, 5});
+  const auto cap = cut.Intersect(along, kInfinity);
+  ASSERT_TRUE(cap.has_value());
+  EXPECT_NEAR(cap->point.y(), -25.0, kDistanceTolerance);
+  params.caps = false;
+  EXPECT_FALSE(CylinderSurface(params).Intersect(along, kInfinity).has_value());
+}
+
+TEST(CylinderSurface, RejectsInvalidParams) {
+  CylinderParams params;
+  params.axis = Eigen::Vector3d::Zero();
+  std::string error;
+  EXPECT_FALSE(params.IsValid(&error));
+  EXPECT_NE(error.find("axis"), std::string::npos);
+  params = CylinderParams{};
+  params.radius_mm = -1.0;
+  EXPECT_FALSE(params.IsValid(&error));
+  EXPECT_NE(error.find("radius_mm"), std::string::npos);
+  EXPECT_THROW(CylinderSurface{params}, std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace bsls::simulator

@@ -11,7 +11,9 @@
 // lights X (dark_transmission on opaque parts), n the shading normal, l the
 // direction to the projector and falloff = (focus_distance / |X - P|)^2 when
 // enabled. Rays that hit nothing give black_level. The mean over the n x n
-// rays is blurred (camera), noised, clamped to [0, 255] and rounded.
+// rays is blurred (camera), noised, clamped to [0, 255] and rounded. Noise:
+// Gaussian with variance noise_sigma^2 + shot_noise * max(0, grey - black_level)
+// (read noise plus photon shot noise in its Gaussian approximation).
 //
 // Errors: the Renderer constructor (and so Render(scene, params)) throws
 // std::invalid_argument naming the field when the scene or params are invalid.
@@ -59,6 +61,9 @@ struct RenderParams {
   double black_level = 6.0;           // grey level of no light, [0, 255]
   double camera_blur_sigma_px = 0.5;  // Gaussian, pixels; 0 = none
   double noise_sigma = 3.0;           // additive Gaussian sensor noise, grey levels; 0 = none
+  // Shot noise: variance in grey levels^2 per grey level above black_level
+  // (the gain in grey levels per photo-electron), >= 0; 0 = none.
+  double shot_noise = 0.0;
   std::uint32_t seed = 1;             // seeds the noise (std::mt19937)
 
   TruthParams truth;  // thresholds of the ground truth

@@ -1,6 +1,7 @@
 // Surfaces the simulator renders: one small ray-intersection interface and the
 // analytic shapes of the thesis test objects (thesis 7.1, Figure 7.2: base
-// plane, 45-degree ramp, ball). Triangle meshes live in mesh.h.
+// plane, 45-degree ramp, ball) and a cylinder (randomised scenes,
+// random_scene.h). Triangle meshes live in mesh.h.
 //
 // Frame and units: world frame of contracts section 3, millimetres (x right,
 // y up, z towards the cameras and projector, base plane z = 0).
@@ -126,6 +127,38 @@ class BallSurface final : public Surface {
 
  private:
   BallParams params_;
+};
+
+// A finite circular cylinder with flat end caps, optionally cut by a
+// horizontal plane: a log or a can lying on (or sunk into) the base plane.
+struct CylinderParams {
+  Eigen::Vector3d centre_mm{-50.0, 0.0, 30.0};  // middle of the axis, world
+  Eigen::Vector3d axis{0.0, 1.0, 0.0};          // axis direction, any length > 0
+  double radius_mm = 40.0;                      // > 0
+  double length_mm = 160.0;                     // along the axis, cap to cap, > 0
+  bool caps = true;                             // close both ends with discs
+  // Points below this height are not part of the surface.
+  double cut_below_z_mm = 0.0;
+
+  // True when the numbers describe a cylinder; otherwise says which field and why.
+  bool IsValid(std::string* error) const;
+};
+
+// The cylinder of CylinderParams; front side is outside (caps: facing away
+// from the middle).
+class CylinderSurface final : public Surface {
+ public:
+  // `params` must be valid (throws std::invalid_argument otherwise).
+  explicit CylinderSurface(const CylinderParams& params);
+
+  // Nearest hit with the mantle or a cap (above the cut), both sides.
+  std::optional<Hit> Intersect(const geometry::Ray& ray, double max_distance) const override;
+  // "cylinder" with centre, axis, radius and length.
+  std::string Name() const override;
+
+ private:
+  CylinderParams params_;
+  Eigen::Vector3d axis_;  // unit
 };
 
 }  // namespace bsls::simulator

@@ -1,0 +1,106 @@
+// A small fixed sample of the held-out set (random_scene.h) through the
+// default decoder: the first kSampleFrames held-out seeds whose image is at
+// most kMaxSampleSize px on its larger side (so that the sample runs in
+// seconds). The full 200-frame figures are bench/decoder/heldout_report's
+// (docs/heldout.md). Nothing is tuned on these frames.
+//
+// What the decoder must never do is asserted outright: label a junction with
+// the wrong line p, or label a frame whose line 0 is hidden (contracts
+// section 2). The rest are the figures the decoder of 2026-11-27 meets on the
+// sample, to be tightened towards the target as it improves.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "bsls/decoder/decoder.h"
+#include "bsls/simulator/evaluation.h"
+#include "bsls/simulator/random_scene.h"
+#include "bsls/simulator/renderer.h"
+#include "test_options.h"
+
+namespace bsls::simulator {
+namespace {
+
+constexpr int kSampleFrames = 6;
+constexpr int kMaxSampleSize = 800;     // px, the larger image side
+constexpr double kMatchReach = 2.5;     // px, as the report
+constexpr int kLineZeroJunctions = 3;   // visible junctions on line 0 that make it visible
+constexpr double kBasePlaneBand = 0.5;  // mm: junctions this close to z = 0 are on the base plane
+
+// Figures of the decoder of 2026-11-27 on the sample (seeds 100000 bunny,
+// 100004-100006 faces, 100011 ramp, 100013 cylinder), measured: no wrong p,
+// no wrong q, 2 refusals with line 0 visible (the bunny and the cylinder),
+// recall 0.633 on the objects and 0.341 on all visible junctions (the faces'
+// base plane beyond the face is not labelled at all). The thresholds keep a
+// little room below them. The target: no refusal while line 0
+// shows, no wrong q, recall >= 0.95 on the objects and on the base plane
+// around them alike.
+constexpr int kMaxWrongRefusals = 2;
+constexpr int kMaxWrongQ = 0;
+constexpr double kMinObjectRecall = 0.60;
+constexpr double kMinRecall = 0.32;
+
+std::vector<std::uint32_t> SampleSeeds() {
+  std::vector<std::uint32_t> seeds;
+  for (int i = 0; static_cast<int>(seeds.size()) < kSampleFrames; ++i) {
+    const RandomSceneDraw d = DrawRandomScene(SeedOf(SeedSet::kHeldOut, i));
+    if (std::max(d.width, d.height) <= kMaxSampleSize) seeds.push_back(d.seed);
+  }
+  return seeds;
+}
+
+int Right(const LabelScore& s) { return s.found - s.Wrong(); }
+
+TEST(HeldOutSample, DecoderNeverMislabelsALineAndMeetsTodaysFigures) {
+  int wrong_refusals = 0, wrong_q = 0, truth = 0, right = 0, object_truth = 0, object_right = 0;
+  for (const std::uint32_t seed : SampleSeeds()) {
+    const RandomScene random = MakeRandomScene(
+        seed, {kDataDir / "canonical_face_model.obj", kDataDir / "stanford_bunny.json"});
+    SCOPED_TRACE(random.draw.Describe());
+    const Frame frame = Renderer(random.scene, random.render).Render();
+    const decoder::DecodeResult r = decoder::Decode(frame.image, random.scene.side);
+    const std::vector<PointLabel> visible = VisibleJunctions(frame.truth);
+    const bool line_zero_visible =
+        std::count_if(visible.begin(), visible.end(),
+                      [](const PointLabel& j) { return j.p == 0; }) >= kLineZeroJunctions;
+    if (!line_zero_visible) {
+      // Contracts section 2: without its reference line a frame is refused.
+      EXPECT_FALSE(r.ok);
+      continue;
+    }
+    std::vector<PointLabel> decoded;
+    for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
+    std::vector<PointLabel> on_object;
+    for (const TruthJunction& j : frame.truth.junctions)
+      if (j.visible &&
+          (random.draw.object == RandomObject::kPlane || std::abs(j.world.z()) >= kBasePlaneBand))
+        on_object.push_back({j.p, j.v, {j.image.x(), j.image.y()}});
+    const LabelScore all = ScoreLabels(visible, decoded, kMatchReach);
+    const LabelScore object = ScoreLabels(on_object, decoded, kMatchReach);
+    // What the decoder must never do: give a junction the wrong line.
+    EXPECT_EQ(all.wrong_p, 0) << all.Summary();
+    wrong_refusals += !r.ok;
+    wrong_q += all.wrong_v;
+    truth += all.truth;
+    right += Right(all);
+    object_truth += object.truth;
+    object_right += Right(object);
+    std::printf("seed %u %s: %s%s\n", seed, std::string(ToString(random.draw.object)).c_str(),
+                r.ok ? "" : "refused; ", all.Summary().substr(0, 120).c_str());
+  }
+  ASSERT_GT(truth, 0);
+  ASSERT_GT(object_truth, 0);
+  const double recall = static_cast<double>(right) / truth;
+  const double object_recall = static_cast<double>(object_right) / object_truth;
+  std::printf("sample: %d wrong refusals, %d wrong q, recall %.3f, on the objects %.3f\n",
+              wrong_refusals, wrong_q, recall, object_recall);
+  EXPECT_LE(wrong_refusals, kMaxWrongRefusals);
+  EXPECT_LE(wrong_q, kMaxWrongQ);
+  EXPECT_GE(object_recall, kMinObjectRecall);
+  EXPECT_GE(recall, kMinRecall);
+}
+
+}  // namespace
+}  // namespace bsls::simulator
