@@ -118,6 +118,10 @@ def failures(row):
             why.append("must be refused (" + row["expect_failure"] + ")")
         return why
     if row["refused"]:
+        # Refusing an object frame whose labels cannot be proven is honest,
+        # where no recall is asked of it yet.
+        if OBJECT_RECALL.get(row["object_name"]) == 0.0:
+            return []
         return ["refused: " + row["reason"]]
     if row["wrong"] > MAX_WRONG:
         why.append(f"{row['wrong']} wrong labels")

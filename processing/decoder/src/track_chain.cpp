@@ -124,37 +124,36 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
   return c;
 }
 
-// Drops the centres of line track t that do not belong to its line p: those
-// more than half a row spacing beyond its first and last junction labelled
-// p, and those past a junction of the track not labelled p that lies
-// beyond its last (or before its first) junction of p: there the track went
-// on across an occluding edge into another line or into a region whose
-// labels could not be proven. (Such a junction between two of p is a
-// stray segment end, and cuts nothing.)
+// Drops the output centres of line track t that do not belong to its line
+// p: where a junction of the track not labelled p lies beyond its last (or
+// before its first) junction of p, the track went on across an occluding
+// edge into another line or into a region whose labels could not be
+// proven, and its centres from half a row spacing past its last junction
+// of p (or that junction, if nearer) on are dropped. A junction not
+// labelled p between two of p is a stray segment end and cuts nothing, and
+// a track that runs on with no junction keeps its centres. The measured
+// centres stay: they still place the line's junctions.
 void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
                        const interpretation::TrackLabels& labels, int t, TrackCentres* c) {
   const int p = labels.line_p[t];
   const double reach = labels.row_spacing > 0 ? 0.5 * labels.row_spacing : 0.0;
-  double from = INFINITY, to = -INFINITY;  // rows of its own
+  double first = INFINITY, last = -INFINITY;  // rows of its junctions of p
   const std::vector<int>& on = net.junctions_on_line[t];
   for (int j : on)
     if (labels.p[j] == p) {
-      from = std::min(from, net.junctions[j].position.y - reach);
-      to = std::max(to, net.junctions[j].position.y + reach);
+      first = std::min(first, net.junctions[j].position.y);
+      last = std::max(last, net.junctions[j].position.y);
     }
+  double from = -INFINITY, to = INFINITY;
   for (int j : on) {
     if (labels.p[j] == p) continue;
     const double y = net.junctions[j].position.y;
-    if (y <= from || y >= to) continue;
-    int above = 0, below = 0;
-    for (int k : on)
-      if (labels.p[k] == p) ++(net.junctions[k].position.y < y ? above : below);
-    if (below == 0) to = y;
-    if (above == 0) from = y;
+    if (y > last) to = std::min(to, std::min(y, last + reach));
+    if (y < first) from = std::max(from, std::max(y, first - reach));
   }
   for (size_t k = 0; k < c->output.size(); ++k) {
     const double y = c->first_row + static_cast<double>(k);
-    if (y < from || y > to) c->output[k] = c->measured[k] = NAN;
+    if (y < from || y > to) c->output[k] = NAN;
   }
 }
 

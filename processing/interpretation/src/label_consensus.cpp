@@ -29,8 +29,10 @@ struct Label {
 bool OddSum(const Label& l) { return ((l.p + l.v) % 2 + 2) % 2 == 1; }
 
 // Patches: the junctions joined by trusted links, each labelled relative to
-// its first junction. A trusted link its patch contradicts is dropped and
-// the patches are made again.
+// its first junction. A trusted link its patch contradicts is dropped with
+// every other trusted link of its two ends (which of them is wrong cannot
+// be told, so both junctions must be proven again as lone ones), and the
+// patches are made again.
 struct Patches {
   std::vector<int> of;      // per junction: its patch
   std::vector<Label> rel;   // per junction: its label within its patch
@@ -87,10 +89,13 @@ Patches MakePatches(const std::vector<char>& odd_kind, const std::vector<Consens
       for (int k = 0; k < static_cast<int>(links.size()); ++k)
         if ((*trusted)[k] && doubtful[out.of[links[k].a]]) bad.push_back(k);
     }
+    std::vector<char> doubted(n, 0);
     for (int k : bad) {
       *contradicted += (*trusted)[k] ? 1 : 0;
-      (*trusted)[k] = 0;
+      doubted[links[k].a] = doubted[links[k].b] = 1;
     }
+    for (int k = 0; k < static_cast<int>(links.size()); ++k)
+      if (doubted[links[k].a] || doubted[links[k].b]) (*trusted)[k] = 0;
   }
 }
 
@@ -222,6 +227,55 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
   }
 }
 
+// Line 0 broken into parts that no two links join (the nose's tip, a lump
+// below it): a component whose own seeds agree on its p joins line 0's
+// main one through the links between them whose shift of p the two sets of
+// seeds confirm, where those agree on one shift (v) and no link
+// contradicts them. The seeds are the second, independent witness that a
+// single link lacks. `votes`: (component, p shift) -> seeds.
+template <typename LabelOf>
+void JoinSeededComponents(const std::vector<ConsensusLink>& links,
+                          const std::vector<char>& trusted,
+                          const std::map<std::pair<int, int>, int>& votes, int main_c,
+                          int main_shift, int min_seeds, const ConsensusParams& params,
+                          LabelOf label_of, Components* comps) {
+  std::map<int, std::pair<int, int>> best;  // component -> (p shift, seeds)
+  std::map<int, int> total;                 // component -> seeds
+  for (const auto& [key, count] : votes) {
+    total[key.first] += count;
+    auto& b = best[key.first];
+    if (count > b.second) b = {key.second, count};
+  }
+  for (const auto& [c, b] : best) {
+    if (c == main_c || b.second < min_seeds ||
+        total[c] - b.second > params.max_dissent * b.second)
+      continue;
+    // Shifts from c's frame to the main one's root frame that the links give.
+    const auto [root, root_shift] = comps->Find(main_c);
+    std::map<Label, int> shifts;
+    int against = 0, count = 0;
+    for (size_t k = 0; k < links.size(); ++k) {
+      if (trusted[k]) continue;
+      const ConsensusLink& l = links[k];
+      const auto [ca, la] = label_of(l.a);
+      const auto [cb, lb] = label_of(l.b);
+      Label h;
+      if (ca == root && cb == c) h = la + Label{l.dp, l.dv} - lb;
+      else if (ca == c && cb == root) h = lb - Label{l.dp, l.dv} - la;
+      else continue;
+      ++count;
+      // c's p is its own label plus b.first; through the link, plus h.p
+      // back to main_c's frame and its shift.
+      if (h.p - root_shift.p + main_shift != b.first || OddSum(h)) ++against;
+      else ++shifts[h];
+    }
+    if (shifts.size() != 1) continue;
+    const auto& [h, agree] = *shifts.begin();
+    if (count - agree > params.max_dissent * agree || against > 0) continue;
+    comps->Join(root, c, h);
+  }
+}
+
 }  // namespace
 
 Consensus LabelByConsensus(const std::vector<char>& odd_kind,
@@ -335,13 +389,18 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
       seeds_of[best_c] - best_votes > params.max_dissent * best_votes)
     return out;
   const Label shift{best_shift, (best_shift % 2 + 2) % 2};  // keeps p + v's parity
+  JoinSeededComponents(links, trusted, votes, best_c, best_shift, min_seeds, params, label_of,
+                       &comps);
+  // Labels in the frame of line 0's component as it now stands: its root
+  // may have moved with a join, so they are taken back to best_c's frame.
+  const auto [main_root, main_shift] = comps.Find(best_c);
   std::vector<char> labelled(n, 0);
   std::vector<Label> label(n);
   for (int j = 0; j < n; ++j) {
     const auto [c, l] = label_of(j);
-    if (c != best_c) continue;
+    if (c != main_root) continue;
     labelled[j] = 1;
-    label[j] = l + shift;
+    label[j] = l - main_shift + shift;
   }
   std::vector<int> patch_size(patches.count, 0);
   for (int j = 0; j < n; ++j) ++patch_size[patches.of[j]];

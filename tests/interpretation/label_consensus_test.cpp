@@ -1,0 +1,190 @@
+// Labels proven by agreement over the junction graph (label_consensus.h):
+// small graphs whose true labels are known, joined by links right and wrong.
+#include "label_consensus.h"
+
+#include <gtest/gtest.h>
+
+#include <climits>
+#include <utility>
+#include <vector>
+
+namespace bsls::interpretation::internal {
+namespace {
+
+constexpr int kNone = INT_MIN;
+
+// A graph built from true labels: junction j is (p, v); a link's change is
+// the difference of its ends' labels unless told otherwise.
+struct Graph {
+  std::vector<std::pair<int, int>> truth;
+  std::vector<ConsensusLink> links;
+
+  int Add(int p, int v) {
+    truth.emplace_back(p, v);
+    return static_cast<int>(truth.size()) - 1;
+  }
+  void Link(int a, int b, bool trusted, bool smooth = false) {
+    links.push_back({a, b, truth[b].first - truth[a].first, truth[b].second - truth[a].second,
+                     trusted, smooth});
+  }
+  // A link whose change is off by (dp, dv) from the truth: a wrong one.
+  void WrongLink(int a, int b, int dp, int dv, bool trusted = false) {
+    links.push_back({a, b, truth[b].first - truth[a].first + dp,
+                     truth[b].second - truth[a].second + dv, trusted, false});
+  }
+  std::vector<char> OddKind() const {
+    std::vector<char> odd;
+    for (const auto& [p, v] : truth) odd.push_back(((p + v) % 2 + 2) % 2);
+    return odd;
+  }
+};
+
+// Patch A: lines 0 and 1, rows 0-3, closed by trusted links; its two seeds
+// on line 0. Patch B: line 2, rows 1-3. Nothing joins them yet.
+struct TwoPatches : ::testing::Test {
+  void SetUp() override {
+    a0 = g.Add(0, 0);
+    a1 = g.Add(0, 2);
+    a2 = g.Add(1, 0);
+    a3 = g.Add(1, 1);
+    a4 = g.Add(1, 2);
+    a5 = g.Add(1, 3);
+    g.Link(a0, a1, true);
+    g.Link(a0, a2, true);
+    g.Link(a2, a3, true);
+    g.Link(a3, a4, true);
+    g.Link(a1, a4, true);
+    g.Link(a4, a5, true);
+    b0 = g.Add(2, 1);
+    b1 = g.Add(2, 2);
+    b2 = g.Add(2, 3);
+    g.Link(b0, b1, true);
+    g.Link(b1, b2, true);
+  }
+  Consensus Run() const {
+    return LabelByConsensus(g.OddKind(), g.links, {a0, a1}, 2, ConsensusParams{});
+  }
+  // Expects junction j labelled with its true p and with v true up to the
+  // even offset of the whole frame, taken from a0.
+  void ExpectRight(const Consensus& c, int j) const {
+    ASSERT_NE(c.p[j], kNone) << "junction " << j;
+    EXPECT_EQ(c.p[j], g.truth[j].first) << "junction " << j;
+    EXPECT_EQ(c.v[j] - c.v[a0], g.truth[j].second - g.truth[a0].second) << "junction " << j;
+  }
+
+  Graph g;
+  int a0, a1, a2, a3, a4, a5, b0, b1, b2;
+};
+
+TEST_F(TwoPatches, LineZerosPatchIsLabelledAndTheOtherIsNotGuessed) {
+  g.Link(a3, b0, false);  // one segment: not proof
+  const Consensus c = Run();
+  for (int j : {a0, a1, a2, a3, a4, a5}) ExpectRight(c, j);
+  for (int j : {b0, b1, b2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
+}
+
+TEST_F(TwoPatches, TwoAgreeingLinksJoinThem) {
+  g.Link(a3, b0, false);
+  g.Link(a5, b2, false);
+  const Consensus c = Run();
+  for (int j : {a0, a1, a2, a3, a4, a5, b0, b1, b2}) ExpectRight(c, j);
+}
+
+TEST_F(TwoPatches, ALinkGivingAnotherShiftKeepsThemApart) {
+  g.Link(a3, b0, false);
+  g.Link(a5, b2, false);
+  g.WrongLink(a4, b1, 2, 0);  // as across an occluding edge: two lines off
+  const Consensus c = Run();
+  for (int j : {b0, b1, b2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
+}
+
+TEST_F(TwoPatches, TwoLinksAgreeingOnAnImpossibleShiftJoinNothing) {
+  // One line and one row off: p + v changes parity, which no true shift does.
+  g.WrongLink(a3, b0, 1, 0);
+  g.WrongLink(a5, b2, 1, 0);
+  const Consensus c = Run();
+  for (int j : {b0, b1, b2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
+}
+
+TEST_F(TwoPatches, AContradictedClosedBrickLinkLeavesNoWrongLabel) {
+  g.WrongLink(a2, a5, 0, 2, /*trusted=*/true);
+  const Consensus c = Run();
+  EXPECT_GE(c.contradicted_links, 1);
+  for (size_t j = 0; j < g.truth.size(); ++j)
+    if (c.p[j] != kNone) ExpectRight(c, static_cast<int>(j));
+}
+
+TEST_F(TwoPatches, ALoneJunctionJoinsThroughTwoAgreeingLinks) {
+  const int lone = g.Add(1, 4);
+  g.Link(a5, lone, false);
+  Consensus c = Run();
+  EXPECT_EQ(c.p[lone], kNone);  // one plain link: not proof
+  const int beside = g.Add(0, 4);  // a lone neighbour whose own link agrees
+  g.Link(a1, beside, false);
+  g.Link(beside, lone, false);
+  c = Run();
+  ExpectRight(c, lone);
+  ExpectRight(c, beside);
+}
+
+TEST_F(TwoPatches, ALoneJunctionJoinsThroughOneSmoothStep) {
+  const int lone = g.Add(1, 4);
+  g.Link(a5, lone, false, /*smooth=*/true);
+  ExpectRight(Run(), lone);
+}
+
+TEST_F(TwoPatches, ASmoothStepThatAnotherLinkContradictsProvesNothing) {
+  const int lone = g.Add(1, 4);
+  g.Link(a5, lone, false, /*smooth=*/true);
+  g.WrongLink(a1, lone, 2, 0);
+  EXPECT_EQ(Run().p[lone], kNone);
+}
+
+TEST_F(TwoPatches, SeedsThatDisagreeAreRefused) {
+  // Two more seeds in patch B, which two links join: their p is 2, not 0.
+  g.Link(a3, b0, false);
+  g.Link(a5, b2, false);
+  const Consensus agreeing = LabelByConsensus(g.OddKind(), g.links, {a0, a1}, 2, {});
+  EXPECT_NE(agreeing.p[a0], kNone);
+  const Consensus c = LabelByConsensus(g.OddKind(), g.links, {a0, a1, b0, b1}, 2, {});
+  for (size_t j = 0; j < g.truth.size(); ++j) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
+}
+
+}  // namespace
+}  // namespace bsls::interpretation::internal
+
+namespace bsls::interpretation::internal {
+namespace {
+
+// Line 0 broken in two (the nose's tip): patch C holds line 0's lower
+// junctions, which are seeds too, and one link crosses the gap.
+struct BrokenLineZero : TwoPatches {
+  void SetUp() override {
+    TwoPatches::SetUp();
+    c0 = g.Add(0, 6);
+    c1 = g.Add(0, 8);
+    c2 = g.Add(1, 6);
+    g.Link(c0, c1, true);
+    g.Link(c0, c2, true);
+  }
+  Consensus RunWithBothParts() const {
+    return LabelByConsensus(g.OddKind(), g.links, {a0, a1, c0, c1}, 2, ConsensusParams{});
+  }
+  int c0, c1, c2;
+};
+
+TEST_F(BrokenLineZero, ItsPartsJoinThroughALinkTheirSeedsConfirm) {
+  g.Link(a1, c0, false);  // the row count across the gap
+  const Consensus c = RunWithBothParts();
+  for (int j : {a0, a1, a2, c0, c1, c2}) ExpectRight(c, j);
+}
+
+TEST_F(BrokenLineZero, ALinkTheSeedsContradictJoinsNothing) {
+  g.WrongLink(a3, c2, 2, 0);  // would put C's line 0 at p = 2
+  const Consensus c = RunWithBothParts();
+  for (int j : {a0, a1, a2}) ExpectRight(c, j);
+  for (int j : {c0, c1, c2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
+}
+
+}  // namespace
+}  // namespace bsls::interpretation::internal
