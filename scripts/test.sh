@@ -17,12 +17,20 @@ root=$(pwd)
 jobs=$(nproc)
 
 bash scripts/install-deps.sh
+# ccache (CMakeLists.txt uses it when present) with paths taken relative to
+# the folder above the clone, so that a fresh clone anywhere beside it hits
+# what an earlier build cached.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$root")}"
+stage_start=$SECONDS
+stage_done() { echo "== $1: $((SECONDS - stage_start)) s"; stage_start=$SECONDS; }
 
 echo "== build: RelWithDebInfo (gcc)"
 cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 cmake --build build/release -j "$jobs"
+stage_done "build RelWithDebInfo"
 echo "== tests: RelWithDebInfo"
 ctest --test-dir build/release --output-on-failure -j "$jobs"
+stage_done "tests RelWithDebInfo"
 
 if [ "${BSLS_TEST_QUICK:-0}" = 1 ]; then exit 0; fi
 
@@ -31,8 +39,10 @@ CC=clang CXX=clang++ cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=Debug 
   -DCMAKE_CXX_FLAGS="-O2" -DBSLS_SANITIZE=address,undefined -DBSLS_FUZZ=ON \
   -DBSLS_BUILD_BENCH=OFF >/dev/null
 cmake --build build/asan -j "$jobs"
+stage_done "build ASan + UBSan"
 echo "== tests: AddressSanitizer + UBSan (fuzz included, accuracy figures left to the first stage)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 ctest --test-dir build/asan --output-on-failure -j "$jobs" -LE "accuracy|timing"
+stage_done "tests ASan + UBSan"
 echo "== all tests passed in $root"

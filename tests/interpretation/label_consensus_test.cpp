@@ -61,8 +61,10 @@ struct TwoPatches : ::testing::Test {
     g.Link(b0, b1, true);
     g.Link(b1, b2, true);
   }
-  Consensus Run() const {
-    return LabelByConsensus(g.OddKind(), g.links, {a0, a1}, 2, ConsensusParams{});
+  // The consensus with `seeds` on line 0 (default: patch A's two).
+  Consensus Run(std::vector<int> seeds = {}) const {
+    if (seeds.empty()) seeds = {a0, a1};
+    return LabelByConsensus(g.OddKind(), g.links, seeds, 2, ConsensusParams{});
   }
   // Expects junction j labelled with its true p and with v true up to the
   // even offset of the whole frame, taken from a0.
@@ -144,9 +146,8 @@ TEST_F(TwoPatches, SeedsThatDisagreeAreRefused) {
   // Two more seeds in patch B, which two links join: their p is 2, not 0.
   g.Link(a3, b0, false);
   g.Link(a5, b2, false);
-  const Consensus agreeing = LabelByConsensus(g.OddKind(), g.links, {a0, a1}, 2, {});
-  EXPECT_NE(agreeing.p[a0], kNone);
-  const Consensus c = LabelByConsensus(g.OddKind(), g.links, {a0, a1, b0, b1}, 2, {});
+  EXPECT_NE(Run().p[a0], kNone);
+  const Consensus c = Run({a0, a1, b0, b1});
   for (size_t j = 0; j < g.truth.size(); ++j) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
 }
 
@@ -167,21 +168,18 @@ struct BrokenLineZero : TwoPatches {
     g.Link(c0, c1, true);
     g.Link(c0, c2, true);
   }
-  Consensus RunWithBothParts() const {
-    return LabelByConsensus(g.OddKind(), g.links, {a0, a1, c0, c1}, 2, ConsensusParams{});
-  }
   int c0, c1, c2;
 };
 
 TEST_F(BrokenLineZero, ItsPartsJoinThroughALinkTheirSeedsConfirm) {
   g.Link(a1, c0, false);  // the row count across the gap
-  const Consensus c = RunWithBothParts();
+  const Consensus c = Run({a0, a1, c0, c1});
   for (int j : {a0, a1, a2, c0, c1, c2}) ExpectRight(c, j);
 }
 
 TEST_F(BrokenLineZero, ALinkTheSeedsContradictJoinsNothing) {
   g.WrongLink(a3, c2, 2, 0);  // would put C's line 0 at p = 2
-  const Consensus c = RunWithBothParts();
+  const Consensus c = Run({a0, a1, c0, c1});
   for (int j : {a0, a1, a2}) ExpectRight(c, j);
   for (int j : {c0, c1, c2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
 }
