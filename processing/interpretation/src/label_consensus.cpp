@@ -378,10 +378,6 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
       best_c = key.first;
       best_shift = key.second;
     }
-  std::vector<int> roots;
-  for (int x = 0; x < patches.count; ++x) roots.push_back(comps.Find(x).first);
-  std::sort(roots.begin(), roots.end());
-  out.components = static_cast<int>(std::unique(roots.begin(), roots.end()) - roots.begin());
   // The seeds of the chosen component must agree: those that do not are
   // stray junctions beside line 0, and may not outnumber a third of them.
   if (best_c < 0 || best_votes < min_seeds ||

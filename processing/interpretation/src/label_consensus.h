@@ -53,7 +53,6 @@ struct Consensus {
   std::vector<int> p;  // per junction: line relative to line 0, or kUnlabelled
   std::vector<int> v;  // per junction: row, relative (any even offset), or kUnlabelled
   int contradicted_links = 0;  // trusted links dropped as contradicting their patch
-  int components = 0;          // components left after joining (labelled or not)
 };
 
 // Labels `odd_kind.size()` junctions (odd_kind[j]: 1 for a corresponding

@@ -199,6 +199,19 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     return own_spacing[track] > 0 ? own_spacing[track] : frame_spacing;
   };
 
+  // The rows from junction a down to junction b on one line at `spacing` px
+  // a row; nullopt where the step fits no whole number of rows of its
+  // parity: it joins a false junction (a segment's end on the wrong line).
+  auto rows_between = [&](int a, int b, double spacing) -> std::optional<int> {
+    if (!(spacing > 0)) return std::nullopt;
+    const TrackJunction& ja = net.junctions[a];
+    const TrackJunction& jb = net.junctions[b];
+    const internal::RowCount step = internal::NearestRowCount(
+        jb.position.y - ja.position.y, spacing, ja.kind != jb.kind, params.max_rows);
+    if (step.miss > params.max_row_miss * spacing) return std::nullopt;
+    return step.rows;
+  };
+
   // Steps along lines: consecutive junctions of a track, a whole number of rows apart.
   struct Step {
     int to = -1;
@@ -208,17 +221,8 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   for (size_t t = 0; t < net.lines.size(); ++t) {
     const std::vector<int>& on = net.junctions_on_line[t];
     const double s = spacing_of(static_cast<int>(t));
-    if (!(s > 0)) continue;
-    for (size_t i = 1; i < on.size(); ++i) {
-      const TrackJunction& a = net.junctions[on[i - 1]];
-      const TrackJunction& b = net.junctions[on[i]];
-      const internal::RowCount step = internal::NearestRowCount(
-          b.position.y - a.position.y, s, a.kind != b.kind, params.max_rows);
-      // A step that fits no whole number of rows of its parity joins a false
-      // junction (a segment's end on the wrong line): no link.
-      if (step.miss > params.max_row_miss * s) continue;
-      down[on[i - 1]] = {on[i], step.rows};
-    }
+    for (size_t i = 1; i < on.size(); ++i)
+      if (const auto rows = rows_between(on[i - 1], on[i], s)) down[on[i - 1]] = {on[i], *rows};
   }
   // Segments: a direct junction at one end and a corresponding one at the
   // other join lines p and p + 1.
@@ -304,13 +308,8 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // A line broken by a gap (net.line_below): its last junction above and
   // first below, a whole number of rows apart at the line's spacing.
   auto gap_step = [&](int a, int b) {
-    const TrackJunction& ja = net.junctions[a];
-    const TrackJunction& jb = net.junctions[b];
-    const double s = spacing_of(ja.line);
-    if (!(s > 0)) return;
-    const internal::RowCount step = internal::NearestRowCount(
-        jb.position.y - ja.position.y, s, ja.kind != jb.kind, params.max_rows);
-    if (step.miss <= params.max_row_miss * s) link(a, b, 0, step.rows, false);
+    if (const auto rows = rows_between(a, b, spacing_of(net.junctions[a].line)))
+      link(a, b, 0, *rows, false);
   };
   for (size_t t = 0; t < net.lines.size(); ++t) {
     const int b = net.line_below[t];
