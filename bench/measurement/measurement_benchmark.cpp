@@ -10,6 +10,9 @@
 // volume, the holes filled). BM_MeasureLumpRing: MeasureLesion against the
 // single-scan cubic ring reference. BM_SurfaceQuery: indexing the surface
 // (SurfaceQuery), which every measurement call starts from.
+// BM_MeasureLumpAgainstDamagedBaseline: as the first, with one vertex of the
+// baseline thrown 1e8 mm away (a damaged upload the service must still
+// answer quickly): its ratio should stay beside the first's.
 // Counters: median_ms, reconstruct_ms (median Reconstruct of the frame),
 // ratio = median / reconstruct_ms, and the measurement's filled_share and
 // area_mm2 (so a change of the figures shows beside a change of speed).
@@ -68,7 +71,8 @@ const Side3d& Face(bool with_lump) {
     params.noise_sigma = 3.0;
     Side3d out;
     out.decode = bsls::decoder::Decode(bsls::simulator::Render(scene, params).image, Side::kLeft);
-    out.model = bsls::reconstruction::ModelOfKnownDevices(scene.side, scene.camera, scene.projector);
+    out.model =
+        bsls::reconstruction::ModelOfKnownDevices(scene.side, scene.camera, scene.projector);
     if (out.decode.ok) out.mesh = bsls::reconstruction::Reconstruct(out.decode, out.model);
     return out;
   };
@@ -131,6 +135,18 @@ void BM_MeasureLumpAgainstBaseline(benchmark::State& state) {
   state.counters["filled_share"] = m.filled_share;
 }
 
+void BM_MeasureLumpAgainstDamagedBaseline(benchmark::State& state) {
+  bsls::geometry::SurfaceMesh damaged = Face(false).mesh;
+  if (!damaged.positions.empty()) damaged.positions[damaged.positions.size() / 2].x() = 1e8;
+  bsls::measurement::LesionMeasurement m;
+  Run(state, [&] {
+    const bsls::measurement::SurfaceQuery surface(Face(true).mesh);
+    m = bsls::measurement::MeasureLesionAgainstBaseline(surface, damaged, Region());
+  });
+  state.counters["area_mm2"] = m.area_mm2.value;
+  state.counters["filled_share"] = m.filled_share;
+}
+
 void BM_MeasureLumpRing(benchmark::State& state) {
   bsls::measurement::LesionMeasurement m;
   Run(state, [&] {
@@ -151,6 +167,7 @@ void BM_SurfaceQuery(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_MeasureLumpAgainstBaseline)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_MeasureLumpAgainstDamagedBaseline)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_MeasureLumpRing)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_SurfaceQuery)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "bsls/measurement/report.h"
+#include "bsls/measurement/surface_query.h"
 #include "bsls/simulator/surface.h"
 #include "bsls/testing/surface_sampling.h"
 
@@ -85,6 +86,36 @@ TEST(MeasuresTest, FacesAreaSumsTheTriangles) {
   EXPECT_NEAR(FacesArea(mesh, {0, 1}).value, 4.0 * stretch, kExactTolerance);
   EXPECT_THROW(FacesArea(mesh, {static_cast<int>(mesh.faces.size())}), MeasurementError);
   EXPECT_THROW(FacesArea(mesh, {}), MeasurementError);
+}
+
+// A vertex thrown far away (a damaged file) leaves the rest of the surface
+// indexed at its own resolution: every query answers as a scan of all faces
+// would, and a small box meets only the faces near it and the stretched ones.
+TEST(SurfaceQueryTest, AVertexThrownFarAwayLeavesTheRestAnsweredExactly) {
+  geometry::SurfaceMesh mesh = TiltedPlane();
+  const int far = static_cast<int>(mesh.positions.size() / 2);
+  mesh.positions[far] = Eigen::Vector3d(1e8, -3e7, 5.0);
+  const SurfaceQuery query(mesh);
+  int stretched = 0;
+  for (const Eigen::Vector3i& f : mesh.faces) stretched += (f.array() == far).any() ? 1 : 0;
+  ASSERT_GT(stretched, 0);
+  for (double x = -39.5; x < 40.0; x += 3.7)
+    for (double y = -39.5; y < 40.0; y += 4.1) {
+      const Eigen::AlignedBox2d box(Eigen::Vector2d(x, y), Eigen::Vector2d(x + 0.5, y + 0.5));
+      std::vector<int> expected;
+      for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        Eigen::AlignedBox2d face_box;
+        for (int k = 0; k < 3; ++k) face_box.extend(mesh.positions[mesh.faces[f][k]].head<2>());
+        if (face_box.intersects(box)) expected.push_back(static_cast<int>(f));
+      }
+      EXPECT_EQ(query.FacesIn(box), expected) << x << ", " << y;
+      EXPECT_LE(query.FacesIn(box).size(), 8u + stretched) << x << ", " << y;
+    }
+  // A box covering everything finds every face once.
+  const Eigen::AlignedBox2d all(Eigen::Vector2d(-1e9, -1e9), Eigen::Vector2d(1e9, 1e9));
+  EXPECT_EQ(query.FacesIn(all).size(), mesh.faces.size());
+  // Off the plane's own area and away from the stretched faces: nothing.
+  EXPECT_FALSE(query.Above(Eigen::Vector2d(-500.0, 500.0)).has_value());
 }
 
 TEST(MeasuresTest, ErrorsNameTheInput) {

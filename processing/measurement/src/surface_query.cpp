@@ -10,8 +10,19 @@
 namespace bsls::measurement {
 namespace {
 
-// Grid cells per axis at most (keeps the index small for huge meshes).
-constexpr int kMaxCellsPerAxis = 2048;
+// A face whose bounding box spans more grid cells than this along either
+// axis is kept in a list of its own and tested by every query: a vertex
+// thrown far away by a damaged file then costs one test per query, not a
+// grid as large as its distance.
+constexpr std::int64_t kMaxCellsPerFace = 16;
+// Cell indices are clamped to this (a coordinate of 1e30 mm must not
+// overflow the key).
+constexpr double kMaxCellIndex = 1 << 30;
+
+std::uint64_t KeyOf(std::int64_t x, std::int64_t y) {
+  return (static_cast<std::uint64_t>(x) << 32) ^ (static_cast<std::uint64_t>(y) & 0xffffffffu);
+}
+
 // Barycentric slack (a point on an edge belongs to both faces).
 constexpr double kInsideTolerance = 1e-9;
 // The quadric of InterpolationError uses vertices within this many longest
@@ -38,42 +49,53 @@ SurfaceQuery::SurfaceQuery(const geometry::SurfaceMesh& mesh, double cell_mm) : 
   std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
   median_edge_mm_ = std::max(edges[edges.size() / 2], 1e-6);
   cell_mm_ = cell_mm > 0.0 ? cell_mm : 2.0 * median_edge_mm_;
-  const Eigen::Vector2d size = bounds_.sizes();
-  cell_mm_ = std::max({cell_mm_, size.x() / kMaxCellsPerAxis, size.y() / kMaxCellsPerAxis});
-  nx_ = std::max(1, static_cast<int>(std::ceil(size.x() / cell_mm_)) + 1);
-  ny_ = std::max(1, static_cast<int>(std::ceil(size.y() / cell_mm_)) + 1);
-  cells_.assign(static_cast<std::size_t>(nx_) * ny_, {});
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
     Eigen::AlignedBox2d box;
     for (int k = 0; k < 3; ++k) box.extend(mesh.positions[mesh.faces[f][k]].head<2>());
-    const int x0 = static_cast<int>((box.min().x() - bounds_.min().x()) / cell_mm_);
-    const int x1 = static_cast<int>((box.max().x() - bounds_.min().x()) / cell_mm_);
-    const int y0 = static_cast<int>((box.min().y() - bounds_.min().y()) / cell_mm_);
-    const int y1 = static_cast<int>((box.max().y() - bounds_.min().y()) / cell_mm_);
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) cells_[y * nx_ + x].push_back(static_cast<int>(f));
+    const std::int64_t x0 = CellOf(box.min().x()), x1 = CellOf(box.max().x());
+    const std::int64_t y0 = CellOf(box.min().y()), y1 = CellOf(box.max().y());
+    if (x1 - x0 >= kMaxCellsPerFace || y1 - y0 >= kMaxCellsPerFace) {
+      large_faces_.push_back(static_cast<int>(f));
+      continue;
+    }
+    for (std::int64_t y = y0; y <= y1; ++y)
+      for (std::int64_t x = x0; x <= x1; ++x) cells_[KeyOf(x, y)].push_back(static_cast<int>(f));
   }
+}
+
+std::int64_t SurfaceQuery::CellOf(double mm) const {
+  return static_cast<std::int64_t>(
+      std::floor(std::clamp(mm / cell_mm_, -kMaxCellIndex, kMaxCellIndex)));
 }
 
 std::vector<int> SurfaceQuery::FacesIn(const Eigen::AlignedBox2d& box) const {
   std::vector<int> faces;
   if (!box.intersects(bounds_)) return faces;
-  // Clamped as doubles first: a box far outside (or huge) must not overflow the cast.
-  auto clampx = [&](double v) {
-    return static_cast<int>(std::clamp((v - bounds_.min().x()) / cell_mm_, 0.0, nx_ - 1.0));
+  const auto meets = [&](int f) {
+    Eigen::AlignedBox2d face_box;
+    for (int k = 0; k < 3; ++k) face_box.extend(mesh_.positions[mesh_.faces[f][k]].head<2>());
+    return face_box.intersects(box);
   };
-  auto clampy = [&](double v) {
-    return static_cast<int>(std::clamp((v - bounds_.min().y()) / cell_mm_, 0.0, ny_ - 1.0));
-  };
-  const int x0 = clampx(box.min().x()), x1 = clampx(box.max().x());
-  const int y0 = clampy(box.min().y()), y1 = clampy(box.max().y());
-  for (int y = y0; y <= y1; ++y)
-    for (int x = x0; x <= x1; ++x)
-      for (int f : cells_[y * nx_ + x]) {
-        Eigen::AlignedBox2d face_box;
-        for (int k = 0; k < 3; ++k) face_box.extend(mesh_.positions[mesh_.faces[f][k]].head<2>());
-        if (face_box.intersects(box)) faces.push_back(f);
+  const Eigen::AlignedBox2d within = box.intersection(bounds_);
+  const std::int64_t x0 = CellOf(within.min().x()), x1 = CellOf(within.max().x());
+  const std::int64_t y0 = CellOf(within.min().y()), y1 = CellOf(within.max().y());
+  const double spanned = static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1);
+  if (spanned > static_cast<double>(cells_.size())) {
+    // A box larger than the occupied grid: walk the occupied cells instead.
+    for (const auto& [key, cell] : cells_)
+      for (int f : cell)
+        if (meets(f)) faces.push_back(f);
+  } else {
+    for (std::int64_t y = y0; y <= y1; ++y)
+      for (std::int64_t x = x0; x <= x1; ++x) {
+        const auto cell = cells_.find(KeyOf(x, y));
+        if (cell == cells_.end()) continue;
+        for (int f : cell->second)
+          if (meets(f)) faces.push_back(f);
       }
+  }
+  for (int f : large_faces_)
+    if (meets(f)) faces.push_back(f);
   std::sort(faces.begin(), faces.end());
   faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
   return faces;

@@ -11,8 +11,10 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cstdint>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "bsls/geometry/surface_mesh.h"
@@ -37,7 +39,10 @@ struct SurfacePoint {
 class SurfaceQuery {
  public:
   // Indexes the faces on an x-y grid of `cell_mm` (0: twice the median edge
-  // length). Throws MeasurementError for an invalid mesh or one without faces.
+  // length), kept sparse so that a vertex thrown far away (a damaged file)
+  // costs neither memory nor the resolution of the rest; a face spanning more
+  // than a few cells is kept aside and tested by every query. Throws
+  // MeasurementError for an invalid mesh or one without faces.
   explicit SurfaceQuery(const geometry::SurfaceMesh& mesh, double cell_mm = 0.0);
 
   // The highest surface point on the vertical line through `xy`; nullopt
@@ -66,8 +71,11 @@ class SurfaceQuery {
   Eigen::AlignedBox2d bounds_;
   double cell_mm_ = 1.0;
   double median_edge_mm_ = 1.0;
-  int nx_ = 1, ny_ = 1;
-  std::vector<std::vector<int>> cells_;  // faces per grid cell, row-major (y, x)
+  // The grid cell of a coordinate (clamped far outside any scan).
+  std::int64_t CellOf(double mm) const;
+
+  std::unordered_map<std::uint64_t, std::vector<int>> cells_;  // faces per occupied cell
+  std::vector<int> large_faces_;  // faces spanning more cells than kMaxCellsPerFace
 };
 
 }  // namespace bsls::measurement
