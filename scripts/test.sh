@@ -17,10 +17,6 @@ root=$(pwd)
 jobs=$(nproc)
 
 bash scripts/install-deps.sh
-# ccache (CMakeLists.txt uses it when present) with paths taken relative to
-# the folder above the clone, so that a fresh clone anywhere beside it hits
-# what an earlier build cached.
-export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(dirname "$root")}"
 stage_start=$SECONDS
 stage_done() { echo "== $1: $((SECONDS - stage_start)) s"; stage_start=$SECONDS; }
 
