@@ -197,6 +197,14 @@ TEST(ReadPly, TruncatedAndCorruptFilesFailClearly) {
   std::string padded = good;
   padded.insert(4, std::string(8 << 20, '\n'));
   expect_error(padded, "header runs past 1024 KiB");
+  // An element without properties takes no bytes whatever its count: it is
+  // passed over at once (this count was 1.8e19 turns of a loop), and a
+  // vertex element without properties is refused.
+  std::string junk = good;
+  junk.insert(junk.find("element vertex"), "element junk 18446744073709551615\n");
+  EXPECT_EQ(DecodePly(junk, "junk.ply").positions.size(), 20u);
+  expect_error("ply\nformat ascii 1.0\nelement vertex 18446744073709551615\nend_header\n",
+               "element vertex has no properties");
   // Words are split on any white space; a header with tabs and padding reads.
   std::string spaced = good;
   spaced.replace(spaced.find("format "), 7, "format\t  ");

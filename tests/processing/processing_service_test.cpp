@@ -256,6 +256,24 @@ TEST(ProcessingService, BadRequestsAreRefusedWithTheFieldNamed) {
          r.mutable_decode()->set_method(v1::DecodeOptions::METHOD_THESIS);
        },
        StatusCode::INVALID_ARGUMENT, "decode.chain"},
+      // Numbers the .proto does not define (proto3 keeps them): refused, not
+      // read as the default.
+      {"undefined chain",
+       [](auto& r) { r.mutable_decode()->set_chain(static_cast<v1::DecodeOptions::Chain>(7)); },
+       StatusCode::INVALID_ARGUMENT, "decode.chain: 7"},
+      {"undefined method",
+       [](auto& r) { r.mutable_decode()->set_method(static_cast<v1::DecodeOptions::Method>(-3)); },
+       StatusCode::INVALID_ARGUMENT, "decode.method: -3"},
+      {"undefined plane model",
+       [](auto& r) {
+         r.mutable_surface()->set_plane_model(static_cast<v1::SurfaceOptions::PlaneModel>(99));
+       },
+       StatusCode::INVALID_ARGUMENT, "surface.plane_model: 99"},
+      {"undefined strips",
+       [](auto& r) {
+         r.mutable_surface()->set_strips(static_cast<v1::SurfaceOptions::StripMethod>(5));
+       },
+       StatusCode::INVALID_ARGUMENT, "surface.strips: 5"},
   };
   for (const Case& c : cases) {
     v1::ProcessFrameRequest request = FaceRequest(pattern::Side::kLeft, true);
@@ -274,6 +292,16 @@ TEST(ProcessingService, BadRequestsAreRefusedWithTheFieldNamed) {
   const grpc::Status status = CallFrame(s, bad_distance);
   EXPECT_EQ(status.error_code(), StatusCode::INVALID_ARGUMENT);
   EXPECT_NE(status.error_message().find("distances[0]"), std::string::npos);
+  v1::ReconstructSessionRequest bad_join = SessionRequest();
+  bad_join.set_join(static_cast<v1::ReconstructSessionRequest::Join>(12));
+  EXPECT_EQ(CallFrame(s, bad_join).error_code(), StatusCode::INVALID_ARGUMENT);
+  v1::ReconstructSessionRequest bad_reference = SessionRequest();
+  bad_reference.mutable_measurements()->set_reference(
+      static_cast<v1::MeasurementPlan::Reference>(8));
+  const grpc::Status reference = CallFrame(s, bad_reference);
+  EXPECT_EQ(reference.error_code(), StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(reference.error_message().find("measurements.reference: 8"), std::string::npos)
+      << reference.error_message();
   // Nothing was left running or queued.
   EXPECT_EQ(s.service().Stats().busy + s.service().Stats().waiting, 0);
 }

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "bsls/io/bounded_yaml.h"
 #include "bsls/io/frame_file.h"
 
 namespace bsls::calibration {
@@ -398,7 +399,7 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
   const Reader r(name);
   YAML::Node root;
   try {
-    root = YAML::Load(text);
+    root = io::LoadBoundedYaml(text);
   } catch (const YAML::Exception& e) {
     r.Fail("", "not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <set>
 
+#include "bsls/io/bounded_yaml.h"
 #include "bsls/io/digest.h"
 #include "bsls/io/frame_file.h"
 
@@ -78,7 +79,7 @@ Manifest LoadManifest(const std::filesystem::path& path) {
   }
   YAML::Node root;
   try {
-    root = YAML::LoadFile(file);
+    root = io::LoadBoundedYamlFile(file);
   } catch (const YAML::Exception& e) {
     throw ManifestError(file + ": not valid YAML: " + e.msg + " (line " +
                         std::to_string(e.mark.line + 1) + ")");

@@ -2,6 +2,8 @@
 
 #include <filesystem>
 
+#include "bsls/io/bounded_yaml.h"
+
 namespace bsls::io {
 
 YAML::Node LoadConfigDocument(const std::optional<std::string>& path,
@@ -12,7 +14,7 @@ YAML::Node LoadConfigDocument(const std::optional<std::string>& path,
     if (!std::filesystem::is_regular_file(*path, ec))
       throw ConfigKeyError("", "configuration file " + *path + " does not exist", true);
     try {
-      root = YAML::LoadFile(*path);
+      root = LoadBoundedYamlFile(*path);
     } catch (const YAML::Exception& e) {
       throw ConfigKeyError("", "configuration file " + *path + " is not valid YAML: " + e.what());
     }
@@ -27,7 +29,7 @@ YAML::Node LoadConfigDocument(const std::optional<std::string>& path,
     const std::string key = assignment.substr(0, equals);
     YAML::Node value;
     try {
-      value = YAML::Load(assignment.substr(equals + 1));
+      value = LoadBoundedYaml(assignment.substr(equals + 1));
     } catch (const YAML::Exception&) {
       throw ConfigKeyError("", "override '" + assignment + "': the value is not valid YAML");
     }

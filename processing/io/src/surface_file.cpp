@@ -392,6 +392,13 @@ geometry::SurfaceMesh DecodePly(std::string_view bytes, const std::string& name)
     if (min_item > 0 && e.count > body.remaining() / min_item)
       throw InputError(name + ": truncated PLY: " + std::to_string(e.count) + " " + e.name +
                        " items do not fit in the rest of the file");
+    // Items without properties take no bytes, whatever their count: nothing
+    // to read, and no loop as long as the count.
+    if (e.properties.empty()) {
+      if (e.name == "vertex" || e.name == "face")
+        throw header_error("element " + e.name + " has no properties");
+      continue;
+    }
     if (e.name == "vertex") {
       if (seen_vertex) body.Fail("two vertex elements");
       seen_vertex = true;

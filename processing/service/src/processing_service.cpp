@@ -17,6 +17,7 @@
 #include "bsls/calibration/calibration_report.h"
 #include "bsls/calibration/manifest.h"
 #include "bsls/decoder/decode_output.h"
+#include "bsls/io/bounded_yaml.h"
 #include "bsls/io/digest.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/measurement/measurement_error.h"
@@ -42,6 +43,14 @@ struct Refusal {
 
 [[noreturn]] void Refuse(StatusCode code, const std::string& message) {
   throw Refusal{Status(code, message)};
+}
+
+// Refuses a number in an enum field that its .proto does not define (proto3
+// keeps unknown numbers rather than rejecting them).
+void RequireDefined(int value, bool (*is_valid)(int), const std::string& field) {
+  if (!is_valid(value))
+    Refuse(StatusCode::INVALID_ARGUMENT,
+           field + ": " + std::to_string(value) + " is not one of the field's values");
 }
 
 pattern::Side SideOf(v1::Side side, const std::string& field) {
@@ -79,6 +88,11 @@ void FillInfo(const CachedCalibration& c, v1::CalibrationInfo* info) {
 
 reconstruction::SidePipelineParams SideParams(const v1::DecodeOptions& decode,
                                               const v1::SurfaceOptions& surface) {
+  RequireDefined(decode.method(), v1::DecodeOptions::Method_IsValid, "decode.method");
+  RequireDefined(decode.chain(), v1::DecodeOptions::Chain_IsValid, "decode.chain");
+  RequireDefined(surface.plane_model(), v1::SurfaceOptions::PlaneModel_IsValid,
+                 "surface.plane_model");
+  RequireDefined(surface.strips(), v1::SurfaceOptions::StripMethod_IsValid, "surface.strips");
   reconstruction::SidePipelineParams params;
   params.decode.extraction.method = decode.method() == v1::DecodeOptions::METHOD_THESIS
                                         ? extraction::ExtractionMethod::kThesis
@@ -114,6 +128,7 @@ measurement::MeasurementPlan PlanOf(const v1::MeasurementPlan& m, int max_figure
   if (figures > max_figures)
     Refuse(StatusCode::INVALID_ARGUMENT, "measurements: " + std::to_string(figures) +
                                              " figures, at most " + std::to_string(max_figures));
+  RequireDefined(m.reference(), v1::MeasurementPlan::Reference_IsValid, "measurements.reference");
   measurement::MeasurementPlan plan;
   for (const v1::PointXY& h : m.heights()) plan.heights.push_back(PointOf(h));
   for (int i = 0; i < m.distances_size(); ++i) {
@@ -226,7 +241,7 @@ std::string PackedSha256(const cv::Mat& grey) {
 void ConfineManifestImages(const std::string& yaml) {
   YAML::Node root;
   try {
-    root = YAML::Load(yaml);
+    root = io::LoadBoundedYaml(yaml);
   } catch (const YAML::Exception&) {
     return;
   }
@@ -448,6 +463,7 @@ Status ProcessingService::ReconstructSession(grpc::ServerContext* context,
     const auto right_cal = ResolveCalibration(request->right_calibration(), "right_calibration");
     session::SessionParams params;
     params.side = SideParams({}, request->surface());
+    RequireDefined(request->join(), v1::ReconstructSessionRequest::Join_IsValid, "join");
     switch (request->join()) {
       case v1::ReconstructSessionRequest::JOIN_SHARED:
         params.join = session::JoinMode::kShared;
