@@ -1,9 +1,8 @@
 #include "bsls/decoder/decode_output.h"
 
 #include <cmath>
-#include <string>
-
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 namespace bsls::decoder {
 namespace {
@@ -73,7 +72,8 @@ cv::Mat RenderOverlay(const cv::Mat& grey, const DecodeResult& r) {
         cv::line(out, fixed(l.points[i - 1]), fixed(l.points[i]), colour, 1, cv::LINE_AA, kShift);
     if (!l.points.empty()) {
       const cv::Point2d top = l.points.front();
-      cv::putText(out, std::to_string(l.p), cv::Point(cvRound(top.x) - 4, std::max(10, cvRound(top.y) - 4)),
+      cv::putText(out, std::to_string(l.p),
+                  cv::Point(cvRound(top.x) - 4, std::max(10, cvRound(top.y) - 4)),
                   cv::FONT_HERSHEY_PLAIN, 0.8, colour, 1, cv::LINE_AA);
     }
   }
@@ -82,8 +82,10 @@ cv::Mat RenderOverlay(const cv::Mat& grey, const DecodeResult& r) {
     const cv::Point c = fixed(d.position);
     if (d.interpolated) {
       const int k = static_cast<int>(2 * kScale);
-      cv::line(out, c - cv::Point(k, k), c + cv::Point(k, k), {0, 255, 255}, 1, cv::LINE_AA, kShift);
-      cv::line(out, c - cv::Point(k, -k), c + cv::Point(k, -k), {0, 255, 255}, 1, cv::LINE_AA, kShift);
+      cv::line(out, c - cv::Point(k, k), c + cv::Point(k, k), {0, 255, 255}, 1, cv::LINE_AA,
+               kShift);
+      cv::line(out, c - cv::Point(k, -k), c + cv::Point(k, -k), {0, 255, 255}, 1, cv::LINE_AA,
+               kShift);
     } else if (d.kind == pattern::JunctionKind::kDirect) {
       cv::circle(out, c, static_cast<int>(1.6 * kScale), colour, cv::FILLED, cv::LINE_AA, kShift);
     } else {
@@ -95,7 +97,8 @@ cv::Mat RenderOverlay(const cv::Mat& grey, const DecodeResult& r) {
   for (const UnlabelledJunction& u : r.unlabelled) {
     const cv::Point c = fixed(u.position);
     const int k = static_cast<int>(2 * kScale);
-    cv::rectangle(out, c - cv::Point(k, k), c + cv::Point(k, k), {0, 0, 255}, 1, cv::LINE_AA, kShift);
+    cv::rectangle(out, c - cv::Point(k, k), c + cv::Point(k, k), {0, 0, 255}, 1, cv::LINE_AA,
+                  kShift);
   }
   return out;
 }

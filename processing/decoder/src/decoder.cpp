@@ -138,7 +138,7 @@ LinePixels PrepareLine(const interpretation::LabelledLine& line) {
 // that a line's centre there is not pulled by its neighbours' light.
 struct CrowdedRows {
   struct Row {
-    std::vector<int> p;                   // the crowding lines, left to right
+    std::vector<int> p;                    // the crowding lines, left to right
     std::vector<std::optional<double>> x;  // their centres (nullopt: no proper ridge)
     bool Has(int line) const { return std::find(p.begin(), p.end(), line) != p.end(); }
     // The joint fit's centre of `line` (a member), nullopt where it failed.
@@ -146,7 +146,7 @@ struct CrowdedRows {
       return x[static_cast<size_t>(std::find(p.begin(), p.end(), line) - p.begin())];
     }
   };
-  std::map<int, std::vector<Row>> rows;  // image row -> its crowds
+  std::map<int, std::vector<Row>> rows;     // image row -> its crowds
   std::map<int, const LinePixels*> pixels;  // p -> the pixels of every line in a crowd
 
   // Whether (x, y) is a pixel of a line of `crowd`.
@@ -233,7 +233,7 @@ CrowdedRows MeasureCrowdedRows(const cv::Mat& grey,
 }
 
 struct LineCentres {
-  RowValues measured;         // row -> sub-pixel x, outliers removed
+  RowValues measured;  // row -> sub-pixel x, outliers removed
   // The measured rows that no segment passes within its widened clearance:
   // the junction fits use only these.
   RowValues clear;
@@ -269,8 +269,7 @@ SegmentNear SegmentNearby(const cv::Mat& skeleton, const LinePixels& own,
     for (int k = 2; k <= 4; ++k)
       for (int side : {-1, 1}) {
         const int xx = x + side * k;
-        if (xx < 0 || xx >= skeleton.cols || !row[xx] ||
-            own.Has(xx, yy) ||
+        if (xx < 0 || xx >= skeleton.cols || !row[xx] || own.Has(xx, yy) ||
             (crowd && crowded.OnLineOf(*crowd, xx, yy)))
           continue;
         if (std::abs(dy) <= clearance || dy * slope * side < 0) return SegmentNear::kNear;
@@ -297,9 +296,9 @@ double LocalSlope(const RowValues& skeleton, int y, int reach) {
 // the full frame (ScaledForBinning); `n` is the binning the skeleton was
 // found at: the skeleton's own pixel sizes (a row's run, the slope's reach)
 // are n times larger.
-LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p,
-                        const LinePixels& own, const CrowdedRows& crowded,
-                        const internal::CentresAhead& ahead, const DecodeParams& params, int n) {
+LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p, const LinePixels& own,
+                        const CrowdedRows& crowded, const internal::CentresAhead& ahead,
+                        const DecodeParams& params, int n) {
   LineCentres out;
   const int first = own.top;
   const int count = static_cast<int>(own.runs.size());
@@ -333,16 +332,14 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p,
     if (!joint) crowd = nullptr;
     // A row where the skeleton runs sideways is a segment, not the line.
     const SegmentNear near =
-        hi - lo > 2 * n
-            ? SegmentNear::kNear
-            : SegmentNearby(skeleton, own, crowded, crowd, x, y, params.junction_clearance,
-                            clearance, signed_slope);
+        hi - lo > 2 * n ? SegmentNear::kNear
+                        : SegmentNearby(skeleton, own, crowded, crowd, x, y,
+                                        params.junction_clearance, clearance, signed_slope);
     if (near == SegmentNear::kNear) {
       skip(y);
       continue;
     }
-    if (auto cx = joint ? joint
-                        : ahead.InRow(grey, y, 0.5 * (lo + hi), params.centre)) {
+    if (auto cx = joint ? joint : ahead.InRow(grey, y, 0.5 * (lo + hi), params.centre)) {
       out.measured.Set(y, *cx);
       if (near == SegmentNear::kNone) out.clear.Set(y, *cx);
     } else {
@@ -482,9 +479,9 @@ void DropWorstColumn(std::vector<std::pair<double, double>>& columns, double max
   const auto residual = [&](const std::pair<double, double>& p) {
     return std::abs(p.second - c - e * p.first);
   };
-  const auto worst = std::max_element(
-      columns.begin(), columns.end(),
-      [&](const auto& l, const auto& r) { return residual(l) < residual(r); });
+  const auto worst =
+      std::max_element(columns.begin(), columns.end(),
+                       [&](const auto& l, const auto& r) { return residual(l) < residual(r); });
   std::vector<std::pair<double, double>> others(columns.begin(), worst);
   others.insert(others.end(), worst + 1, columns.end());
   if (FitLine(others, &c, &e) && residual(*worst) > max_residual) columns = std::move(others);
@@ -634,6 +631,11 @@ bool TrackChainParams::IsValid(std::string* error) const {
     return fail("track_chain.centre_fit_rows must lie in 1..50");
   if (segment_columns < 2) return fail("track_chain.segment_columns must be at least 2");
   if (!(tuned_pitch > 0)) return fail("track_chain.tuned_pitch must be positive");
+  if (!(native_pitch_min > 0.0 && native_pitch_min <= tuned_pitch &&
+        tuned_pitch <= native_pitch_max))
+    return fail("track_chain: 0 < native_pitch_min <= tuned_pitch <= native_pitch_max must hold");
+  if (!(min_scale > 0.0 && min_scale <= 1.0))
+    return fail("track_chain.min_scale must lie in (0, 1]");
   return true;
 }
 

@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <tuple>
-#include <optional>
-#include <vector>
-
 #include <opencv2/imgproc.hpp>
+#include <optional>
+#include <tuple>
+#include <vector>
 
 #include "bsls/extraction/stripe_centre.h"
 #include "bsls/extraction/stripe_pitch.h"
@@ -186,7 +185,8 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
   };
   const int want = params.track_chain.segment_columns;
   if (junction.segment_left) {
-    for (int i = static_cast<int>(seg.size()) - 1; i >= 0 && static_cast<int>(columns.size()) < want; --i)
+    for (int i = static_cast<int>(seg.size()) - 1;
+         i >= 0 && static_cast<int>(columns.size()) < want; --i)
       take(seg[i]);
   } else {
     for (size_t i = 0; i < seg.size() && static_cast<int>(columns.size()) < want; ++i) take(seg[i]);
@@ -203,8 +203,7 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
   Samples above, below;
   for (const Sample& s : near) (s.first < 0 ? above : below).push_back(s);
   double a_above, b_above, a_below, b_below;
-  const bool both_sides =
-      FitLine(above, &a_above, &b_above) && FitLine(below, &a_below, &b_below);
+  const bool both_sides = FitLine(above, &a_above, &b_above) && FitLine(below, &a_below, &b_below);
   if (!both_sides || std::abs(b_above - b_below) > params.fold_slope_change) {
     // The track's ridge points, with those of the tracks continuing it
     // across a gap above and below (joined by a chord).
@@ -246,15 +245,16 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
 }
 
 // The line and segment tracks' ridge points drawn on a CV_8UC1 image of
-// the full frame's `size` (0/255); found on a frame binned n x n (n > 1),
-// each track as a polyline through its points' full-frame pixels.
-cv::Mat DrawTracks(const interpretation::TrackNetwork& net, int n, cv::Size size) {
+// the full frame's `size` (0/255); found on a resampled frame, each track as
+// a polyline through its points' full-frame pixels.
+cv::Mat DrawTracks(const interpretation::TrackNetwork& net, const WorkingScale& scale,
+                   cv::Size size) {
   cv::Mat out = cv::Mat::zeros(size, CV_8UC1);
   std::vector<cv::Point> path;
   auto draw = [&](const std::vector<interpretation::Track>& tracks,
                   const extraction::RidgePoints& points, bool transposed) {
     for (const interpretation::Track& track : tracks) {
-      if (n == 1) {  // each point on its own pixel, next to its neighbours
+      if (scale.IsIdentity()) {  // each point on its own pixel, next to its neighbours
         for (int k : track.points) {
           const extraction::RidgePoint& p = points.points[k];
           const int x = static_cast<int>(std::lround(p.x));
@@ -266,7 +266,7 @@ cv::Mat DrawTracks(const interpretation::TrackNetwork& net, int n, cv::Size size
       for (int k : track.points) {
         const extraction::RidgePoint& p = points.points[k];
         const cv::Point2d at =
-            ToFullFrame(transposed ? cv::Point2d(p.y, p.x) : cv::Point2d(p.x, p.y), n);
+            scale.ToFull(transposed ? cv::Point2d(p.y, p.x) : cv::Point2d(p.x, p.y));
         path.emplace_back(static_cast<int>(std::lround(at.x)), static_cast<int>(std::lround(at.y)));
       }
       cv::polylines(out, path, false, cv::Scalar(255), 1, cv::LINE_8);
@@ -277,20 +277,21 @@ cv::Mat DrawTracks(const interpretation::TrackNetwork& net, int n, cv::Size size
   return out;
 }
 
-// A line's centres on the binned frame (one per binned row, ordered by y)
+// A line's centres on the working frame (one per working row, ordered by y)
 // as one per row of the full frame: each mapped to the full frame and the
-// rows between two consecutive binned rows interpolated linearly; no row is
-// filled across a binned row without a centre.
-std::vector<cv::Point2d> RowsOfFullFrame(const std::vector<cv::Point2d>& binned, int n) {
+// full rows between two consecutive working rows interpolated linearly; no
+// row is filled across a working row without a centre.
+std::vector<cv::Point2d> RowsOfFullFrame(const std::vector<cv::Point2d>& working,
+                                         const WorkingScale& scale) {
   std::vector<cv::Point2d> out;
-  for (size_t k = 0; k < binned.size(); ++k) {
-    const cv::Point2d a = ToFullFrame(binned[k], n);
-    const bool joined = k + 1 < binned.size() && binned[k + 1].y - binned[k].y == 1.0;
+  for (size_t k = 0; k < working.size(); ++k) {
+    const cv::Point2d a = scale.ToFull(working[k]);
+    const bool joined = k + 1 < working.size() && working[k + 1].y - working[k].y == 1.0;
     if (!joined) {
-      if (a.y == std::floor(a.y)) out.push_back(a);  // an odd n: a full row of its own
+      if (a.y == std::floor(a.y)) out.push_back(a);  // on a full row of its own
       continue;
     }
-    const cv::Point2d b = ToFullFrame(binned[k + 1], n);
+    const cv::Point2d b = scale.ToFull(working[k + 1]);
     for (int y = static_cast<int>(std::ceil(a.y)); y < b.y; ++y)
       out.emplace_back(a.x + (b.x - a.x) * (y - a.y) / (b.y - a.y), y);
   }
@@ -303,14 +304,16 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
                     DecodeResult* result) {
   const TrackChainParams& tp = params.track_chain;
   auto t = Clock::now();
-  // The working resolution: a frame whose stripes lie n times further apart
-  // than the pixel sizes are tuned for is binned n x n.
+  // The working resolution: the frame resampled so that its stripes lie
+  // about as far apart as the pixel sizes are tuned for.
   if (params.binning == 0)
     result->pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
-  const int n = BinningFor(result->pitch, tp.tuned_pitch, params);
-  result->binning = n;
+  const double factor = WorkingFactor(result->pitch, params);
+  cv::Mat working;
+  const WorkingScale scale = ResampleFrame(grey, factor, &working);
+  result->scale = factor;
+  result->binning = std::max(1, static_cast<int>(std::lround(factor)));
   result->region = cv::Rect(0, 0, grey.cols, grey.rows);
-  const cv::Mat working = BinFrame(grey, n);
   cv::Mat smoothed;
   cv::GaussianBlur(working, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
                    cv::BORDER_REPLICATE);
@@ -326,7 +329,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
   // The tracks' ridge points, as the skeleton chain's repaired skeleton.
-  result->skeleton = DrawTracks(net, n, grey.size());
+  result->skeleton = DrawTracks(net, scale, grey.size());
   if (!labels.ok) {
     result->error = labels.error;
     return;
@@ -350,7 +353,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   const int q_offset = params.q_offset.value_or(0);
   std::vector<std::tuple<int, int, int>> claims;  // (p, v, junction), in junction order
   for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
-    if (labels.p[j] != interpretation::kUnlabelled) claims.emplace_back(labels.p[j], labels.v[j], j);
+    if (labels.p[j] != interpretation::kUnlabelled)
+      claims.emplace_back(labels.p[j], labels.v[j], j);
   std::sort(claims.begin(), claims.end());
   auto on_own_line = [&](int j) { return labels.line_p[net.junctions[j].line] == labels.p[j]; };
   std::vector<int> placed;
@@ -360,7 +364,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     for (; k < claims.size() && std::get<0>(claims[k]) == std::get<0>(claims[i]) &&
            std::get<1>(claims[k]) == std::get<1>(claims[i]);
          ++k)
-      if (!on_own_line(keeper) && on_own_line(std::get<2>(claims[k]))) keeper = std::get<2>(claims[k]);
+      if (!on_own_line(keeper) && on_own_line(std::get<2>(claims[k])))
+        keeper = std::get<2>(claims[k]);
     result->label_conflicts += static_cast<int>(k - i) - 1;
     placed.push_back(keeper);
     i = k;
@@ -373,8 +378,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       d.p = labels.p[j];
       d.q = labels.v[j] + q_offset;
       d.kind = net.junctions[j].kind;
-      d.position = ToFullFrame(
-          PlaceJunction(working, net, j, centres[net.junctions[j].line], params), n);
+      d.position =
+          scale.ToFull(PlaceJunction(working, net, j, centres[net.junctions[j].line], params));
     }
   });
 
@@ -383,7 +388,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
     if (labels.p[j] == interpretation::kUnlabelled)
       result->unlabelled.push_back(
-          {ToFullFrame(net.junctions[j].position, n), net.junctions[j].kind});
+          {scale.ToFull(net.junctions[j].position), net.junctions[j].kind});
   std::sort(result->unlabelled.begin(), result->unlabelled.end(),
             [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
               return a.position.y < b.position.y;
@@ -413,8 +418,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     for (int y = 0; y < working.rows; ++y)
       if (!std::isnan(row_x[y])) line.points.emplace_back(row_x[y], y);
   }
-  if (n > 1)
-    for (DecodedLine& line : result->lines) line.points = RowsOfFullFrame(line.points, n);
+  if (!scale.IsIdentity())
+    for (DecodedLine& line : result->lines) line.points = RowsOfFullFrame(line.points, scale);
   result->times.subpixel_ms = MsSince(t);
   result->ok = true;
 }

@@ -8,6 +8,9 @@
 namespace bsls::decoder::internal {
 namespace {
 
+// A reduction within this fraction of a whole factor is made by that factor.
+constexpr double kWholeFactorSpread = 0.1;
+
 // The full-frame pixel at the centre of binned pixel p (n odd: exact; n even:
 // the one just above and left of the centre).
 cv::Point Centre(const cv::Point& p, int n) {
@@ -50,8 +53,30 @@ std::vector<cv::Point> RedrawSet(const std::vector<cv::Point>& pixels, const cv:
 int BinningFor(double pitch, double tuned_pitch, const DecodeParams& params) {
   if (params.binning > 0) return params.binning;
   if (pitch <= 0.0) return 1;
-  return std::clamp(static_cast<int>(std::lround(pitch / tuned_pitch)), 1,
-                    params.max_binning);
+  return std::clamp(static_cast<int>(std::lround(pitch / tuned_pitch)), 1, params.max_binning);
+}
+
+double WorkingFactor(double pitch, const DecodeParams& params) {
+  const TrackChainParams& tp = params.track_chain;
+  if (params.binning > 0) return params.binning;
+  if (!(pitch > 0.0) || (pitch >= tp.native_pitch_min && pitch <= tp.native_pitch_max)) return 1.0;
+  const double factor =
+      std::clamp(pitch / tp.tuned_pitch, tp.min_scale, static_cast<double>(params.max_binning));
+  // Near a whole factor, the whole one: exact block means, as a sensor bins.
+  const double whole = std::round(factor);
+  return whole >= 2.0 && std::abs(factor - whole) <= kWholeFactorSpread * whole ? whole : factor;
+}
+
+WorkingScale ResampleFrame(const cv::Mat& grey, double factor, cv::Mat* working) {
+  if (factor == 1.0) {
+    *working = grey;
+    return {};
+  }
+  const cv::Size size(std::max(1, static_cast<int>(std::lround(grey.cols / factor))),
+                      std::max(1, static_cast<int>(std::lround(grey.rows / factor))));
+  cv::resize(grey, *working, size, 0, 0, factor > 1.0 ? cv::INTER_AREA : cv::INTER_CUBIC);
+  return {static_cast<double>(grey.cols) / size.width,
+          static_cast<double>(grey.rows) / size.height};
 }
 
 cv::Mat BinFrame(const cv::Mat& grey, int n) {

@@ -53,6 +53,32 @@ class GreyHistogram {
 // interpretation finds the reference line among the frame's central rows.
 cv::Rect PatternColumns(const cv::Mat& grey, int n, double rise, int margin);
 
+// The track chain's working frame: full-frame pixels per working pixel along
+// x and y (above 1: the frame was reduced, below 1: enlarged).
+struct WorkingScale {
+  double x = 1.0, y = 1.0;
+
+  bool IsIdentity() const { return x == 1.0 && y == 1.0; }
+  // A working frame's point in full-frame pixel coordinates (pixel centres
+  // at whole numbers in both).
+  cv::Point2d ToFull(const cv::Point2d& p) const {
+    return {(p.x + 0.5) * x - 0.5, (p.y + 0.5) * y - 0.5};
+  }
+};
+
+// The factor (full-frame px per working px) that brings a measured stripe
+// pitch `pitch` (px; 0: none) to the track chain's tuned pitch:
+// params.binning when set; 1 when the pitch is unknown or within the
+// chain's native range; otherwise pitch / tuned_pitch within
+// [min_scale, params.max_binning].
+double WorkingFactor(double pitch, const DecodeParams& params);
+
+// `grey` (CV_8UC1) resampled by `factor` (full px per working px) into
+// `working`: reduced by area averaging (a whole factor is the exact block
+// mean), enlarged by cubic interpolation; the frame itself for factor 1.
+// Returns the exact scale of the sizes made.
+WorkingScale ResampleFrame(const cv::Mat& grey, double factor, cv::Mat* working);
+
 // A binned frame's point in full-frame pixel coordinates.
 cv::Point2d ToFullFrame(const cv::Point2d& p, int n);
 

@@ -2,11 +2,77 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
 #include "input_checks.h"
 
 namespace bsls::extraction {
+namespace {
+
+// Median of `v` (reordered); 0 for none.
+double Median(std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  auto middle = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), middle, v.end());
+  return *middle;
+}
+
+// The row's pixel noise (sigma): the median absolute second difference,
+// which the smooth profile of a stripe hardly touches, scaled for Gaussian
+// noise (a second difference has sqrt(6) sigma).
+double RowNoise(const uchar* row, int width, std::vector<double>* scratch) {
+  scratch->clear();
+  for (int x = 1; x + 1 < width; ++x)
+    scratch->push_back(std::abs(static_cast<double>(row[x - 1]) - 2.0 * row[x] + row[x + 1]));
+  return 1.4826 * Median(*scratch) / std::sqrt(6.0);
+}
+
+// The sub-pixel ridges of one smoothed row that stand out by `least`:
+// local maxima (the first pixel of a flat top) whose prominence, looked for
+// within `reach` px on either side, reaches it; each refined by a parabola.
+void RowRidges(const float* r, int width, double least, int reach, std::vector<double>* ridges) {
+  ridges->clear();
+  for (int x = 1; x + 1 < width; ++x) {
+    if (!(r[x] > r[x - 1])) continue;
+    int end = x;  // the last pixel of a flat top
+    while (end + 1 < width && r[end + 1] == r[x]) ++end;
+    if (end + 1 >= width || !(r[end + 1] < r[x])) {
+      x = end;
+      continue;
+    }
+    // The lowest point on each side before a higher one (or the reach).
+    float left = r[x], right = r[x];
+    for (int k = x - 1; k >= std::max(0, x - reach) && r[k] <= r[x]; --k)
+      left = std::min(left, r[k]);
+    for (int k = end + 1; k < std::min(width, end + 1 + reach) && r[k] <= r[x]; ++k)
+      right = std::min(right, r[k]);
+    if (r[x] - std::max(left, right) >= least) {
+      double at = 0.5 * (x + end);
+      if (end == x) {
+        const double curvature = r[x - 1] - 2.0 * r[x] + r[x + 1];
+        if (curvature < 0.0) at += std::clamp(0.5 * (r[x - 1] - r[x + 1]) / curvature, -0.5, 0.5);
+      }
+      ridges->push_back(at);
+    }
+    x = end;
+  }
+}
+
+// The densest cluster of sorted `spacings` (members within `spread` of its
+// smallest, relatively): its first and one-past-last index.
+std::pair<size_t, size_t> DensestCluster(const std::vector<double>& spacings, double spread) {
+  std::pair<size_t, size_t> best{0, 0};
+  for (size_t i = 0, j = 0; i < spacings.size(); ++i) {
+    j = std::max(j, i);
+    while (j < spacings.size() && spacings[j] <= spacings[i] * (1.0 + spread)) ++j;
+    if (j - i > best.second - best.first) best = {i, j};
+  }
+  return best;
+}
+
+}  // namespace
 
 bool StripePitchParams::IsValid(std::string* error) const {
   auto fail = [error](const char* why) {
@@ -18,11 +84,16 @@ bool StripePitchParams::IsValid(std::string* error) const {
   if (!(min_pitch >= 2.0)) return fail("min_pitch must be at least 2 px");
   if (!(max_pitch_fraction > 0.0 && max_pitch_fraction <= 0.5))
     return fail("max_pitch_fraction must lie in (0, 0.5]");
-  if (!(min_correlation > 0.0 && min_correlation < 1.0))
-    return fail("min_correlation must lie in (0, 1)");
-  if (!(min_significance >= 0.0)) return fail("min_significance must not be negative");
-  if (!(harmonic_ratio > 0.0 && harmonic_ratio <= 1.0))
-    return fail("harmonic_ratio must lie in (0, 1]");
+  if (!(smoothing_sigma >= 0.0 && smoothing_sigma <= 16.0))
+    return fail("smoothing_sigma must lie in [0, 16] px");
+  if (!(min_prominence_noise >= 0.0 && min_prominence_noise <= 1000.0))
+    return fail("min_prominence_noise must lie in [0, 1000]");
+  if (!(min_prominence_contrast >= 0.0 && min_prominence_contrast < 1.0))
+    return fail("min_prominence_contrast must lie in [0, 1)");
+  if (!(cluster_spread > 0.0 && cluster_spread < 1.0))
+    return fail("cluster_spread must lie in (0, 1)");
+  if (min_spacings < 1) return fail("min_spacings must be at least 1");
+  if (!(min_share > 0.0 && min_share <= 1.0)) return fail("min_share must lie in (0, 1]");
   return true;
 }
 
@@ -30,60 +101,69 @@ std::optional<double> MeasureStripePitch(const cv::Mat& grey, const StripePitchP
   internal::RequireGrey8(grey, "MeasureStripePitch");
   internal::RequireValid(params, "MeasureStripePitch");
   const int width = grey.cols;
-  const int max_lag = static_cast<int>(std::floor(params.max_pitch_fraction * width));
-  if (width < 8 || max_lag + 2 >= width - 1 || max_lag < params.min_pitch) return std::nullopt;
+  const double max_pitch = std::floor(params.max_pitch_fraction * width);
+  if (width < 8 || max_pitch < params.min_pitch) return std::nullopt;
+  const int reach = static_cast<int>(max_pitch);
   const int y0 = static_cast<int>(std::floor(0.5 * (1.0 - params.central_band) * grey.rows));
   const int y1 =
       std::max(y0 + 1, static_cast<int>(std::ceil(0.5 * (1.0 + params.central_band) * grey.rows)));
   const int rows = std::min(params.sampled_rows, y1 - y0);
-  // Each sampled row's differences along x, zero-padded to twice its length
-  // (a linear, not circular, correlation).
-  const int n = cv::getOptimalDFTSize(2 * width);
-  cv::Mat edges = cv::Mat::zeros(rows, n, CV_32F);
+
+  std::vector<double> spacings, scratch, ridges;
+  cv::Mat smoothed;
   for (int i = 0; i < rows; ++i) {
     const int y = y0 + static_cast<int>((i + 0.5) * (y1 - y0) / rows);
-    const uchar* in = grey.ptr<uchar>(y);
-    float* out = edges.ptr<float>(i);
-    for (int x = 0; x + 1 < width; ++x) out[x] = static_cast<float>(in[x + 1]) - in[x];
-  }
-  // Summed power spectra, back to the summed autocorrelation.
-  cv::Mat spectra, power, summed, correlation;
-  cv::dft(edges, spectra, cv::DFT_ROWS);
-  cv::mulSpectrums(spectra, spectra, power, cv::DFT_ROWS, /*conjB=*/true);
-  cv::reduce(power, summed, 0, cv::REDUCE_SUM, CV_32F);
-  cv::dft(summed, correlation, cv::DFT_INVERSE | cv::DFT_REAL_OUTPUT);
-  const float* raw = correlation.ptr<float>(0);
-  std::vector<double> c(static_cast<size_t>(max_lag + 2));
-  for (int lag = 0; lag <= max_lag + 1; ++lag)
-    c[lag] = raw[lag] / static_cast<double>(width - 1 - lag);
-  if (!(c[0] > 0.0)) return std::nullopt;  // a flat band
-  // The first zero crossing, then the highest lag beyond it.
-  int first = 1;
-  while (first <= max_lag && c[first] > 0.0) ++first;
-  first = std::max(first, static_cast<int>(std::ceil(params.min_pitch)));
-  int highest = -1;
-  for (int lag = first; lag <= max_lag; ++lag)
-    if (highest < 0 || c[lag] > c[highest]) highest = lag;
-  // White noise alone correlates by about 1 / sqrt(pairs) of lag 0.
-  const double pairs = static_cast<double>(rows) * (width - 1);
-  const double least =
-      c[0] * std::max(params.min_correlation, params.min_significance / std::sqrt(pairs));
-  if (highest < 0 || c[highest] < least) return std::nullopt;
-  // A comb whose pitch is not a whole number of pixels repeats exactly only
-  // at a multiple of it, which may correlate a little higher: the first peak
-  // that comes near the highest is the pitch.
-  int best = highest;
-  for (int lag = first; lag < highest; ++lag)
-    if (c[lag] >= params.harmonic_ratio * c[highest] && c[lag] >= c[lag - 1] &&
-        c[lag] >= c[lag + 1]) {
-      best = lag;
-      break;
+    const cv::Mat row = grey.row(y);
+    if (params.smoothing_sigma > 0.0)
+      cv::GaussianBlur(row, smoothed, cv::Size(0, 1), params.smoothing_sigma, 0.0,
+                       cv::BORDER_REPLICATE);
+    else
+      smoothed = row;
+    smoothed.convertTo(smoothed, CV_32F);
+    const float* r = smoothed.ptr<float>(0);
+    // The smoothing leaves 1 / (2 sqrt(pi) sigma)^(1/2) of white noise's sigma.
+    const double kept =
+        params.smoothing_sigma > 0.5
+            ? 1.0 / std::sqrt(2.0 * std::sqrt(std::numbers::pi) * params.smoothing_sigma)
+            : 1.0;
+    const double noise = RowNoise(grey.ptr<uchar>(y), width, &scratch) * kept;
+    scratch.assign(r, r + width);
+    std::sort(scratch.begin(), scratch.end());
+    const double spread = scratch[scratch.size() * 95 / 100] - scratch[scratch.size() * 5 / 100];
+    const double least = std::max(
+        {params.min_prominence_noise * noise, params.min_prominence_contrast * spread, 1e-3});
+    RowRidges(r, width, least, reach, &ridges);
+    for (size_t k = 1; k < ridges.size(); ++k) {
+      const double s = ridges[k] - ridges[k - 1];
+      if (s >= params.min_pitch && s <= max_pitch) spacings.push_back(s);
     }
-  const double below = c[best - 1], at = c[best], above = c[best + 1];
-  const double curvature = below - 2.0 * at + above;
-  const double offset =
-      curvature < 0.0 ? std::clamp(0.5 * (below - above) / curvature, -0.5, 0.5) : 0.0;
-  return best + offset;
+  }
+  if (spacings.empty()) return std::nullopt;
+  std::sort(spacings.begin(), spacings.end());
+  auto [first, last] = DensestCluster(spacings, params.cluster_spread);
+  // A cluster at half the spacing with at least half the count is the pitch.
+  std::vector<double> cluster(spacings.begin() + first, spacings.begin() + last);
+  const double half = 0.5 * Median(cluster);
+  {
+    const auto lo =
+        std::lower_bound(spacings.begin(), spacings.end(), half / (1.0 + params.cluster_spread));
+    const auto hi =
+        std::upper_bound(spacings.begin(), spacings.end(), half * (1.0 + params.cluster_spread));
+    std::vector<double> below(lo, hi);
+    if (!below.empty()) {
+      const auto [b0, b1] = DensestCluster(below, params.cluster_spread);
+      if (2 * (b1 - b0) >= last - first) {
+        first = static_cast<size_t>(lo - spacings.begin()) + b0;
+        last = static_cast<size_t>(lo - spacings.begin()) + b1;
+      }
+    }
+  }
+  const size_t count = last - first;
+  if (static_cast<int>(count) < params.min_spacings ||
+      static_cast<double>(count) < params.min_share * spacings.size())
+    return std::nullopt;
+  cluster.assign(spacings.begin() + first, spacings.begin() + last);
+  return Median(cluster);
 }
 
 }  // namespace bsls::extraction

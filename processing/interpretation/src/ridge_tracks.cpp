@@ -100,7 +100,8 @@ std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
       }
       Track piece;
       for (; i < n && !steep[i]; ++i) piece.points.push_back(t.points[i]);
-      if (static_cast<int>(piece.points.size()) >= params.min_track) out.push_back(std::move(piece));
+      if (static_cast<int>(piece.points.size()) >= params.min_track)
+        out.push_back(std::move(piece));
     }
   }
   return out;
@@ -128,22 +129,40 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
     const double d = std::hypot(b.x - a.x, static_cast<double>(rows_between));
     return d <= params.bridge_distance ? d : -1.0;
   };
+  // Tracks by the row of their first point, each row's by its x, so that a
+  // track's end looks only at the starts it can reach (linear in tracks).
+  std::vector<std::vector<int>> starting(
+      net.rows.row_start.empty() ? 0 : net.rows.row_start.size() - 1);
+  for (int b = 0; b < n_lines; ++b) starting[first(b).y].push_back(b);
+  for (std::vector<int>& row : starting)
+    std::sort(row.begin(), row.end(), [&](int u, int v) { return first(u).x < first(v).x; });
   std::vector<int> nearest_below(n_lines, -1), nearest_above(n_lines, -1);
   std::vector<double> below_d(n_lines, 0), above_d(n_lines, 0);
-  for (int a = 0; a < n_lines; ++a)
-    for (int b = 0; b < n_lines; ++b) {
-      if (a == b) continue;
-      const double d = gap(a, b);
-      if (d < 0) continue;
-      if (nearest_below[a] < 0 || d < below_d[a]) {
-        nearest_below[a] = b;
-        below_d[a] = d;
-      }
-      if (nearest_above[b] < 0 || d < above_d[b]) {
-        nearest_above[b] = a;
-        above_d[b] = d;
+  for (int a = 0; a < n_lines; ++a) {
+    const extraction::RidgePoint end = last(a);
+    const int y_end =
+        std::min<int>(end.y + params.bridge_rows, static_cast<int>(starting.size()) - 1);
+    for (int y = end.y + 1; y <= y_end; ++y) {
+      const std::vector<int>& row = starting[y];
+      auto k = std::lower_bound(row.begin(), row.end(), end.x - params.bridge_distance,
+                                [&](int b, double x) { return first(b).x < x; });
+      for (; k != row.end() && first(*k).x <= end.x + params.bridge_distance; ++k) {
+        const int b = *k;
+        if (a == b) continue;
+        const double d = gap(a, b);
+        if (d < 0) continue;
+        // Ties go to the lower index, as a scan of every pair in order gives.
+        if (nearest_below[a] < 0 || d < below_d[a] || (d == below_d[a] && b < nearest_below[a])) {
+          nearest_below[a] = b;
+          below_d[a] = d;
+        }
+        if (nearest_above[b] < 0 || d < above_d[b]) {
+          nearest_above[b] = a;
+          above_d[b] = d;
+        }
       }
     }
+  }
   net.line_below.assign(n_lines, -1);
   net.line_above.assign(n_lines, -1);
   for (int a = 0; a < n_lines; ++a) {
@@ -153,6 +172,14 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
       net.line_above[b] = a;
     }
   }
+
+  // The bridged gaps by row: gap a (from line a's last point to the first of
+  // line_below[a]) is listed at every row from its upper end to the row
+  // before its lower end, each row's in ascending a.
+  std::vector<std::vector<int>> gaps_at(starting.size());
+  for (int a = 0; a < n_lines; ++a)
+    if (net.line_below[a] >= 0)
+      for (int y = last(a).y; y < first(net.line_below[a]).y; ++y) gaps_at[y].push_back(a);
 
   // The line point of row y within [lo, hi] nearest to `at`, or -1.
   auto line_point = [&](int y, double lo, double hi, double at) {
@@ -167,7 +194,7 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
   };
   const int towards_p = pattern::ImageDirectionOfIncreasingP(side);
   const auto& cp = net.columns.points;  // x: image row, y: image column
-  geometry::Samples in;  // a segment's end: (column - the end's column, row)
+  geometry::Samples in;                 // a segment's end: (column - the end's column, row)
   for (int s = 0; s < static_cast<int>(net.segments.size()); ++s) {
     const std::vector<int>& t = net.segments[s].points;
     if (static_cast<int>(t.size()) < params.min_segment) continue;
@@ -186,7 +213,8 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
       const int n_points = static_cast<int>(t.size());
       if (n_points >= params.end_skip + 2) {
         in.clear();
-        for (int k = params.end_skip; k < std::min(n_points, params.end_skip + params.end_fit); ++k) {
+        for (int k = params.end_skip; k < std::min(n_points, params.end_skip + params.end_fit);
+             ++k) {
           const extraction::RidgePoint& q = cp[left_end ? t[k] : t[n_points - 1 - k]];
           in.emplace_back(q.y - ex, q.x);
         }
@@ -208,9 +236,13 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
       } else {
         // No ridge point there: the end may meet a line across a gap, on the
         // chord joining its two tracks (a break next to the junction).
-        for (int a = 0; a < n_lines && j.line < 0; ++a) {
+        const int gap_row = std::isfinite(ey) ? static_cast<int>(std::floor(ey)) : -1;
+        const std::vector<int> none;
+        const std::vector<int>& crossing =
+            gap_row >= 0 && gap_row < static_cast<int>(gaps_at.size()) ? gaps_at[gap_row] : none;
+        for (size_t g = 0; g < crossing.size() && j.line < 0; ++g) {
+          const int a = crossing[g];
           const int b = net.line_below[a];
-          if (b < 0) continue;
           const extraction::RidgePoint p0 = last(a), p1 = first(b);
           if (ey <= p0.y || ey >= p1.y) continue;
           const double x = p0.x + (p1.x - p0.x) * (ey - p0.y) / (p1.y - p0.y);

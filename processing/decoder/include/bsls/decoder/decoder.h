@@ -57,11 +57,17 @@ enum class DecodeChain {
 
 // The track chain's own stages (DecodeChain::kTracks).
 struct TrackChainParams {
-  // The pixel sizes below hold for a stripe pitch near this (px, > 0); a
-  // frame whose measured pitch is n times wider is binned n x n
-  // (DecodeParams::pitch, max_binning and binning apply as for the skeleton
-  // chain).
+  // The pixel sizes below hold for stripe pitches from native_pitch_min to
+  // native_pitch_max px (the thesis scenes they were tuned on span 10.4 to
+  // 20.8 px): a frame whose measured pitch (DecodeParams::pitch) lies
+  // outside is resampled by pitch / tuned_pitch, reduced by area averaging
+  // up to DecodeParams::max_binning times or enlarged by cubic interpolation
+  // down to min_scale (DecodeParams::binning forces a whole factor, for
+  // tests and benchmarks). 0 < min <= tuned <= max.
   double tuned_pitch = 15.0;
+  double native_pitch_min = 10.0;
+  double native_pitch_max = 22.0;
+  double min_scale = 1.0;  // (0, 1]
   double smoothing_sigma = 1.0;  // px, Gaussian applied before the ridge points, > 0
   extraction::RidgeParams ridge;
   interpretation::TrackParams tracks;
@@ -201,6 +207,9 @@ struct DecodeResult {
   // Diagnostics.
   double pitch = 0.0;  // measured stripe pitch, px of the frame (0: none found)
   int binning = 1;     // n: extraction and interpretation ran on the frame binned n x n
+  // The track chain's working frame: full-frame px per working px (above 1
+  // reduced, below 1 enlarged; 1: the frame itself).
+  double scale = 1.0;
   cv::Rect region;     // the part of the frame they ran on (DecodeParams::region_rise)
   // Sub-pixel centres measured ahead while the frame was interpreted
   // (DecodeParams::measure_ahead; 0: none). The output does not depend on it.

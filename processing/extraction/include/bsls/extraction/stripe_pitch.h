@@ -3,28 +3,32 @@
 // it never needs it). The decoder uses it to choose the working resolution at
 // which its pixel-sized parameters hold (docs/decoding.md, "Frame size").
 //
-// Method: sampled_rows rows evenly spaced over the central band of the frame
-// are differentiated along x (so that shading, the lit area's outline and the
-// dark ground do not count, only edges) and their autocorrelations summed
-// (through the DFT, zero-padded, so not circular; each lag divided by the
-// number of pixel pairs it has). The autocorrelation of the edges of a comb
-// of stripes falls below zero within the stripe width, then peaks at the
-// pitch; its multiples (2, 3 pitches) peak lower wherever the pitch varies
-// across the frame, but a perfect comb of a pitch that is no whole number of
-// pixels repeats exactly only at a multiple. The pitch is the first local
-// peak beyond the first zero crossing, within [min_pitch,
-// max_pitch_fraction * width], that reaches harmonic_ratio of the highest
-// one there, refined by a parabola through the three lags around it. Segments
-// (the rows' bright horizontal runs) have no edges along x and add nothing.
+// Method: the stripes' ridges along sampled_rows rows evenly spaced over
+// the central band of the frame. Each row is smoothed (smoothing_sigma) and
+// its local maxima kept where they stand out: a peak's prominence (its
+// height above the higher of the lowest points between it and a higher peak
+// on either side, looked for within the largest pitch) must reach
+// min_prominence_noise times the row's pixel noise (from the median absolute
+// second difference, which a stripe's smooth profile hardly touches) and
+// min_prominence_contrast of the row's spread of grey (95th - 5th
+// percentile). Each kept peak is refined by a parabola; the spacings of
+// neighbouring peaks are pooled over the rows. The pitch is the median of
+// the densest cluster of spacings (those within cluster_spread of one
+// another); a cluster at half that spacing with at least half its count is
+// taken instead (a stripe missing in every other place doubles a spacing,
+// nothing halves one). Segments (the rows' bright horizontal runs) make no
+// peaks of their own; an occluding edge or a shadow only removes spacings.
 //
-// Measured on the simulator's thesis scenes at 512 x 512 (the decoder's
-// evaluation set, docs/decoding.md; synthetic combs in tests/extraction/
-// stripe_pitch_test.cpp): plane 11.6 px, ball cap 10.4, face 15.2-15.4, ramp
-// 20.8 (the true line spacings at the centre row: 10-14, 6-16, 13-42, 20-22);
-// doubling the image size doubles the measurement to within 1 %. 16 rows
-// measure these scenes to within 2 % of 64 rows (4 % on the 2048 face) at a
-// quarter of the cost (0.08 ms at 512 x 512): enough for the binning, which
-// rounds the pitch to a multiple of about 21 px.
+// Why not the autocorrelation of the rows (the measurement before): where
+// the pitch changes across the frame (perspective, a face's side, an object
+// in front of the base plane), the autocorrelation's first peak smears out
+// and a multiple wins: 2x on the outside corpus's face/right, which was then
+// binned 2 x 2 and lost a fifth of its junctions, and 3.6x on a held-out
+// face of 8.7 px (tuning seed 44). Neighbouring ridges are the pitch by
+// definition, wherever they are.
+//
+// Cost: linear in the sampled pixels (each peak's walk is bounded by the
+// largest pitch).
 //
 // Images: CV_8UC1 grey, x = column, y = row.
 //
@@ -44,18 +48,21 @@ namespace bsls::extraction {
 
 struct StripePitchParams {
   double central_band = 0.6;         // fraction of the rows, centred, that are sampled, (0, 1]
-  int sampled_rows = 16;             // rows taken from the band (fewer if it is shorter), >= 1
+  int sampled_rows = 32;             // rows taken from the band (fewer if it is shorter), >= 1
   double min_pitch = 4.0;            // px, smallest pitch reported, >= 2
   double max_pitch_fraction = 0.25;  // largest pitch reported, fraction of the width, (0, 0.5]
-  // The pitch's autocorrelation must reach this fraction of the one at lag 0
-  // (a comb of stripes: 0.05-0.6; white noise: about 0), (0, 1),
-  double min_correlation = 0.01;
-  // and this many times what white noise alone reaches (1 / sqrt(pixel
-  // pairs) of lag 0), >= 0.
-  double min_significance = 6.0;
-  // The first local peak within this fraction of the highest is the pitch
-  // (the others are its multiples), (0, 1].
-  double harmonic_ratio = 0.8;
+  double smoothing_sigma = 1.0;      // px, Gaussian along the row, >= 0
+  // A ridge's prominence must reach this many times the row's pixel noise
+  // (sigma, after the smoothing), >= 0,
+  double min_prominence_noise = 6.0;
+  // and this fraction of the row's spread of grey, [0, 1).
+  double min_prominence_contrast = 0.1;
+  // Spacings within this fraction of one another form one cluster, (0, 1).
+  double cluster_spread = 0.15;
+  // At least this many spacings in the chosen cluster, >= 1,
+  int min_spacings = 12;
+  // and at least this share of all the spacings, (0, 1].
+  double min_share = 0.05;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
