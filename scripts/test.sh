@@ -4,7 +4,10 @@
 # again with clang, AddressSanitizer and UndefinedBehaviorSanitizer, runs the
 # same tests there (except those labelled `accuracy`: figures on full frames
 # or the whole chain against the acceptance bounds, whose code the other tests
-# already run under the sanitizers at a fraction of the time; and `timing`),
+# already run under the sanitizers at a fraction of the time; `timing`;
+# `python`: the Python clients driving the services, whose C++ side the
+# services' own tests and the malformed-request load run there; and `load`:
+# the failover's hundred sessions, whose calls the other service tests make),
 # and runs the libFuzzer targets for a bounded time. The malformed-request
 # load is 2,000 calls per service there instead of 10,000: the sanitizer stage
 # looks for memory errors and leaks, the first stage for the issue's figure.
@@ -39,6 +42,6 @@ stage_done "build ASan + UBSan"
 echo "== tests: AddressSanitizer + UBSan (fuzz included, accuracy figures left to the first stage)"
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-ctest --test-dir build/asan --output-on-failure -j "$jobs" -LE "accuracy|timing"
+ctest --test-dir build/asan --output-on-failure -j "$jobs" -LE "accuracy|timing|python|load"
 stage_done "tests ASan + UBSan"
 echo "== all tests passed in $root"
