@@ -187,6 +187,12 @@ TEST(CaptureStoreTest, ListFiltersAndPages) {
   bad.page_size = 0;
   bad.page_token = "not-a-token";
   EXPECT_EQ(store->List(bad).status().code(), ErrorCode::kInvalidArgument);
+  // A huge token is quoted in part: the message must fit a reply's metadata.
+  bad.page_token = std::string(60000, 'x');
+  const auto huge = store->List(bad);
+  EXPECT_EQ(huge.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_LT(huge.status().message().size(), 200u) << huge.status().message().substr(0, 200);
+  EXPECT_NE(huge.status().message().find("60000 bytes"), std::string::npos);
 }
 
 TEST(CaptureStoreTest, DeleteRemovesRowAndFiles) {

@@ -1,6 +1,8 @@
 #include "bsls/service/unix_listener.h"
 
 #include <fcntl.h>
+#include <grpcpp/server.h>
+#include <grpcpp/server_posix.h>
 #include <poll.h>
 #include <pwd.h>
 #include <sys/socket.h>
@@ -10,8 +12,6 @@
 
 #include <cerrno>
 #include <cstring>
-#include <grpcpp/server.h>
-#include <grpcpp/server_posix.h>
 #include <vector>
 
 namespace bsls::service {
@@ -38,6 +38,10 @@ std::size_t PeerRegistry::size() const {
 }
 
 namespace {
+
+// How long the accept loop waits after shedding a connection for want of
+// descriptors (EMFILE, ENFILE), before it accepts again.
+constexpr int kDescriptorBackoffMs = 50;
 
 std::string Errno(const std::string& what) { return what + ": " + std::strerror(errno); }
 
@@ -80,8 +84,7 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
       return Status(ErrorCode::kAlreadyExists,
                     "socket path " + options.path + " exists and is not a socket");
     if (SocketIsLive(address))
-      return Status(ErrorCode::kAlreadyExists,
-                    "another daemon is listening on " + options.path);
+      return Status(ErrorCode::kAlreadyExists, "another daemon is listening on " + options.path);
     ::unlink(options.path.c_str());  // left by a daemon that died
   }
   const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
@@ -95,7 +98,8 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
     return status;
   }
   if (::chmod(options.path.c_str(), options.mode) != 0 ||
-      (options.group && ::chown(options.path.c_str(), static_cast<uid_t>(-1), *options.group) != 0)) {
+      (options.group &&
+       ::chown(options.path.c_str(), static_cast<uid_t>(-1), *options.group) != 0)) {
     Status status(ErrorCode::kPermissionDenied, Errno("setting owner/mode of " + options.path));
     ::close(fd);
     ::unlink(options.path.c_str());
@@ -110,6 +114,8 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
   std::unique_ptr<UnixListener> listener(new UnixListener(options, fd));
   if (::pipe2(listener->wake_, O_CLOEXEC) != 0)
     return Status(ErrorCode::kUnavailable, Errno("pipe"));
+  listener->spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+  if (listener->spare_ < 0) return Status(ErrorCode::kUnavailable, Errno("open /dev/null"));
   return listener;
 }
 
@@ -118,6 +124,7 @@ UnixListener::~UnixListener() {
   if (fd_ >= 0) ::close(fd_);
   for (int& end : wake_)
     if (end >= 0) ::close(end);
+  if (spare_ >= 0) ::close(spare_);
 }
 
 void UnixListener::Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy) {
@@ -143,7 +150,25 @@ void UnixListener::AcceptLoop(grpc::Server* server, PeerRegistry* registry,
     }
     if (fds[1].revents != 0) return;
     const int connection = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-    if (connection < 0) continue;  // EAGAIN, ECONNABORTED, EMFILE: try the next one
+    if (connection < 0) {
+      if (errno == EMFILE || errno == ENFILE) {
+        // Out of descriptors: the waiting connection would keep poll awake
+        // and this loop spinning. Shed it through the spare descriptor,
+        // then wait a moment (or for Stop).
+        if (spare_ >= 0) {
+          ::close(spare_);
+          const int shed = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
+          if (shed >= 0) {
+            ::close(shed);
+            ++shed_;
+          }
+          spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
+        }
+        pollfd wake = {wake_[0], POLLIN, 0};
+        if (::poll(&wake, 1, kDescriptorBackoffMs) > 0) return;
+      }
+      continue;  // EAGAIN, ECONNABORTED: try the next one
+    }
     ucred credentials{};
     socklen_t length = sizeof(credentials);
     if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &credentials, &length) != 0) {

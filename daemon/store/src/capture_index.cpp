@@ -429,8 +429,14 @@ Result<CapturePage> CaptureIndex::List(const CaptureFilter& filter) {
   std::int64_t after_ns = 0;
   std::string after_id;
   if (!filter.page_token.empty() && !ParsePageToken(filter.page_token, &after_ns, &after_id)) {
+    // The token is the caller's: quoted only in part (a reply's metadata is small).
+    constexpr std::size_t kQuoted = 40;
+    const std::string quoted = filter.page_token.size() <= kQuoted
+                                   ? filter.page_token
+                                   : filter.page_token.substr(0, kQuoted) + "... (" +
+                                         std::to_string(filter.page_token.size()) + " bytes)";
     return Status(ErrorCode::kInvalidArgument,
-                  "page token \"" + filter.page_token + "\" was not made by this store");
+                  "page token \"" + quoted + "\" was not made by this store");
   }
   std::string sql = std::string("SELECT ") + kCaptureColumns + " FROM captures WHERE 1";
   if (filter.session_id) sql += " AND session_id = :session";

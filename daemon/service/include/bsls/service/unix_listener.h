@@ -76,6 +76,11 @@ class UnixListener {
   const std::string& path() const { return options_.path; }
   // Connections accepted so far.
   std::uint64_t accepted() const { return accepted_; }
+  // Connections shed because the process had no descriptor left for them
+  // (EMFILE, ENFILE): each is accepted on a descriptor kept spare for this
+  // and closed at once, so that its caller hears at once, and the loop
+  // waits a moment before it accepts again instead of spinning.
+  std::uint64_t shed() const { return shed_; }
 
  private:
   UnixListener(UnixListenerOptions options, int fd);
@@ -84,8 +89,10 @@ class UnixListener {
   UnixListenerOptions options_;
   int fd_ = -1;
   int wake_[2] = {-1, -1};  // a pipe that wakes the accept loop to stop
+  int spare_ = -1;          // /dev/null, given up to shed a connection at EMFILE
   std::thread thread_;
   std::atomic<std::uint64_t> accepted_{0};
+  std::atomic<std::uint64_t> shed_{0};
 };
 
 }  // namespace bsls::service

@@ -1,0 +1,132 @@
+// UnixListener when the process runs out of descriptors (issue 26): the
+// accept loop sheds the waiting callers at once and does not spin. The
+// listener runs in a child process whose descriptor limit is set just above
+// what it holds, so that each further connection meets EMFILE.
+#include "bsls/service/unix_listener.h"
+
+#include <grpcpp/server.h>
+#include <grpcpp/server_builder.h>
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bsls/v1/capture.grpc.pb.h"
+
+namespace bsls::service {
+namespace {
+
+// User + system CPU seconds of process `pid` (from /proc/<pid>/stat).
+double CpuSeconds(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::istringstream fields(text.substr(text.rfind(')') + 2));
+  std::string field;
+  long ticks = 0;
+  for (int i = 3; i <= 15 && fields >> field; ++i)
+    if (i == 14 || i == 15) ticks += std::stol(field);  // utime, stime
+  return static_cast<double>(ticks) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+}
+
+// A connected client socket to `path`, or -1.
+int Connect(const std::string& path) {
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
+  if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Descriptors open in this process.
+int OpenDescriptors() {
+  int n = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator("/proc/self/fd"))
+    ++n;
+  return n;
+}
+
+TEST(UnixListener, OutOfDescriptorsItShedsCallersAndDoesNotSpin) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("bsls_listener_" + std::to_string(::getpid()) + ".sock"))
+                               .string();
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    ::close(ready[0]);
+    v1::CaptureDaemon::Service unimplemented;  // a server needs one service
+    grpc::ServerBuilder builder;
+    builder.RegisterService(&unimplemented);
+    std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+    auto listener = UnixListener::Create({path, 0600});
+    if (!server) ::_exit(2);
+    if (!listener.ok()) ::_exit(5);
+    PeerRegistry registry;
+    RolePolicy policy;
+    (*listener)->Start(server.get(), &registry, &policy);
+    // Room for a few connections more, then EMFILE.
+    const rlim_t limit = static_cast<rlim_t>(OpenDescriptors() + 4);
+    const rlimit low{limit, limit};
+    if (::setrlimit(RLIMIT_NOFILE, &low) != 0) ::_exit(3);
+    const char byte = 1;
+    if (::write(ready[1], &byte, 1) != 1) ::_exit(4);
+    for (;;) ::pause();
+  }
+  ::close(ready[1]);
+  char byte = 0;
+  if (::read(ready[0], &byte, 1) != 1) {
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    FAIL() << "the listener did not start: exit " << WEXITSTATUS(status);
+  }
+  ::close(ready[0]);
+
+  // Far more callers than the child has descriptors for.
+  std::vector<int> clients;
+  for (int i = 0; i < 40; ++i) {
+    const int fd = Connect(path);
+    if (fd >= 0) clients.push_back(fd);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  const double cpu_before = CpuSeconds(child);
+  std::this_thread::sleep_for(std::chrono::seconds(2));
+  const double cpu_used = CpuSeconds(child) - cpu_before;
+  // Shed callers see their connection closed (end of file or a reset).
+  int closed = 0;
+  for (int fd : clients) {
+    timeval wait{0, 200000};
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &wait, sizeof wait);
+    char buffer[64];
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
+    if (n == 0 || (n < 0 && errno == ECONNRESET)) ++closed;
+    ::close(fd);
+  }
+  ::kill(child, SIGKILL);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  std::filesystem::remove(path);
+  ASSERT_GE(clients.size(), 30u);
+  // Spinning on EMFILE used a whole core (4.85 s of CPU in 5 s).
+  EXPECT_LT(cpu_used, 0.5) << "the accept loop spins";
+  EXPECT_GE(closed, 20) << "callers beyond the descriptor limit were not shed";
+}
+
+}  // namespace
+}  // namespace bsls::service
