@@ -200,6 +200,27 @@ TEST(Decoder, TheChinsBottomRowIsDecodedAndPlaced) {
 // so 10 px here; sub-pixel centres within 0.6 px (0.15 px at 512). Before the
 // working resolution (docs/decoding.md, "Frame size") this frame failed: its
 // reference line was not found.
+// A decode of a frame worked at another scale, scored against its truth:
+// labels matched within `reach` px (none wrong), line centres; checks that
+// the lines have one point per full-frame row, in order, and the skeleton
+// the frame's size.
+std::pair<simulator::LabelScore, simulator::LineScore> ScoreResizedFrame(
+    const simulator::Frame& frame, const DecodeResult& r, double reach) {
+  std::vector<simulator::PointLabel> decoded;
+  for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
+  const simulator::LabelScore score =
+      simulator::ScoreLabels(simulator::VisibleJunctions(frame.truth), decoded, reach);
+  EXPECT_EQ(score.wrong_p, 0) << score.Summary();
+  EXPECT_EQ(score.wrong_v, 0) << score.Summary();
+  std::vector<simulator::LinePoints> lines;
+  for (const DecodedLine& line : r.lines) lines.push_back({line.p, line.points});
+  for (const DecodedLine& line : r.lines)
+    for (size_t k = 1; k < line.points.size(); ++k)
+      EXPECT_GT(line.points[k].y, line.points[k - 1].y) << "line " << line.p;
+  EXPECT_EQ(r.skeleton.size(), frame.image.size());
+  return {score, simulator::ScoreLines(simulator::TruthLines(frame.truth), lines)};
+}
+
 class LargeFrame : public ::testing::TestWithParam<DecodeChain> {};
 
 TEST_P(LargeFrame, IsBinnedAndDecodedAsWell) {
@@ -221,23 +242,10 @@ TEST_P(LargeFrame, IsBinnedAndDecodedAsWell) {
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(r.pitch, 61.0, 3.0);
   EXPECT_EQ(r.binning, GetParam() == DecodeChain::kTracks ? 4 : 3);
-  std::vector<simulator::PointLabel> decoded;
-  for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
-  const simulator::LabelScore score = simulator::ScoreLabels(
-      simulator::VisibleJunctions(frame.truth), decoded, kMatchReach * kScale);
-  EXPECT_EQ(score.wrong_p, 0) << score.Summary();
-  EXPECT_EQ(score.wrong_v, 0) << score.Summary();
+  const auto [score, centres] = ScoreResizedFrame(frame, r, kMatchReach * kScale);
   EXPECT_GE(score.Recall(), 0.97) << score.Summary();
-  std::vector<simulator::LinePoints> lines;
-  for (const DecodedLine& line : r.lines) lines.push_back({line.p, line.points});
-  const simulator::LineScore centres =
-      simulator::ScoreLines(simulator::TruthLines(frame.truth), lines);
   EXPECT_LE(centres.rms, 0.15 * kScale) << "points " << centres.points;
   EXPECT_GT(centres.points, 15000);
-  for (const DecodedLine& line : r.lines)  // one point per row of the full frame, in order
-    for (size_t k = 1; k < line.points.size(); ++k)
-      ASSERT_GT(line.points[k].y, line.points[k - 1].y) << "line " << line.p;
-  EXPECT_EQ(r.skeleton.size(), frame.image.size());
   std::printf("2048 frame, %s chain: %s, line centres %.3f px RMS over %d points\n",
               ChainName(GetParam()).c_str(), score.Summary().c_str(), centres.rms, centres.points);
 }
@@ -272,24 +280,11 @@ TEST(Decoder, ASmallPitchIsEnlargedAndDecodedAsWell) {
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(r.pitch, 15.3 * kScale, 1.0);
   EXPECT_NEAR(r.scale, r.pitch / params.track_chain.tuned_pitch, 1e-9);
-  std::vector<simulator::PointLabel> decoded;
-  for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
-  const simulator::LabelScore score = simulator::ScoreLabels(
-      simulator::VisibleJunctions(frame.truth), decoded, kMatchReach * kScale);
-  EXPECT_EQ(score.wrong_p, 0) << score.Summary();
-  EXPECT_EQ(score.wrong_v, 0) << score.Summary();
+  const auto [score, centres] = ScoreResizedFrame(frame, r, kMatchReach * kScale);
   EXPECT_GE(score.Recall(), 0.9) << score.Summary();
-  std::vector<simulator::LinePoints> lines;
-  for (const DecodedLine& line : r.lines) lines.push_back({line.p, line.points});
-  const simulator::LineScore centres =
-      simulator::ScoreLines(simulator::TruthLines(frame.truth), lines);
   EXPECT_LE(centres.rms, 0.15) << "points " << centres.points;
-  for (const DecodedLine& line : r.lines)  // one point per row of the full frame, in order
-    for (size_t k = 1; k < line.points.size(); ++k)
-      ASSERT_GT(line.points[k].y, line.points[k - 1].y) << "line " << line.p;
-  EXPECT_EQ(r.skeleton.size(), frame.image.size());
-  std::printf("288 frame: %s, line centres %.3f px RMS over %d points\n",
-              score.Summary().c_str(), centres.rms, centres.points);
+  std::printf("288 frame: %s, line centres %.3f px RMS over %d points\n", score.Summary().c_str(),
+              centres.rms, centres.points);
 }
 
 // The 512 x 512 frames are not binned: their pitch is what the parameters
@@ -312,9 +307,9 @@ TEST(Decoder, ColumnsBesideThePatternAreLeftOutWithTheSameResult) {
     Side side;
     std::uint32_t seed;
   };
-  for (const Case& c : {Case{SurfaceKind::kFace, Side::kLeft, 1},
-                        Case{SurfaceKind::kFace, Side::kRight, 3},
-                        Case{SurfaceKind::kPlane, Side::kLeft, 3}}) {
+  for (const Case& c :
+       {Case{SurfaceKind::kFace, Side::kLeft, 1}, Case{SurfaceKind::kFace, Side::kRight, 3},
+        Case{SurfaceKind::kPlane, Side::kLeft, 3}}) {
     SCOPED_TRACE(std::string(simulator::ToString(c.kind)) + " " +
                  std::string(pattern::ToString(c.side)));
     const simulator::Frame frame = RenderFrame(c.kind, c.side, c.seed);
@@ -358,7 +353,8 @@ TEST(Decoder, JsonFollowsContracts) {
   EXPECT_EQ(j["width"], 512);
   EXPECT_EQ(j["height"], 512);
   ASSERT_FALSE(j["junctions"].empty());
-  for (const auto& k : {"x", "y", "p", "q", "kind"}) EXPECT_TRUE(j["junctions"][0].contains(k)) << k;
+  for (const auto& k : {"x", "y", "p", "q", "kind"})
+    EXPECT_TRUE(j["junctions"][0].contains(k)) << k;
   ASSERT_FALSE(j["lines"].empty());
   const auto& points = j["lines"][0]["points"];
   for (size_t i = 1; i < points.size(); ++i)  // ordered, one per row
