@@ -192,14 +192,6 @@ TEST(Decoder, TheChinsBottomRowIsDecodedAndPlaced) {
   }
 }
 
-// Frame size: a 2048 x 2048 face (stripe pitch about 61 px, four times the
-// thesis's) is decoded as well as a 512 one by either chain, each binning it
-// to the pitch its pixel sizes are tuned for (the skeleton chain 3 x 3 for
-// 21 px, the track chain 4 x 4 for 15 px). Its junctions are matched within
-// the same part of the pattern as at 512 (2.5 px there, 0.16 of the pitch),
-// so 10 px here; sub-pixel centres within 0.6 px (0.15 px at 512). Before the
-// working resolution (docs/decoding.md, "Frame size") this frame failed: its
-// reference line was not found.
 // A decode of a frame worked at another scale, scored against its truth:
 // labels matched within `reach` px (none wrong), line centres; checks that
 // the lines have one point per full-frame row, in order, and the skeleton
@@ -221,23 +213,36 @@ std::pair<simulator::LabelScore, simulator::LineScore> ScoreResizedFrame(
   return {score, simulator::ScoreLines(simulator::TruthLines(frame.truth), lines)};
 }
 
+// The thesis face on a `size` x `size` frame (noise as the 512 frames',
+// seed 1); `supersampling` 0 keeps the renderer's default.
+simulator::Frame FaceOfSize(int size, Side side, int supersampling = 0) {
+  simulator::ThesisSceneOptions options;
+  options.rig.width = size;
+  options.rig.height = size;
+  simulator::RenderParams render;
+  render.noise_sigma = kNoiseSigma;
+  render.seed = 1;
+  if (supersampling > 0) render.supersampling = supersampling;
+  return simulator::Render(simulator::ThesisScene(side, SurfaceKind::kFace, options), render);
+}
+
+// Frame size: a 2048 x 2048 face (stripe pitch about 61 px, four times the
+// thesis's) is decoded as well as a 512 one by either chain, each binning it
+// to the pitch its pixel sizes are tuned for (the skeleton chain 3 x 3 for
+// 21 px, the track chain 4 x 4 for 15 px). Its junctions are matched within
+// the same part of the pattern as at 512 (2.5 px there, 0.16 of the pitch),
+// so 10 px here; sub-pixel centres within 0.6 px (0.15 px at 512). Before the
+// working resolution (docs/decoding.md, "Frame size") this frame failed: its
+// reference line was not found.
 class LargeFrame : public ::testing::TestWithParam<DecodeChain> {};
 
 TEST_P(LargeFrame, IsBinnedAndDecodedAsWell) {
   constexpr int kSize = 2048;
   constexpr double kScale = kSize / 512.0;
-  simulator::ThesisSceneOptions options;
-  options.rig.width = kSize;
-  options.rig.height = kSize;
-  simulator::RenderParams render;
-  render.noise_sigma = kNoiseSigma;
-  render.seed = 1;
   // One ray per pixel: a 2048 pixel is a sixteenth of a 512 one, finer than
   // the 512 frames' 3 x 3 rays (and 9x quicker to render, most of this
   // test's time under the sanitizers).
-  render.supersampling = 1;
-  const simulator::Frame frame =
-      simulator::Render(simulator::ThesisScene(Side::kRight, SurfaceKind::kFace, options), render);
+  const simulator::Frame frame = FaceOfSize(kSize, Side::kRight, 1);
   const DecodeResult r = Decode(frame.image, Side::kRight, WithChain(GetParam()));
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(r.pitch, 61.0, 3.0);
@@ -266,14 +271,7 @@ INSTANTIATE_TEST_SUITE_P(BothChains, LargeFrame,
 TEST(Decoder, ASmallPitchIsEnlargedAndDecodedAsWell) {
   constexpr int kSize = 288;
   constexpr double kScale = kSize / 512.0;
-  simulator::ThesisSceneOptions options;
-  options.rig.width = kSize;
-  options.rig.height = kSize;
-  simulator::RenderParams render;
-  render.noise_sigma = kNoiseSigma;
-  render.seed = 1;
-  const simulator::Frame frame =
-      simulator::Render(simulator::ThesisScene(Side::kLeft, SurfaceKind::kFace, options), render);
+  const simulator::Frame frame = FaceOfSize(kSize, Side::kLeft);
   DecodeParams params;
   params.track_chain.min_scale = 0.5;
   const DecodeResult r = Decode(frame.image, Side::kLeft, params);
