@@ -285,6 +285,18 @@ TEST(Decoder, ASmallPitchIsEnlargedAndDecodedAsWell) {
               centres.rms, centres.points);
 }
 
+// A frame of noise has no pattern to label: refused, where it gave four
+// labelled junctions (and 31,000 unlabelled ones) before the pitch was
+// required.
+TEST(Decoder, NoiseIsRefusedNotLabelled) {
+  cv::Mat noise(1024, 1024, CV_8UC1);
+  cv::RNG(7).fill(noise, cv::RNG::UNIFORM, 0, 256);
+  const DecodeResult r = Decode(noise, Side::kLeft);
+  EXPECT_FALSE(r.ok);
+  EXPECT_TRUE(r.junctions.empty());
+  EXPECT_NE(r.error.find("no stripe pattern"), std::string::npos) << r.error;
+}
+
 // The 512 x 512 frames are not binned: their pitch is what the parameters
 // are tuned for.
 TEST(Decoder, ThesisSizeFrameIsNotBinned) {

@@ -306,8 +306,17 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   auto t = Clock::now();
   // The working resolution: the frame resampled so that its stripes lie
   // about as far apart as the pixel sizes are tuned for.
-  if (params.binning == 0)
+  if (params.binning == 0) {
     result->pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
+    // Without a regular spacing of stripes there is no pattern to label
+    // (noise, a blank or a covered slide): whatever the tracks would find
+    // there is not a label.
+    if (result->pitch == 0.0) {
+      result->error =
+          "no stripe pattern: the frame's central rows show no regular spacing of stripes";
+      return;
+    }
+  }
   const double factor = WorkingFactor(result->pitch, params);
   cv::Mat working;
   const WorkingScale scale = ResampleFrame(grey, factor, &working);
