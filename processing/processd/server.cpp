@@ -1,14 +1,44 @@
 #include "server.h"
 
 #include <spdlog/spdlog.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
 #include "bsls/rpc/tls.h"
 
 namespace bsls::processd {
+namespace {
+
+// True when something accepts connections on the Unix socket at `path`.
+bool SocketIsLive(const std::string& path) {
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  if (path.size() >= sizeof(address.sun_path)) return false;
+  std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
+  const int probe = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (probe < 0) return false;
+  const bool live =
+      ::connect(probe, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
+  ::close(probe);
+  return live;
+}
+
+// The (device, inode) of the file at `path`, if there is one.
+std::optional<std::pair<dev_t, ino_t>> FileId(const std::string& path) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0) return std::nullopt;
+  return std::make_pair(st.st_dev, st.st_ino);
+}
+
+}  // namespace
 
 std::unique_ptr<Server> Server::Start(const Config& config, const std::string& software_version) {
   Validate(config);
@@ -35,15 +65,23 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
   builder.SetResourceQuota(quota);
   builder.RegisterService(s->service_.get());
   if (!config.listen.unix_socket.empty()) {
+    const std::string& path = config.listen.unix_socket;
+    struct stat existing {};
+    if (::lstat(path.c_str(), &existing) == 0) {
+      if (!S_ISSOCK(existing.st_mode))
+        throw std::runtime_error("listen.unix_socket: " + path + " exists and is not a socket");
+      if (SocketIsLive(path))
+        throw std::runtime_error("listen.unix_socket: another live instance serves " + path);
+    }
     std::error_code ec;
-    std::filesystem::remove(config.listen.unix_socket, ec);  // a socket left by a dead replica
+    std::filesystem::remove(path, ec);  // a socket left by a dead replica
     builder.AddListeningPort("unix:" + config.listen.unix_socket,
                              grpc::InsecureServerCredentials());
   }
   if (!config.listen.tcp.empty()) {
     rpc::TlsFiles tls{config.listen.tls_client_ca, config.listen.tls_certificate,
-                      config.listen.tls_key, "listen.tls_client_ca", "listen.tls_certificate",
-                      "listen.tls_key"};
+                      config.listen.tls_key,       "listen.tls_client_ca",
+                      "listen.tls_certificate",    "listen.tls_key"};
     builder.AddListeningPort(config.listen.tcp,
                              config.listen.plaintext_loopback
                                  ? grpc::InsecureServerCredentials()
@@ -51,18 +89,21 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
                              &s->tcp_port_);
   }
   s->server_ = builder.BuildAndStart();
+  if (s->server_ && !config.listen.unix_socket.empty())
+    s->socket_file_ = FileId(config.listen.unix_socket);
   if (!s->server_ || (!config.listen.tcp.empty() && s->tcp_port_ == 0))
     throw std::runtime_error(
         "the gRPC server could not start" +
         (config.listen.tcp.empty() ? std::string() : " on TCP " + config.listen.tcp) +
         (config.listen.unix_socket.empty() ? std::string()
                                            : " (socket " + config.listen.unix_socket + ")"));
-  spdlog::info("serving: {} workers, {} queue places{}{}", options.workers, options.queue,
-               config.listen.unix_socket.empty() ? "" : ", unix:" + config.listen.unix_socket,
-               config.listen.tcp.empty()
-                   ? ""
-                   : ", tcp port " + std::to_string(s->tcp_port_) +
-                         (config.listen.plaintext_loopback ? " (plain, loopback)" : " (mutual TLS)"));
+  spdlog::info(
+      "serving: {} workers, {} queue places{}{}", options.workers, options.queue,
+      config.listen.unix_socket.empty() ? "" : ", unix:" + config.listen.unix_socket,
+      config.listen.tcp.empty()
+          ? ""
+          : ", tcp port " + std::to_string(s->tcp_port_) +
+                (config.listen.plaintext_loopback ? " (plain, loopback)" : " (mutual TLS)"));
   return s;
 }
 
@@ -76,8 +117,8 @@ void Server::Drain() {
     // Work under way stops at its next stage; wait for that (at most the
     // drain timeout), then shut down at once: gRPC's own deadline would also
     // wait for idle client connections (a daemon's channel) to go away.
-    const auto until = std::chrono::steady_clock::now() +
-                       std::chrono::milliseconds(config_.drain_timeout_ms);
+    const auto until =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(config_.drain_timeout_ms);
     while (std::chrono::steady_clock::now() < until) {
       const processing::WorkPoolStats s = service_->Stats();
       if (s.busy == 0 && s.waiting == 0) break;
@@ -86,7 +127,9 @@ void Server::Drain() {
     server_->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(100));
     server_->Wait();
   }
-  if (!config_.listen.unix_socket.empty()) {
+  // Only the file this server made: another instance may have replaced a
+  // socket it found stale.
+  if (socket_file_ && FileId(config_.listen.unix_socket) == socket_file_) {
     std::error_code ec;
     std::filesystem::remove(config_.listen.unix_socket, ec);
   }

@@ -7,9 +7,12 @@
 #define BSLS_PROCESSD_SERVER_H_
 
 #include <grpcpp/grpcpp.h>
+#include <sys/types.h>
 
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "bsls/processing/processing_service.h"
 #include "config.h"
@@ -20,7 +23,8 @@ class Server {
  public:
   // Starts serving `config` (checked first). Throws ConfigError naming the
   // key, rpc::TlsFileError for an unusable TLS file, std::runtime_error when
-  // a listener cannot be bound.
+  // a listener cannot be bound or the Unix socket is served by another live
+  // instance (a stale socket file left by a dead one is replaced).
   static std::unique_ptr<Server> Start(const Config& config, const std::string& software_version);
   // Drains (see Drain) if not done yet.
   ~Server();
@@ -43,6 +47,9 @@ class Server {
   std::unique_ptr<grpc::Server> server_;
   int tcp_port_ = 0;
   bool drained_ = false;
+  // The Unix socket file this server made (device, inode): removed on
+  // Drain only while it is still that file, never a later instance's.
+  std::optional<std::pair<dev_t, ino_t>> socket_file_;
 };
 
 }  // namespace bsls::processd

@@ -1,15 +1,18 @@
 // bsls-processd's server assembly: the Unix socket and plain loopback TCP
 // for one machine, mutual TLS for the network (every handshake without a
 // certificate of the configured CA fails), draining.
-#include "server.h"
-
 #include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/un.h>
 #include <unistd.h>
 
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 
 #include "bsls/processing/processing_client.h"
 #include "bsls/testing/certificates.h"
+#include "server.h"
 
 namespace bsls::processd {
 namespace {
@@ -57,6 +60,51 @@ TEST_F(ProcessdServer, ServesTheUnixSocketAndPlainLoopback) {
   EXPECT_FALSE(fs::exists(config.listen.unix_socket));
 }
 
+// One instance per socket: a second server on a socket that a live one
+// serves refuses to start and leaves it alone; a stale socket file (its
+// server gone) is replaced; a server removes only the socket file it made.
+TEST_F(ProcessdServer, OneLiveInstancePerSocket) {
+  Config config;
+  config.listen.unix_socket = (dir_ / "processd.sock").string();
+  config.workers = 1;
+  config.replica = "first";
+  auto first = Server::Start(config, "test");
+  Config second = config;
+  second.replica = "second";
+  try {
+    Server::Start(second, "test");
+    FAIL() << "a second instance started on a live socket";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("another live instance"), std::string::npos) << e.what();
+  }
+  processing::ClientOptions options;
+  options.target = "unix:" + config.listen.unix_socket;
+  v1::ServerInfo info;
+  ASSERT_TRUE(Info(processing::OpenProcessingChannel(options), &info).ok());
+  EXPECT_EQ(info.replica(), "first");
+  // The first stops; a file at the path that is not its socket stays.
+  fs::remove(config.listen.unix_socket);
+  { std::ofstream(config.listen.unix_socket) << "not a socket"; }
+  first->Drain();
+  EXPECT_TRUE(fs::exists(config.listen.unix_socket));
+  EXPECT_THROW(Server::Start(second, "test"), std::runtime_error);  // not a socket
+  fs::remove(config.listen.unix_socket);
+  // A stale socket file (nobody listens) is replaced.
+  {
+    const int fd = ::socket(AF_UNIX, SOCK_STREAM, 0);
+    sockaddr_un address{};
+    address.sun_family = AF_UNIX;
+    std::strncpy(address.sun_path, config.listen.unix_socket.c_str(), sizeof(address.sun_path) - 1);
+    ASSERT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0);
+    ::close(fd);
+  }
+  auto third = Server::Start(second, "test");
+  ASSERT_TRUE(Info(processing::OpenProcessingChannel(options), &info).ok());
+  EXPECT_EQ(info.replica(), "second");
+  third->Drain();
+  EXPECT_FALSE(fs::exists(config.listen.unix_socket));
+}
+
 TEST_F(ProcessdServer, TcpServesOnlyMutualTlsClientsOfItsCa) {
   testing::TestPki pki(dir_ / "pki", "clinic");
   const testing::PemFiles server_files = pki.Issue("localhost", true);
@@ -88,9 +136,8 @@ TEST_F(ProcessdServer, TcpServesOnlyMutualTlsClientsOfItsCa) {
     args.SetInt("bsls.test.fresh", i);  // a distinct channel, never a shared subchannel
     grpc::SslCredentialsOptions no_cert;
     no_cert.pem_root_certs = testing::ReadText(pki.ca());
-    plain_failures += !Info(grpc::CreateCustomChannel(target, grpc::SslCredentials(no_cert), args),
-                            &info)
-                           .ok();
+    plain_failures +=
+        !Info(grpc::CreateCustomChannel(target, grpc::SslCredentials(no_cert), args), &info).ok();
     processing::ClientOptions bad = good;
     bad.tls = {pki.ca(), forged.certificate, forged.key};
     grpc::SslCredentialsOptions forged_cert;
@@ -105,8 +152,7 @@ TEST_F(ProcessdServer, TcpServesOnlyMutualTlsClientsOfItsCa) {
   EXPECT_EQ(forged_failures, 100);
   // Plain TCP to a TLS port fails too; and the client refuses plain TCP to
   // another machine before it tries.
-  EXPECT_FALSE(
-      Info(grpc::CreateChannel(target, grpc::InsecureChannelCredentials()), &info).ok());
+  EXPECT_FALSE(Info(grpc::CreateChannel(target, grpc::InsecureChannelCredentials()), &info).ok());
   processing::ClientOptions remote;
   remote.target = "processd.clinic:7000";
   EXPECT_THROW(processing::OpenProcessingChannel(remote), std::invalid_argument);
