@@ -1,35 +1,18 @@
 #include "server.h"
 
 #include <spdlog/spdlog.h>
-#include <sys/socket.h>
 #include <sys/stat.h>
-#include <sys/un.h>
-#include <unistd.h>
 
-#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
 #include <thread>
 
 #include "bsls/rpc/tls.h"
+#include "bsls/rpc/unix_socket.h"
 
 namespace bsls::processd {
 namespace {
-
-// True when something accepts connections on the Unix socket at `path`.
-bool SocketIsLive(const std::string& path) {
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  if (path.size() >= sizeof(address.sun_path)) return false;
-  std::memcpy(address.sun_path, path.c_str(), path.size() + 1);
-  const int probe = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (probe < 0) return false;
-  const bool live =
-      ::connect(probe, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
-  ::close(probe);
-  return live;
-}
 
 // The (device, inode) of the file at `path`, if there is one.
 std::optional<std::pair<dev_t, ino_t>> FileId(const std::string& path) {
@@ -70,7 +53,7 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     if (::lstat(path.c_str(), &existing) == 0) {
       if (!S_ISSOCK(existing.st_mode))
         throw std::runtime_error("listen.unix_socket: " + path + " exists and is not a socket");
-      if (SocketIsLive(path))
+      if (rpc::UnixSocketIsLive(path))
         throw std::runtime_error("listen.unix_socket: another live instance serves " + path);
     }
     std::error_code ec;

@@ -128,5 +128,28 @@ TEST(UnixListener, OutOfDescriptorsItShedsCallersAndDoesNotSpin) {
   EXPECT_GE(closed, 20) << "callers beyond the descriptor limit were not shed";
 }
 
+// One daemon per socket: a second listener on a live socket is refused and
+// leaves it working; once the first is gone, its stale file is replaced.
+TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("bsls_listener_twice_" + std::to_string(::getpid()) + ".sock"))
+                               .string();
+  std::filesystem::remove(path);
+  auto first = UnixListener::Create({path, 0600});
+  ASSERT_TRUE(first.ok()) << first.status().message();
+  auto second = UnixListener::Create({path, 0600});
+  ASSERT_FALSE(second.ok());
+  EXPECT_EQ(second.status().code(), framestore::ErrorCode::kAlreadyExists);
+  const int client = Connect(path);
+  EXPECT_GE(client, 0) << "the first listener's socket was taken";
+  if (client >= 0) ::close(client);
+  first->reset();  // closed without Start/Stop: the file stays, stale
+  ASSERT_TRUE(std::filesystem::exists(path));
+  auto third = UnixListener::Create({path, 0600});
+  EXPECT_TRUE(third.ok()) << third.status().message();
+  third->reset();
+  std::filesystem::remove(path);
+}
+
 }  // namespace
 }  // namespace bsls::service

@@ -14,6 +14,8 @@
 #include <cstring>
 #include <vector>
 
+#include "bsls/rpc/unix_socket.h"
+
 namespace bsls::service {
 
 using framestore::ErrorCode;
@@ -54,16 +56,6 @@ std::string UserName(uid_t uid) {
   return "uid" + std::to_string(uid);
 }
 
-// True when something accepts connections on the socket at `path`.
-bool SocketIsLive(const sockaddr_un& address) {
-  const int probe = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  if (probe < 0) return false;
-  const bool live =
-      ::connect(probe, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
-  ::close(probe);
-  return live;
-}
-
 }  // namespace
 
 UnixListener::UnixListener(UnixListenerOptions options, int fd)
@@ -83,7 +75,7 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
     if (!S_ISSOCK(existing.st_mode))
       return Status(ErrorCode::kAlreadyExists,
                     "socket path " + options.path + " exists and is not a socket");
-    if (SocketIsLive(address))
+    if (rpc::UnixSocketIsLive(options.path))
       return Status(ErrorCode::kAlreadyExists, "another daemon is listening on " + options.path);
     ::unlink(options.path.c_str());  // left by a daemon that died
   }
