@@ -48,16 +48,9 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
   builder.SetResourceQuota(quota);
   builder.RegisterService(s->service_.get());
   if (!config.listen.unix_socket.empty()) {
-    const std::string& path = config.listen.unix_socket;
-    struct stat existing {};
-    if (::lstat(path.c_str(), &existing) == 0) {
-      if (!S_ISSOCK(existing.st_mode))
-        throw std::runtime_error("listen.unix_socket: " + path + " exists and is not a socket");
-      if (rpc::UnixSocketIsLive(path))
-        throw std::runtime_error("listen.unix_socket: another live instance serves " + path);
-    }
-    std::error_code ec;
-    std::filesystem::remove(path, ec);  // a socket left by a dead replica
+    if (const std::string taken = rpc::ClaimUnixSocketPath(config.listen.unix_socket);
+        !taken.empty())
+      throw std::runtime_error("listen.unix_socket: " + taken);
     builder.AddListeningPort("unix:" + config.listen.unix_socket,
                              grpc::InsecureServerCredentials());
   }

@@ -70,15 +70,8 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
                       std::to_string(sizeof(address.sun_path) - 1) + " bytes");
   std::memcpy(address.sun_path, options.path.c_str(), options.path.size() + 1);
 
-  struct stat existing {};
-  if (::lstat(options.path.c_str(), &existing) == 0) {
-    if (!S_ISSOCK(existing.st_mode))
-      return Status(ErrorCode::kAlreadyExists,
-                    "socket path " + options.path + " exists and is not a socket");
-    if (rpc::UnixSocketIsLive(options.path))
-      return Status(ErrorCode::kAlreadyExists, "another daemon is listening on " + options.path);
-    ::unlink(options.path.c_str());  // left by a daemon that died
-  }
+  if (const std::string taken = rpc::ClaimUnixSocketPath(options.path); !taken.empty())
+    return Status(ErrorCode::kAlreadyExists, "socket path: " + taken);
   const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   if (fd < 0) return Status(ErrorCode::kUnavailable, Errno("socket(AF_UNIX)"));
   // The file is created with the umask applied; permissions are set next,

@@ -150,7 +150,7 @@ cv::Rect PatternColumns(const cv::Mat& grey, int n, double rise, int margin) {
 }
 
 cv::Point2d ToFullFrame(const cv::Point2d& p, int n) {
-  return {n * p.x + 0.5 * (n - 1), n * p.y + 0.5 * (n - 1)};
+  return WorkingScale{static_cast<double>(n), static_cast<double>(n)}.ToFull(p);
 }
 
 void MapToFullFrame(int n, cv::Point offset, cv::Size full,

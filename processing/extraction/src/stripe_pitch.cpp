@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
+#include <span>
 #include <vector>
 
 #include "input_checks.h"
@@ -62,7 +63,7 @@ void RowRidges(const float* r, int width, double least, int reach, std::vector<d
 
 // The densest cluster of sorted `spacings` (members within `spread` of its
 // smallest, relatively): its first and one-past-last index.
-std::pair<size_t, size_t> DensestCluster(const std::vector<double>& spacings, double spread) {
+std::pair<size_t, size_t> DensestCluster(std::span<const double> spacings, double spread) {
   std::pair<size_t, size_t> best{0, 0};
   for (size_t i = 0, j = 0; i < spacings.size(); ++i) {
     j = std::max(j, i);
@@ -109,6 +110,11 @@ std::optional<double> MeasureStripePitch(const cv::Mat& grey, const StripePitchP
       std::max(y0 + 1, static_cast<int>(std::ceil(0.5 * (1.0 + params.central_band) * grey.rows)));
   const int rows = std::min(params.sampled_rows, y1 - y0);
 
+  // The smoothing leaves 1 / (2 sqrt(pi) sigma)^(1/2) of white noise's sigma.
+  const double kept =
+      params.smoothing_sigma > 0.5
+          ? 1.0 / std::sqrt(2.0 * std::sqrt(std::numbers::pi) * params.smoothing_sigma)
+          : 1.0;
   std::vector<double> spacings, scratch, ridges;
   cv::Mat smoothed;
   for (int i = 0; i < rows; ++i) {
@@ -121,15 +127,13 @@ std::optional<double> MeasureStripePitch(const cv::Mat& grey, const StripePitchP
       smoothed = row;
     smoothed.convertTo(smoothed, CV_32F);
     const float* r = smoothed.ptr<float>(0);
-    // The smoothing leaves 1 / (2 sqrt(pi) sigma)^(1/2) of white noise's sigma.
-    const double kept =
-        params.smoothing_sigma > 0.5
-            ? 1.0 / std::sqrt(2.0 * std::sqrt(std::numbers::pi) * params.smoothing_sigma)
-            : 1.0;
     const double noise = RowNoise(grey.ptr<uchar>(y), width, &scratch) * kept;
     scratch.assign(r, r + width);
-    std::sort(scratch.begin(), scratch.end());
-    const double spread = scratch[scratch.size() * 95 / 100] - scratch[scratch.size() * 5 / 100];
+    const auto low = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() * 5 / 100);
+    const auto high = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() * 95 / 100);
+    std::nth_element(scratch.begin(), high, scratch.end());
+    std::nth_element(scratch.begin(), low, high);
+    const double spread = *high - *low;
     const double least = std::max(
         {params.min_prominence_noise * noise, params.min_prominence_contrast * spread, 1e-3});
     RowRidges(r, width, least, reach, &ridges);
@@ -149,9 +153,8 @@ std::optional<double> MeasureStripePitch(const cv::Mat& grey, const StripePitchP
         std::lower_bound(spacings.begin(), spacings.end(), half / (1.0 + params.cluster_spread));
     const auto hi =
         std::upper_bound(spacings.begin(), spacings.end(), half * (1.0 + params.cluster_spread));
-    std::vector<double> below(lo, hi);
-    if (!below.empty()) {
-      const auto [b0, b1] = DensestCluster(below, params.cluster_spread);
+    if (lo != hi) {
+      const auto [b0, b1] = DensestCluster(std::span<const double>(lo, hi), params.cluster_spread);
       if (2 * (b1 - b0) >= last - first) {
         first = static_cast<size_t>(lo - spacings.begin()) + b0;
         last = static_cast<size_t>(lo - spacings.begin()) + b1;
