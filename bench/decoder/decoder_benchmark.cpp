@@ -21,11 +21,11 @@
 #include <chrono>
 #include <filesystem>
 #include <map>
+#include <opencv2/imgproc.hpp>
 #include <vector>
 
-#include <opencv2/imgproc.hpp>
-
 #include "bsls/decoder/decoder.h"
+#include "bsls/extraction/stripe_pitch.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
 
@@ -44,8 +44,8 @@ const cv::Mat& FaceFrame(int size) {
   bsls::simulator::RenderParams params;
   params.supersampling = size > 1024 ? 1 : 3;
   params.noise_sigma = 3.0;
-  const auto scene =
-      bsls::simulator::ThesisScene(bsls::pattern::Side::kLeft, bsls::simulator::SurfaceKind::kFace, options);
+  const auto scene = bsls::simulator::ThesisScene(bsls::pattern::Side::kLeft,
+                                                  bsls::simulator::SurfaceKind::kFace, options);
   return frames[size] = bsls::simulator::Renderer(scene, params).RenderImage(1);
 }
 
@@ -111,6 +111,24 @@ void DecodeWithThreads(benchmark::State& state, int threads,
 
 void BM_Decode(benchmark::State& state) { DecodeWithThreads(state, 0); }
 
+// The stripe pitch alone (the decoder's first step), against the baseline.
+void BM_MeasureStripePitch(benchmark::State& state) {
+  const cv::Mat& frame = FaceFrame(static_cast<int>(state.range(0)));
+  std::vector<double> base, ms;
+  for (int i = 0; i < 30; ++i) base.push_back(BaselineOnce(frame));
+  double pitch = 0.0;
+  for (auto _ : state) {
+    const auto t = Clock::now();
+    pitch = bsls::extraction::MeasureStripePitch(frame).value_or(0.0);
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+    benchmark::DoNotOptimize(pitch);
+  }
+  state.counters["median_ms"] = Median(ms);
+  state.counters["baseline_ms"] = Median(base);
+  state.counters["ratio"] = Median(ms) / Median(base);
+  state.counters["pitch"] = pitch;
+}
+
 void BM_DecodeSingleThread(benchmark::State& state) { DecodeWithThreads(state, 1); }
 
 // The skeleton chain: the same as BM_Decode and BM_DecodeSingleThread with
@@ -132,6 +150,7 @@ void BM_DecodeSkeletonNothingAhead(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_GaussianBlurCanny)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_MeasureStripePitch)->Arg(512)->Arg(2048)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Decode)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK(BM_Decode)->Arg(2048)->Unit(benchmark::kMillisecond)->Iterations(20);
 BENCHMARK(BM_DecodeSingleThread)->Arg(512)->Unit(benchmark::kMillisecond)->MinTime(2.0);

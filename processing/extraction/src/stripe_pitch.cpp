@@ -1,6 +1,7 @@
 #include "bsls/extraction/stripe_pitch.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <opencv2/imgproc.hpp>
@@ -22,12 +23,30 @@ double Median(std::vector<double>& v) {
 
 // The row's pixel noise (sigma): the median absolute second difference,
 // which the smooth profile of a stripe hardly touches, scaled for Gaussian
-// noise (a second difference has sqrt(6) sigma).
-double RowNoise(const uchar* row, int width, std::vector<double>* scratch) {
-  scratch->clear();
-  for (int x = 1; x + 1 < width; ++x)
-    scratch->push_back(std::abs(static_cast<double>(row[x - 1]) - 2.0 * row[x] + row[x + 1]));
-  return 1.4826 * Median(*scratch) / std::sqrt(6.0);
+// noise (a second difference has sqrt(6) sigma). The differences are
+// integers in [0, 1020], so the median is counted, not sorted.
+double RowNoise(const uchar* row, int width) {
+  std::array<int, 1021> counts{};
+  for (int x = 1; x + 1 < width; ++x) ++counts[std::abs(row[x - 1] - 2 * row[x] + row[x + 1])];
+  const int n = std::max(0, width - 2);
+  int seen = 0, median = 0;
+  while (median < 1020 && seen + counts[median] <= n / 2) seen += counts[median++];
+  return 1.4826 * median / std::sqrt(6.0);
+}
+
+// The spread of a smoothed row's grey (95th - 5th percentile), counted in
+// quarter grey levels (the smoothed values lie in [0, 255]).
+double RowSpread(const float* r, int width) {
+  constexpr int kBins = 1024;
+  std::array<int, kBins> counts{};
+  for (int x = 0; x < width; ++x)
+    ++counts[std::clamp(static_cast<int>(r[x] * (kBins / 256.0f)), 0, kBins - 1)];
+  auto percentile = [&](int rank) {
+    int seen = 0, bin = 0;
+    while (bin < kBins - 1 && seen + counts[bin] <= rank) seen += counts[bin++];
+    return (bin + 0.5) * (256.0 / kBins);
+  };
+  return percentile(width * 95 / 100) - percentile(width * 5 / 100);
 }
 
 // The sub-pixel ridges of one smoothed row that stand out by `least`:
@@ -43,13 +62,23 @@ void RowRidges(const float* r, int width, double least, int reach, std::vector<d
       x = end;
       continue;
     }
-    // The lowest point on each side before a higher one (or the reach).
-    float left = r[x], right = r[x];
+    // On each side, a point `least` below the top before a higher one (or
+    // the reach): the walk ends at the first such point, since only whether
+    // the prominence reaches `least` matters.
+    const float floor = static_cast<float>(r[x] - least);
+    bool deep_left = false, deep_right = false;
     for (int k = x - 1; k >= std::max(0, x - reach) && r[k] <= r[x]; --k)
-      left = std::min(left, r[k]);
-    for (int k = end + 1; k < std::min(width, end + 1 + reach) && r[k] <= r[x]; ++k)
-      right = std::min(right, r[k]);
-    if (r[x] - std::max(left, right) >= least) {
+      if (r[k] <= floor) {
+        deep_left = true;
+        break;
+      }
+    if (deep_left)
+      for (int k = end + 1; k < std::min(width, end + 1 + reach) && r[k] <= r[x]; ++k)
+        if (r[k] <= floor) {
+          deep_right = true;
+          break;
+        }
+    if (deep_left && deep_right) {
       double at = 0.5 * (x + end);
       if (end == x) {
         const double curvature = r[x - 1] - 2.0 * r[x] + r[x + 1];
@@ -115,27 +144,23 @@ std::optional<double> MeasureStripePitch(const cv::Mat& grey, const StripePitchP
       params.smoothing_sigma > 0.5
           ? 1.0 / std::sqrt(2.0 * std::sqrt(std::numbers::pi) * params.smoothing_sigma)
           : 1.0;
-  std::vector<double> spacings, scratch, ridges;
+  // The sampled rows, stacked and smoothed along x in one pass.
+  cv::Mat sampled(rows, width, CV_8UC1);
+  for (int i = 0; i < rows; ++i)
+    grey.row(y0 + static_cast<int>((i + 0.5) * (y1 - y0) / rows)).copyTo(sampled.row(i));
   cv::Mat smoothed;
+  if (params.smoothing_sigma > 0.0)
+    cv::GaussianBlur(sampled, smoothed, cv::Size(0, 1), params.smoothing_sigma, 0.0,
+                     cv::BORDER_REPLICATE);
+  else
+    smoothed = sampled;
+  smoothed.convertTo(smoothed, CV_32F);
+  std::vector<double> spacings, ridges;
   for (int i = 0; i < rows; ++i) {
-    const int y = y0 + static_cast<int>((i + 0.5) * (y1 - y0) / rows);
-    const cv::Mat row = grey.row(y);
-    if (params.smoothing_sigma > 0.0)
-      cv::GaussianBlur(row, smoothed, cv::Size(0, 1), params.smoothing_sigma, 0.0,
-                       cv::BORDER_REPLICATE);
-    else
-      smoothed = row;
-    smoothed.convertTo(smoothed, CV_32F);
-    const float* r = smoothed.ptr<float>(0);
-    const double noise = RowNoise(grey.ptr<uchar>(y), width, &scratch) * kept;
-    scratch.assign(r, r + width);
-    const auto low = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() * 5 / 100);
-    const auto high = scratch.begin() + static_cast<std::ptrdiff_t>(scratch.size() * 95 / 100);
-    std::nth_element(scratch.begin(), high, scratch.end());
-    std::nth_element(scratch.begin(), low, high);
-    const double spread = *high - *low;
-    const double least = std::max(
-        {params.min_prominence_noise * noise, params.min_prominence_contrast * spread, 1e-3});
+    const float* r = smoothed.ptr<float>(i);
+    const double noise = RowNoise(sampled.ptr<uchar>(i), width) * kept;
+    const double least = std::max({params.min_prominence_noise * noise,
+                                   params.min_prominence_contrast * RowSpread(r, width), 1e-3});
     RowRidges(r, width, least, reach, &ridges);
     for (size_t k = 1; k < ridges.size(); ++k) {
       const double s = ridges[k] - ridges[k - 1];
