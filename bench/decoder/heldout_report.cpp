@@ -15,11 +15,14 @@
 // tolerance class, and the worst frames with every drawn parameter.
 //
 //   heldout_report [--set tuning|heldout] [--count N] [--first I] [--worst K]
-//                  [--json FILE] [--images DIR] [--quiet]
+//                  [--json FILE] [--images DIR] [--cache DIR] [--quiet]
 //     --count  frames (default 200); --first  index of the first seed in the
 //     set (default 0); --worst  frames listed in full (default 10); --json
 //     per-frame figures and draws as JSON; --images  write each frame to
-//     DIR/<seed>.png; --quiet  totals only.
+//     DIR/<seed>.png; --cache  keep each rendered frame and its visible truth in
+//     DIR (<seed>.png, <seed>.truth) and read them back on later runs (the
+//     render is 99 % of a run; the drawing code must not have changed);
+//     --quiet  totals only.
 // Exit status 0 when every frame ran, 2 on bad arguments, 1 on an error.
 #include <algorithm>
 #include <chrono>
@@ -55,6 +58,9 @@ struct Options {
   int worst = 10;
   std::string json;
   std::string images;  // folder for the rendered frames; empty: none
+  // Folder of rendered frames and their visible truth, kept between runs
+  // (a frame is rendered once, then read back); empty: none.
+  std::string cache;
   bool quiet = false;
 };
 
@@ -135,23 +141,62 @@ std::string PitchBand(const sim::RandomSceneDraw& d) {
   return "pitch 32-64";
 }
 
+// The visible truth junctions: label, image point and world z.
+struct VisibleTruth {
+  sim::PointLabel label;
+  double z = 0.0;
+};
+
+// The frame of `seed` and its visible truth: rendered, or read from the
+// cache folder when it holds them (written there after rendering).
+cv::Mat FrameOf(std::uint32_t seed, const sim::RandomScene& random, const Options& o,
+                std::vector<VisibleTruth>* truth) {
+  const std::string stem = o.cache.empty() ? "" : o.cache + "/" + std::to_string(seed);
+  if (!stem.empty() && std::filesystem::exists(stem + ".png")) {
+    cv::Mat image = cv::imread(stem + ".png", cv::IMREAD_UNCHANGED);
+    std::ifstream in(stem + ".truth");
+    if (!image.empty() && in) {
+      VisibleTruth t;
+      while (in >> t.label.p >> t.label.v >> t.label.position.x >> t.label.position.y >> t.z)
+        truth->push_back(t);
+      if (in.eof()) return image;
+      truth->clear();
+    }
+  }
+  sim::Frame frame = sim::Renderer(random.scene, random.render).Render();
+  for (const sim::TruthJunction& j : frame.truth.junctions)
+    if (j.visible) truth->push_back({{j.p, j.v, {j.image.x(), j.image.y()}}, j.world.z()});
+  if (!stem.empty()) {
+    std::ofstream out(stem + ".truth");
+    out.precision(17);
+    for (const VisibleTruth& t : *truth)
+      out << t.label.p << ' ' << t.label.v << ' ' << t.label.position.x << ' ' << t.label.position.y
+          << ' ' << t.z << '\n';
+    if (!out || !cv::imwrite(stem + ".png", frame.image))
+      throw std::runtime_error("could not write " + stem + ".png / .truth");
+  }
+  return frame.image;
+}
+
 FrameResult RunFrame(std::uint32_t seed, const Options& o) {
   FrameResult f;
   const auto t0 = std::chrono::steady_clock::now();
   const sim::RandomScene random = sim::MakeRandomScene(seed);
   f.draw = random.draw;
-  const sim::Frame frame = sim::Renderer(random.scene, random.render).Render();
+  std::vector<VisibleTruth> visible;
+  const cv::Mat image = FrameOf(seed, random, o, &visible);
   const auto t1 = std::chrono::steady_clock::now();
   if (!o.images.empty()) {
     const std::string path = o.images + "/" + std::to_string(seed) + ".png";
-    if (!cv::imwrite(path, frame.image)) throw std::runtime_error("could not write " + path);
+    if (!cv::imwrite(path, image)) throw std::runtime_error("could not write " + path);
   }
-  const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame.image, random.scene.side);
+  const bsls::decoder::DecodeResult r = bsls::decoder::Decode(image, random.scene.side);
   const auto t2 = std::chrono::steady_clock::now();
   f.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   f.decode_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
   f.measured_pitch = r.pitch;
-  const std::vector<sim::PointLabel> truth = sim::VisibleJunctions(frame.truth);
+  std::vector<sim::PointLabel> truth;
+  for (const VisibleTruth& t : visible) truth.push_back(t.label);
   f.line_zero_visible = std::count_if(truth.begin(), truth.end(),
                                       [](const auto& j) { return j.p == 0; }) >= kLineZeroJunctions;
   std::vector<sim::PointLabel> decoded;
@@ -164,11 +209,9 @@ FrameResult RunFrame(std::uint32_t seed, const Options& o) {
   f.score = sim::ScoreLabels(truth, decoded, kMatchReach);
   // Recall on the object and on the base plane around it, apart.
   std::vector<sim::PointLabel> on_object, on_base;
-  for (const sim::TruthJunction& j : frame.truth.junctions) {
-    if (!j.visible) continue;
-    const bool base =
-        f.draw.object != sim::RandomObject::kPlane && std::abs(j.world.z()) < kBasePlaneBand;
-    (base ? on_base : on_object).push_back({j.p, j.v, {j.image.x(), j.image.y()}});
+  for (const VisibleTruth& t : visible) {
+    const bool base = f.draw.object != sim::RandomObject::kPlane && std::abs(t.z) < kBasePlaneBand;
+    (base ? on_base : on_object).push_back(t.label);
   }
   for (const auto& [part, score] :
        {std::pair{&on_object, &f.object}, std::pair{&on_base, &f.base}}) {
@@ -213,7 +256,7 @@ nlohmann::json FrameJson(const FrameResult& f) {
 int Usage(const char* argv0) {
   std::fprintf(stderr,
                "usage: %s [--set tuning|heldout] [--count N] [--first I] [--worst K] "
-               "[--json FILE] [--images DIR] [--quiet]\n",
+               "[--json FILE] [--images DIR] [--cache DIR] [--quiet]\n",
                argv0);
   return 2;
 }
@@ -243,6 +286,8 @@ int main(int argc, char** argv) {
       o.json = argv[++i];
     } else if (a == "--images" && has_value) {
       o.images = argv[++i];
+    } else if (a == "--cache" && has_value) {
+      o.cache = argv[++i];
     } else if (a == "--quiet") {
       o.quiet = true;
     } else {
