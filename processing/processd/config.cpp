@@ -18,8 +18,8 @@ using io::ConfigKeyError;
 Config Parse(const YAML::Node& root) {
   Config c;
   io::OnlyKeys(root, "",
-               {"listen", "workers", "queue", "calibration_cache_entries", "replica",
-                "scratch_dir", "max_upload_bytes", "drain_timeout_ms", "log_level"});
+               {"listen", "workers", "queue", "calibration_cache_entries", "replica", "scratch_dir",
+                "max_upload_bytes", "max_frame_pixels", "drain_timeout_ms", "log_level"});
   const YAML::Node listen = root["listen"];
   io::OnlyKeys(listen, "listen",
                {"unix_socket", "tcp", "plaintext_loopback", "tls_certificate", "tls_key",
@@ -39,12 +39,13 @@ Config Parse(const YAML::Node& root) {
   }
   io::ReadKeyInRange(root, "", "workers", c.workers, 0, 256);
   io::ReadKeyInRange(root, "", "queue", c.queue, -1, 4096);
-  io::ReadKeyInRange(root, "", "calibration_cache_entries", c.calibration_cache_entries, 1,
-                     100000);
+  io::ReadKeyInRange(root, "", "calibration_cache_entries", c.calibration_cache_entries, 1, 100000);
   io::ReadKey(root, "", "replica", c.replica);
   io::ReadKey(root, "", "scratch_dir", c.scratch_dir);
   io::ReadKeyInRange(root, "", "max_upload_bytes", c.max_upload_bytes, std::uint64_t{1} << 20,
                      std::uint64_t{64} << 30);
+  io::ReadKeyInRange(root, "", "max_frame_pixels", c.max_frame_pixels, std::int64_t{512} * 512,
+                     std::int64_t{4096} * 4096);
   io::ReadKeyInRange(root, "", "drain_timeout_ms", c.drain_timeout_ms, 0, 600000);
   io::ReadKey(root, "", "log_level", c.log_level);
   return c;
@@ -118,6 +119,7 @@ std::string Dump(const Config& c) {
   out << YAML::Key << "replica" << YAML::Value << c.replica;
   out << YAML::Key << "scratch_dir" << YAML::Value << c.scratch_dir;
   out << YAML::Key << "max_upload_bytes" << YAML::Value << c.max_upload_bytes;
+  out << YAML::Key << "max_frame_pixels" << YAML::Value << c.max_frame_pixels;
   out << YAML::Key << "drain_timeout_ms" << YAML::Value << c.drain_timeout_ms;
   out << YAML::Key << "log_level" << YAML::Value << c.log_level;
   out << YAML::EndMap;

@@ -36,16 +36,20 @@ struct Config {
   int workers = 0;  // 0: one per CPU core
   int queue = -1;   // -1: twice the workers
   int calibration_cache_entries = 64;
-  std::string replica;       // "" : host:pid
-  std::string scratch_dir;   // "" : $TMPDIR or /tmp
+  std::string replica;      // "" : host:pid
+  std::string scratch_dir;  // "" : $TMPDIR or /tmp
   std::uint64_t max_upload_bytes = std::uint64_t{256} << 20;
+  // Pixels of one frame (width x height) a call may ask to be worked on,
+  // [512^2, 4096^2]: a frame above it is refused with INVALID_ARGUMENT.
+  std::int64_t max_frame_pixels = std::int64_t{8} << 20;
   int drain_timeout_ms = 5000;
   std::string log_level = "info";
 };
 
 // The defaults, then the file at `path` (if given), then each override.
 // Unknown keys are errors. Throws ConfigError.
-Config LoadConfig(const std::optional<std::string>& path, const std::vector<std::string>& overrides);
+Config LoadConfig(const std::optional<std::string>& path,
+                  const std::vector<std::string>& overrides);
 // Checks the whole configuration; throws ConfigError naming the first bad key.
 void Validate(const Config& config);
 // Workers and queue with the defaults (0, -1) resolved.

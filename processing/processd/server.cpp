@@ -36,6 +36,7 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
   options.software_version = software_version;
   if (!config.scratch_dir.empty()) options.scratch_dir = config.scratch_dir;
   options.max_upload_bytes = config.max_upload_bytes;
+  options.max_frame_pixels = config.max_frame_pixels;
   s->service_ = std::make_unique<processing::ProcessingService>(options);
 
   grpc::EnableDefaultHealthCheckService(true);

@@ -144,8 +144,9 @@ TEST_P(OutsideCorpusSession, CalibratesAndNamesEveryDroppedView) {
             << " mm\n";
 }
 
-INSTANTIATE_TEST_SUITE_P(Rig, OutsideCorpusSession, ::testing::Values("left", "right"),
-                         [](const auto& info) { return info.param; });
+std::string RigName(const ::testing::TestParamInfo<std::string>& rig) { return rig.param; }
+
+INSTANTIATE_TEST_SUITE_P(Rig, OutsideCorpusSession, ::testing::Values("left", "right"), RigName);
 
 }  // namespace
 }  // namespace bsls::calibration

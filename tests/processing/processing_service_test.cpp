@@ -60,8 +60,8 @@ TEST(ProcessingService, ProcessFrameDecodesAndReconstructsOneSide) {
   request.set_want_overlay(true);
   request.set_request_tag("bed 3");
   std::vector<std::string> stages;
-  const WorkOutcome out = s.Client().ProcessFrame(
-      request, [&](const v1::Progress& p) { stages.push_back(p.stage()); });
+  const WorkOutcome out =
+      s.Client().ProcessFrame(request, [&](const v1::Progress& p) { stages.push_back(p.stage()); });
   ASSERT_TRUE(out.status.ok()) << out.status.error_message();
   ASSERT_FALSE(stages.empty());
   EXPECT_EQ(stages.front(), "queued");
@@ -84,8 +84,8 @@ TEST(ProcessingService, ProcessFrameDecodesAndReconstructsOneSide) {
   const geometry::SurfaceMesh mesh = io::DecodePly(out.files.at("surface.ply"), "surface.ply");
   EXPECT_EQ(mesh.VertexCount(), side.vertices());
   const std::string& png = out.files.at("overlay.png");
-  const cv::Mat overlay = cv::imdecode(std::vector<unsigned char>(png.begin(), png.end()),
-                                       cv::IMREAD_COLOR);
+  const cv::Mat overlay =
+      cv::imdecode(std::vector<unsigned char>(png.begin(), png.end()), cv::IMREAD_COLOR);
   EXPECT_EQ(overlay.cols, FaceFrame(pattern::Side::kLeft).cols);
   // The calibration sent inline is now cached by its id.
   EXPECT_EQ(s.service().calibrations().size(), 1u);
@@ -216,14 +216,14 @@ TEST(ProcessingService, BadRequestsAreRefusedWithTheFieldNamed) {
   const std::vector<Case> cases = {
       {"short pixels", [](auto& r) { r.mutable_frame()->mutable_pixels()->resize(100); },
        StatusCode::INVALID_ARGUMENT, "frame"},
-      {"zero width", [](auto& r) { r.mutable_frame()->set_width(0); },
-       StatusCode::INVALID_ARGUMENT, "frame"},
-      {"huge", [](auto& r) { r.mutable_frame()->set_height(100000); },
-       StatusCode::INVALID_ARGUMENT, "4096"},
+      {"zero width", [](auto& r) { r.mutable_frame()->set_width(0); }, StatusCode::INVALID_ARGUMENT,
+       "frame"},
+      {"huge", [](auto& r) { r.mutable_frame()->set_height(100000); }, StatusCode::INVALID_ARGUMENT,
+       "4096"},
       {"stride below width", [](auto& r) { r.mutable_frame()->set_stride(3); },
        StatusCode::INVALID_ARGUMENT, "stride"},
-      {"no side", [](auto& r) { r.set_side(v1::SIDE_UNSPECIFIED); },
-       StatusCode::INVALID_ARGUMENT, "side"},
+      {"no side", [](auto& r) { r.set_side(v1::SIDE_UNSPECIFIED); }, StatusCode::INVALID_ARGUMENT,
+       "side"},
       {"surface without calibration",
        [](auto& r) {
          r.clear_calibration();
@@ -420,6 +420,70 @@ TEST(ProcessingService, ACallPastItsDeadlineStops) {
   EXPECT_EQ(s.service().Stats().busy, 0);
 }
 
+// A frame that keeps every stage of the decoder busy: 2896 x 2896 (8 Mpx,
+// the default budget), every other row the stripes, the rest noise.
+v1::Frame HostileFrame() {
+  cv::Mat grey(2896, 2896, CV_8UC1);
+  cv::RNG rng(7);
+  rng.fill(grey, cv::RNG::UNIFORM, 0, 256);
+  for (int y = 0; y < grey.rows; y += 2)
+    for (int x = 0; x < grey.cols; ++x)
+      grey.at<uchar>(y, x) = cv::saturate_cast<uchar>(128 + 100 * std::cos(2 * CV_PI * x / 15));
+  return FrameMessage(grey);
+}
+
+TEST(ProcessingService, ADeadlineFreesTheWorkerInsideTheDecode) {
+  InProcessService s;
+  v1::ProcessFrameRequest request;
+  *request.mutable_frame() = HostileFrame();
+  request.set_side(v1::SIDE_LEFT);
+  // How long the whole decode takes here (no deadline).
+  auto start = std::chrono::steady_clock::now();
+  (void)s.Client().ProcessFrame(request);
+  const auto whole = std::chrono::steady_clock::now() - start;
+
+  const auto allowed = whole / 5;
+  grpc::ClientContext context;
+  start = std::chrono::steady_clock::now();
+  context.set_deadline(std::chrono::system_clock::now() + allowed);
+  auto reader = s.stub().ProcessFrame(&context, request);
+  v1::WorkEvent event;
+  while (reader->Read(&event)) {
+  }
+  EXPECT_EQ(reader->Finish().error_code(), StatusCode::DEADLINE_EXCEEDED);
+  // The worker comes free well before the decode would have ended: the
+  // stages ask between themselves and inside the long ones.
+  while (s.service().Stats().busy != 0 && std::chrono::steady_clock::now() - start < whole * 2)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const auto freed = std::chrono::steady_clock::now() - start;
+  RecordProperty("decode_ms",
+                 std::to_string(std::chrono::duration<double, std::milli>(whole).count()));
+  RecordProperty(
+      "freed_after_deadline_ms",
+      std::to_string(std::chrono::duration<double, std::milli>(freed - allowed).count()));
+  EXPECT_EQ(s.service().Stats().busy, 0);
+  EXPECT_LT(freed, allowed + (whole - allowed) / 2)
+      << "decode " << std::chrono::duration<double>(whole).count() << " s, deadline "
+      << std::chrono::duration<double>(allowed).count() << " s, worker free after "
+      << std::chrono::duration<double>(freed).count() << " s";
+}
+
+TEST(ProcessingService, AFrameAboveThePixelBudgetIsRefusedBeforeAnyWork) {
+  ProcessingServiceOptions options;
+  options.max_frame_pixels = 512 * 512;
+  InProcessService s(options);
+  EXPECT_TRUE(s.Client().ProcessFrame(FaceRequest(pattern::Side::kLeft, false)).status.ok());
+  v1::ProcessFrameRequest request;
+  *request.mutable_frame() = FrameMessage(cv::Mat(512, 513, CV_8UC1, cv::Scalar(9)));
+  request.set_side(v1::SIDE_LEFT);
+  const grpc::Status status = s.Client().ProcessFrame(request).status;
+  EXPECT_EQ(status.error_code(), StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("max_frame_pixels"), std::string::npos)
+      << status.error_message();
+  EXPECT_NE(status.error_message().find("frame: 513 x 512"), std::string::npos)
+      << status.error_message();
+}
+
 // The files of a rendered calibration session, relative to its folder.
 std::vector<UploadFile> SessionFiles(const fs::path& folder, std::string* manifest) {
   std::vector<UploadFile> files;
@@ -449,10 +513,9 @@ TEST(ProcessingService, CalibrateFromAnUploadedSession) {
       SessionFiles(calibration::testing::SessionFolder(SessionKind::kRightClean), &manifest);
   ASSERT_FALSE(files.empty());
   int views = 0;
-  const WorkOutcome out =
-      s.Client().Calibrate(manifest, files, "rig 2", [&](const v1::Progress& p) {
-        views += p.stage().starts_with("calibrate ");
-      });
+  const WorkOutcome out = s.Client().Calibrate(
+      manifest, files, "rig 2",
+      [&](const v1::Progress& p) { views += p.stage().starts_with("calibrate "); });
   ASSERT_TRUE(out.status.ok()) << out.status.error_message();
   EXPECT_EQ(views, static_cast<int>(files.size()));
   ASSERT_TRUE(out.files.count("calibration.yaml"));

@@ -692,7 +692,8 @@ std::optional<DecodeChain> ChainFor(std::optional<DecodeChain> named, const Deco
   return named;
 }
 
-DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams& params) {
+DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
+                    const Cancellation& cancel) {
   if (grey.empty() || grey.type() != CV_8UC1)
     throw std::invalid_argument("Decode: frame must be a non-empty CV_8UC1 image");
   std::string why;
@@ -710,7 +711,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     return result;
   }
   if (params.chain == DecodeChain::kTracks) {
-    internal::DecodeByTracks(grey, side, params, &result);
+    internal::DecodeByTracks(grey, side, params, cancel, &result);
     result.times.total_ms = MsSince(start);
     return result;
   }
@@ -720,6 +721,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   auto t = Clock::now();
   if (params.binning == 0)
     result.pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
+  cancel.ThrowIfRequested("the stripe pitch");
   const int n = internal::BinningFor(result.pitch, params.tuned_pitch, params);
   result.binning = n;
   // The columns beside the lit pattern hold nothing to find.
@@ -731,6 +733,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   const extraction::ExtractionResult features =
       extraction::ExtractFeatures(working, params.extraction);
   result.times.extraction_ms = MsSince(t);
+  cancel.ThrowIfRequested("the feature extraction");
 
   // Where a second core is free, the sub-pixel centres of the skeleton's
   // runs are measured on it while this one interprets (centres_ahead.h).
@@ -769,6 +772,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     result.times.total_ms = MsSince(start);
     return result;
   }
+  cancel.ThrowIfRequested("the interpretation");
 
   t = Clock::now();
   const int q_offset = params.q_offset.value_or(0);

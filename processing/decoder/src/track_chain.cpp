@@ -301,7 +301,7 @@ std::vector<cv::Point2d> RowsOfFullFrame(const std::vector<cv::Point2d>& working
 }  // namespace
 
 void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
-                    DecodeResult* result) {
+                    const Cancellation& cancel, DecodeResult* result) {
   const TrackChainParams& tp = params.track_chain;
   auto t = Clock::now();
   // The working resolution: the frame resampled so that its stripes lie
@@ -317,6 +317,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       return;
     }
   }
+  cancel.ThrowIfRequested("the stripe pitch");
   const double factor = WorkingFactor(result->pitch, params);
   cv::Mat working;
   const WorkingScale scale = ResampleFrame(grey, factor, &working);
@@ -326,15 +327,18 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   cv::Mat smoothed;
   cv::GaussianBlur(working, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
                    cv::BORDER_REPLICATE);
+  cancel.ThrowIfRequested("the smoothing");
   extraction::RidgePoints rows = extraction::FindRidgePoints(smoothed, tp.ridge);
+  cancel.ThrowIfRequested("the ridges along rows");
   extraction::RidgePoints columns = extraction::FindColumnRidgePoints(smoothed, tp.ridge);
+  cancel.ThrowIfRequested("the ridges along columns");
   result->times.extraction_ms = MsSince(t);
 
   t = Clock::now();
-  const interpretation::TrackNetwork net =
-      interpretation::BuildTrackNetwork(std::move(rows), std::move(columns), side, tp.tracks);
+  const interpretation::TrackNetwork net = interpretation::BuildTrackNetwork(
+      std::move(rows), std::move(columns), side, tp.tracks, cancel);
   const interpretation::TrackLabels labels =
-      interpretation::LabelTracks(net, side, params.spec, tp.labelling);
+      interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
   // The tracks' ridge points, as the skeleton chain's repaired skeleton.
@@ -343,6 +347,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     result->error = labels.error;
     return;
   }
+  cancel.ThrowIfRequested("the labelling");
 
   t = Clock::now();
   // Centres of every labelled line track, in parallel.

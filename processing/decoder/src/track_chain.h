@@ -16,9 +16,9 @@ namespace bsls::decoder::internal {
 // Decodes the CV_8UC1 frame `grey` (already checked: not blank, not
 // saturated) by the track chain into `result`, whose frame fields (side,
 // size, q_absolute) the caller has set. Without a reference line, result->ok
-// stays false with the reason.
+// stays false with the reason. Throws Cancelled when `cancel` asks to stop.
 void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
-                    DecodeResult* result);
+                    const Cancellation& cancel, DecodeResult* result);
 
 }  // namespace bsls::decoder::internal
 

@@ -108,14 +108,17 @@ std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
 }
 
 TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePoints columns,
-                               pattern::Side side, const TrackParams& params) {
+                               pattern::Side side, const TrackParams& params,
+                               const Cancellation& cancel) {
   std::string why;
   if (!params.IsValid(&why)) throw std::invalid_argument("BuildTrackNetwork: " + why);
   TrackNetwork net;
   net.rows = std::move(rows);
   net.columns = std::move(columns);
   net.lines = LinkTracks(net.rows, params, &net.line_of_point);
+  cancel.ThrowIfRequested("the line tracks");
   net.segments = CutSteepStretches(net.columns, LinkTracks(net.columns, params), params);
+  cancel.ThrowIfRequested("the segment tracks");
 
   // Gaps in lines: each track's end and the start of the nearest track
   // beginning within bridge_rows below it, when each is the other's nearest.
@@ -173,21 +176,36 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
     }
   }
 
-  // The bridged gaps by row: gap a (from line a's last point to the first of
-  // line_below[a]) is listed at every row from its upper end to the row
-  // before its lower end, each row's in ascending a.
-  std::vector<std::vector<int>> gaps_at(starting.size());
-  for (int a = 0; a < n_lines; ++a)
-    if (net.line_below[a] >= 0)
-      for (int y = last(a).y; y < first(net.line_below[a]).y; ++y) gaps_at[y].push_back(a);
+  // The bridged gaps by row: gap a (the chord from line a's last point to
+  // the first of line_below[a]) is listed at every row from its upper end to
+  // the row before its lower end, with its x half a row down; each row's by
+  // that x. A chord moves at most bridge_distance in x over a row.
+  struct GapAtRow {
+    double x;
+    int a;
+  };
+  std::vector<std::vector<GapAtRow>> gaps_at(starting.size());
+  for (int a = 0; a < n_lines; ++a) {
+    if (net.line_below[a] < 0) continue;
+    const extraction::RidgePoint p0 = last(a), p1 = first(net.line_below[a]);
+    for (int y = p0.y; y < p1.y; ++y)
+      gaps_at[y].push_back({p0.x + (p1.x - p0.x) * (y + 0.5 - p0.y) / (p1.y - p0.y), a});
+  }
+  for (std::vector<GapAtRow>& row : gaps_at)
+    std::sort(row.begin(), row.end(),
+              [](const GapAtRow& u, const GapAtRow& v) { return u.x < v.x; });
 
-  // The line point of row y within [lo, hi] nearest to `at`, or -1.
+  // The line point of row y within [lo, hi] nearest to `at`, or -1. A row's
+  // points run left to right: only those within [lo, hi] are looked at.
   auto line_point = [&](int y, double lo, double hi, double at) {
     int best = -1;
     const auto row = net.rows.Row(y);
-    for (size_t k = 0; k < row.size(); ++k) {
+    const auto from = std::partition_point(
+        row.begin(), row.end(), [lo](const extraction::RidgePoint& r) { return r.x < lo; });
+    for (size_t k = static_cast<size_t>(from - row.begin()); k < row.size() && row[k].x <= hi;
+         ++k) {
       const int i = net.rows.row_start[y] + static_cast<int>(k);
-      if (net.line_of_point[i] < 0 || row[k].x < lo || row[k].x > hi) continue;
+      if (net.line_of_point[i] < 0) continue;
       if (best < 0 || std::abs(row[k].x - at) < std::abs(net.rows.points[best].x - at)) best = i;
     }
     return best;
@@ -196,6 +214,7 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
   const auto& cp = net.columns.points;  // x: image row, y: image column
   geometry::Samples in;                 // a segment's end: (column - the end's column, row)
   for (int s = 0; s < static_cast<int>(net.segments.size()); ++s) {
+    if (s % 4096 == 0) cancel.ThrowIfRequested("the junctions");
     const std::vector<int>& t = net.segments[s].points;
     if (static_cast<int>(t.size()) < params.min_segment) continue;
     // The segment's middle column: each end looks for its line on its own
@@ -235,15 +254,18 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
         j.position = {net.rows.points[hit].x, static_cast<double>(net.rows.points[hit].y)};
       } else {
         // No ridge point there: the end may meet a line across a gap, on the
-        // chord joining its two tracks (a break next to the junction).
+        // chord joining its two tracks (a break next to the junction); of
+        // several, the first line's.
         const int gap_row = std::isfinite(ey) ? static_cast<int>(std::floor(ey)) : -1;
-        const std::vector<int> none;
-        const std::vector<int>& crossing =
-            gap_row >= 0 && gap_row < static_cast<int>(gaps_at.size()) ? gaps_at[gap_row] : none;
-        for (size_t g = 0; g < crossing.size() && j.line < 0; ++g) {
-          const int a = crossing[g];
-          const int b = net.line_below[a];
-          const extraction::RidgePoint p0 = last(a), p1 = first(b);
+        if (gap_row < 0 || gap_row >= static_cast<int>(gaps_at.size())) continue;
+        const std::vector<GapAtRow>& crossing = gaps_at[gap_row];
+        auto g = std::partition_point(crossing.begin(), crossing.end(), [&](const GapAtRow& c) {
+          return c.x < lo - params.bridge_distance;
+        });
+        for (; g != crossing.end() && g->x <= hi + params.bridge_distance; ++g) {
+          const int a = g->a;
+          if (j.line >= 0 && a > j.line) continue;
+          const extraction::RidgePoint p0 = last(a), p1 = first(net.line_below[a]);
           if (ey <= p0.y || ey >= p1.y) continue;
           const double x = p0.x + (p1.x - p0.x) * (ey - p0.y) / (p1.y - p0.y);
           if (x < lo || x > hi) continue;

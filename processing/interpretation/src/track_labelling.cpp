@@ -26,9 +26,9 @@ struct Link {
   int dv = 0;
 };
 
-constexpr double kSmoothSpread = 1.2;  // a smooth step's row spacing against its neighbour's
-constexpr double kPitchSpread = 1.4;   // and the pitch beside its two ends
-constexpr double kOwnLine = 2.0;       // px: ridge points this close to a junction are its line's
+constexpr double kSmoothSpread = 1.2;   // a smooth step's row spacing against its neighbour's
+constexpr double kPitchSpread = 1.4;    // and the pitch beside its two ends
+constexpr double kOwnLine = 2.0;        // px: ridge points this close to a junction are its line's
 constexpr double kSpacingSpread = 1.6;  // a line's own row spacing lies within this factor
                                         // of the frame's
 // The row spacing along a line: the dy of a step between junctions of
@@ -120,8 +120,8 @@ std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
     return {};
   }
   if (corresponding > params.max_inner_fraction * (direct + corresponding)) {
-    *why = "no reference line (line 0): the outermost line has " +
-           std::to_string(corresponding) + " segments on its inner side";
+    *why = "no reference line (line 0): the outermost line has " + std::to_string(corresponding) +
+           " segments on its inner side";
     return {};
   }
   return chain;
@@ -150,7 +150,8 @@ bool TrackLabellingParams::IsValid(std::string* error) const {
 
 // Thesis 5.1.4.9: labelling, on the track network.
 TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
-                        const pattern::PatternSpec& spec, const TrackLabellingParams& params) {
+                        const pattern::PatternSpec& spec, const TrackLabellingParams& params,
+                        const Cancellation& cancel) {
   std::string invalid;
   if (!params.IsValid(&invalid)) throw std::invalid_argument("LabelTracks: " + invalid);
   const int n = static_cast<int>(net.junctions.size());
@@ -167,6 +168,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     out.error = why;
     return out;
   }
+  cancel.ThrowIfRequested("line 0");
   std::vector<char> is_reference(net.lines.size(), 0);
   for (int t : out.reference) is_reference[t] = 1;
 
@@ -180,7 +182,8 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     int previous = -1;
     for (int j : net.junctions_on_line[t]) {
       if (is_reference[t] && net.junctions[j].kind != JunctionKind::kDirect) continue;
-      if (previous >= 0) samples[t].push_back(RowSpacing(net.junctions[previous], net.junctions[j]));
+      if (previous >= 0)
+        samples[t].push_back(RowSpacing(net.junctions[previous], net.junctions[j]));
       previous = j;
     }
     all_spacing.insert(all_spacing.end(), samples[t].begin(), samples[t].end());
@@ -277,11 +280,16 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // crossed by the track changes the spacing or the pitch).
   auto pitch_at = [&](int j) {  // px to the nearest other line in j's row, or 0
     const cv::Point2d at = net.junctions[j].position;
+    const auto row = net.rows.Row(static_cast<int>(std::lround(at.y)));
+    // The row runs left to right: the nearest beyond kOwnLine on each side.
+    const auto right = std::partition_point(row.begin(), row.end(),
+                                            [&](const auto& r) { return r.x <= at.x + kOwnLine; });
+    const auto left = std::partition_point(row.begin(), row.end(),
+                                           [&](const auto& r) { return r.x < at.x - kOwnLine; });
     double nearest = 0;
-    for (const extraction::RidgePoint& r : net.rows.Row(static_cast<int>(std::lround(at.y)))) {
-      const double d = std::abs(r.x - at.x);
-      if (d > kOwnLine && (nearest == 0 || d < nearest)) nearest = d;
-    }
+    if (right != row.end()) nearest = right->x - at.x;
+    if (left != row.begin() && (nearest == 0 || at.x - std::prev(left)->x < nearest))
+      nearest = at.x - std::prev(left)->x;
     return nearest;
   };
   std::vector<double> pitch(n);
@@ -349,26 +357,27 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // joins (thesis 5.2.1): the rows counted from the gap's length.
   for (size_t i = 1; i < seeds.size(); ++i) {
     const int above = net.junctions[seeds[i - 1]].line, below = net.junctions[seeds[i]].line;
-    if (above != below && net.line_below[above] != below)
-      gap_step(seeds[i - 1], seeds[i]);
+    if (above != below && net.line_below[above] != below) gap_step(seeds[i - 1], seeds[i]);
   }
 
+  cancel.ThrowIfRequested("the links between junctions");
   // Labels proven by agreement (label_consensus.h): only the component of
   // line 0 is labelled, every other junction left unlabelled.
   std::vector<char> odd_kind(n);
   for (int j = 0; j < n; ++j) odd_kind[j] = net.junctions[j].kind == JunctionKind::kCorresponding;
-  const Consensus consensus = LabelByConsensus(odd_kind, links, seeds,
-                                               params.min_reference_junctions,
-                                               {params.min_support, params.max_dissent});
-  if (consensus.p.empty() ||
-      std::none_of(consensus.p.begin(), consensus.p.end(), [](int p) { return p != kUnlabelled; })) {
+  const Consensus consensus =
+      LabelByConsensus(odd_kind, links, seeds, params.min_reference_junctions,
+                       {params.min_support, params.max_dissent});
+  if (consensus.p.empty() || std::none_of(consensus.p.begin(), consensus.p.end(),
+                                          [](int p) { return p != kUnlabelled; })) {
     out.error = "no reference line (line 0): its junctions do not agree on their labels";
     return out;
   }
   for (int j = 0; j < n; ++j) {
     if (consensus.p[j] == kUnlabelled) continue;
     // A label outside the slide, or of the other kind, is not reported.
-    if (pattern::JunctionOnRowParity(spec, consensus.p[j], consensus.v[j]) != net.junctions[j].kind) {
+    if (pattern::JunctionOnRowParity(spec, consensus.p[j], consensus.v[j]) !=
+        net.junctions[j].kind) {
       ++out.conflicts;
       continue;
     }
@@ -376,6 +385,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
     out.v[j] = consensus.v[j];
   }
   const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
+  cancel.ThrowIfRequested("the consensus of labels");
 
   // A label most of whose neighbours disagree is dropped, not guessed.
   out.conflicts += internal::DropDisagreeingLabels(

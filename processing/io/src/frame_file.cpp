@@ -4,15 +4,16 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
-#include <random>
-
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <random>
 
 namespace bsls::io {
 namespace {
@@ -43,6 +44,26 @@ cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion,
 cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::string& path,
                         FrameConversion* conversion, const FrameLimits& limits) {
   if (bytes.empty()) throw InputError(path + ": file is empty");
+  auto check_size = [&](std::uint64_t width, std::uint64_t height) {
+    if (width < static_cast<std::uint64_t>(limits.min_side) ||
+        height < static_cast<std::uint64_t>(limits.min_side) ||
+        width > static_cast<std::uint64_t>(limits.max_side) ||
+        height > static_cast<std::uint64_t>(limits.max_side))
+      throw InputError(path + ": size " + std::to_string(width) + "x" + std::to_string(height) +
+                       " is outside " + std::to_string(limits.min_side) + ".." +
+                       std::to_string(limits.max_side) + " pixels a side");
+  };
+  // A PNG says its size in its first chunk (IHDR): a size outside the
+  // limits is refused before anything is decoded or allocated for it.
+  static constexpr unsigned char kPngStart[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
+                                                0,    0,   0,   13,  'I',  'H',  'D',  'R'};
+  if (bytes.size() >= 24 && std::equal(std::begin(kPngStart), std::end(kPngStart), bytes.begin())) {
+    auto be32 = [&](size_t at) {
+      return std::uint64_t{bytes[at]} << 24 | std::uint64_t{bytes[at + 1]} << 16 |
+             std::uint64_t{bytes[at + 2]} << 8 | std::uint64_t{bytes[at + 3]};
+    };
+    check_size(be32(16), be32(20));
+  }
   cv::Mat raw;
   try {
     raw = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
@@ -51,24 +72,30 @@ cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::stri
   }
   if (raw.empty()) throw InputError(path + ": not a readable image (truncated or unknown format)");
   if (raw.dims != 2) throw InputError(path + ": not a two-dimensional image");
-  if (raw.cols < limits.min_side || raw.rows < limits.min_side || raw.cols > limits.max_side ||
-      raw.rows > limits.max_side)
-    throw InputError(path + ": size " + std::to_string(raw.cols) + "x" + std::to_string(raw.rows) +
-                     " is outside " + std::to_string(limits.min_side) + ".." +
-                     std::to_string(limits.max_side) + " pixels a side");
+  check_size(static_cast<std::uint64_t>(raw.cols), static_cast<std::uint64_t>(raw.rows));
   FrameConversion conv;
   conv.source_channels = raw.channels();
   switch (raw.depth()) {
-    case CV_8U: conv.source_depth_bits = 8; break;
-    case CV_16U: conv.source_depth_bits = 16; break;
+    case CV_8U:
+      conv.source_depth_bits = 8;
+      break;
+    case CV_16U:
+      conv.source_depth_bits = 16;
+      break;
     default:
       throw InputError(path + ": pixel depth is neither 8 nor 16 bits");
   }
   cv::Mat grey;
   switch (raw.channels()) {
-    case 1: grey = raw; break;
-    case 3: cv::cvtColor(raw, grey, cv::COLOR_BGR2GRAY); break;
-    case 4: cv::cvtColor(raw, grey, cv::COLOR_BGRA2GRAY); break;
+    case 1:
+      grey = raw;
+      break;
+    case 3:
+      cv::cvtColor(raw, grey, cv::COLOR_BGR2GRAY);
+      break;
+    case 4:
+      cv::cvtColor(raw, grey, cv::COLOR_BGRA2GRAY);
+      break;
     case 2: {
       std::vector<cv::Mat> planes;
       cv::split(raw, planes);  // grey + alpha
@@ -128,7 +155,8 @@ void WritePngAtomically(const std::string& path, const cv::Mat& image) {
   } catch (const cv::Exception& e) {
     throw OutputError(path + ": PNG encoding failed: " + e.err);
   }
-  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  WriteFileAtomically(path,
+                      std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
 }
 
 }  // namespace bsls::io

@@ -45,8 +45,7 @@ bool MeasurementPlan::IsValid(std::string* error) const {
     return false;
   };
   for (size_t i = 0; i < heights.size(); ++i)
-    if (!Finite(heights[i]))
-      return fail("height " + std::to_string(i + 1) + ": " + kNotOnThePlane);
+    if (!Finite(heights[i])) return fail("height " + std::to_string(i + 1) + ": " + kNotOnThePlane);
   for (size_t i = 0; i < distances.size(); ++i)
     if (!Finite(distances[i][0]) || !Finite(distances[i][1]))
       return fail("distance " + std::to_string(i + 1) + ": " + kNotOnThePlane);
@@ -67,7 +66,8 @@ bool MeasurementPlan::IsValid(std::string* error) const {
   return true;
 }
 
-MeasurementOutcome MeasurePlan(const geometry::SurfaceMesh& mesh, const MeasurementPlan& plan) {
+MeasurementOutcome MeasurePlan(const geometry::SurfaceMesh& mesh, const MeasurementPlan& plan,
+                               const Cancellation& cancel) {
   std::string why;
   if (!plan.IsValid(&why)) throw std::invalid_argument("measurement plan: " + why);
   MeasurementOutcome out;
@@ -76,13 +76,16 @@ MeasurementOutcome MeasurePlan(const geometry::SurfaceMesh& mesh, const Measurem
             {"distances", nlohmann::json::array()},
             {"areas", nlohmann::json::array()},
             {"lesions", nlohmann::json::array()}};
+  cancel.ThrowIfRequested("the surface's index");
   const SurfaceQuery surface(mesh);
   for (const Eigen::Vector2d& xy : plan.heights) {
+    cancel.ThrowIfRequested("the heights");
     const Measured h = HeightAboveBase(surface, xy);
     out.rows.push_back({"height at " + PointText(xy), h, "mm"});
     report["heights"].push_back({{"at", {xy.x(), xy.y()}}, {"height_mm", ToJson(h)}});
   }
   for (const auto& d : plan.distances) {
+    cancel.ThrowIfRequested("the distances");
     const GeodesicResult g = GeodesicDistance(surface, d[0], d[1]);
     const std::string between = PointText(d[0]) + "-" + PointText(d[1]);
     out.rows.push_back({"straight " + between, g.straight_mm, "mm"});
@@ -93,11 +96,13 @@ MeasurementOutcome MeasurePlan(const geometry::SurfaceMesh& mesh, const Measurem
     report["distances"].push_back(entry);
   }
   for (size_t i = 0; i < plan.areas.size(); ++i) {
+    cancel.ThrowIfRequested("the areas");
     const Measured a = SurfaceArea(surface, plan.areas[i]);
     out.rows.push_back({"area of region " + std::to_string(i + 1), a, "mm^2"});
     report["areas"].push_back({{"region", PolygonJson(plan.areas[i])}, {"area_mm2", ToJson(a)}});
   }
   for (size_t i = 0; i < plan.lesions.size(); ++i) {
+    cancel.ThrowIfRequested("the lesions");
     LesionMeasurement m;
     if (!plan.baseline) {
       m = MeasureLesion(surface, plan.lesions[i], plan.lesion);

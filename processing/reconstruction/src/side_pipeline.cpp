@@ -19,7 +19,7 @@ bool SidePipelineParams::IsValid(std::string* error) const {
 }
 
 SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeometry& geometry,
-                        const SidePipelineParams& params) {
+                        const SidePipelineParams& params, const Cancellation& cancel) {
   std::string error;
   if (!params.IsValid(&error)) throw std::invalid_argument("ProcessSide: " + error);
   const auto* calibration = std::get_if<const calibration::SideCalibration*>(&geometry);
@@ -42,7 +42,7 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
   decode.chain = surface ? decoder::DecodeChain::kSkeleton : decoder::DecodeChain::kTracks;
   decode.chain = *decoder::ChainFor(params.chain, decode, nullptr);  // checked by IsValid
   SideOutcome outcome;
-  outcome.decode = decoder::Decode(grey, side, decode);
+  outcome.decode = decoder::Decode(grey, side, decode, cancel);
   if (!outcome.decode.ok) return outcome;
   if (calibration) {
     if (const auto offset =
@@ -60,6 +60,7 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
     model.side = side;
     model.geometry = std::get<GeometricSetupParams>(geometry);
   }
+  cancel.ThrowIfRequested("the decode");
   outcome.surface = Reconstruct(outcome.decode, model, params.reconstruction, &outcome.report);
   return outcome;
 }

@@ -1,9 +1,9 @@
 #include "bsls/processing/processing_service.h"
 
-#include <spdlog/spdlog.h>
-#include <yaml-cpp/yaml.h>
 #include <malloc.h>
+#include <spdlog/spdlog.h>
 #include <stdlib.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <chrono>
@@ -69,12 +69,21 @@ void CheckTag(const std::string& tag) {
            "request_tag: " + std::to_string(tag.size()) + " bytes, at most 256");
 }
 
-cv::Mat FrameOf(const v1::Frame& frame, const std::string& name) {
+// The frame `name` of a request, refused (INVALID_ARGUMENT) when malformed
+// or above `max_pixels`.
+cv::Mat FrameOf(const v1::Frame& frame, const std::string& name, std::int64_t max_pixels) {
+  cv::Mat grey;
   try {
-    return rpc::FrameView(frame, name);
+    grey = rpc::FrameView(frame, name);
   } catch (const rpc::FrameMessageError& e) {
     Refuse(StatusCode::INVALID_ARGUMENT, e.what());
   }
+  if (static_cast<std::int64_t>(grey.total()) > max_pixels)
+    Refuse(StatusCode::INVALID_ARGUMENT,
+           name + ": " + std::to_string(grey.cols) + " x " + std::to_string(grey.rows) + " = " +
+               std::to_string(grey.total()) + " pixels is above this service's budget of " +
+               std::to_string(max_pixels) + " (max_frame_pixels)");
+  return grey;
 }
 
 void FillInfo(const CachedCalibration& c, v1::CalibrationInfo* info) {
@@ -133,9 +142,10 @@ measurement::MeasurementPlan PlanOf(const v1::MeasurementPlan& m, int max_figure
   for (const v1::PointXY& h : m.heights()) plan.heights.push_back(PointOf(h));
   for (int i = 0; i < m.distances_size(); ++i) {
     if (m.distances(i).points_size() != 2)
-      Refuse(StatusCode::INVALID_ARGUMENT, "measurements.distances[" + std::to_string(i) +
-                                               "]: give exactly two points");
-    plan.distances.push_back({PointOf(m.distances(i).points(0)), PointOf(m.distances(i).points(1))});
+      Refuse(StatusCode::INVALID_ARGUMENT,
+             "measurements.distances[" + std::to_string(i) + "]: give exactly two points");
+    plan.distances.push_back(
+        {PointOf(m.distances(i).points(0)), PointOf(m.distances(i).points(1))});
   }
   for (const v1::Polygon& a : m.areas()) plan.areas.push_back(PolygonOf(a));
   for (const v1::Polygon& l : m.lesions()) plan.lesions.push_back(PolygonOf(l));
@@ -391,9 +401,9 @@ Status ProcessingService::RunWork(grpc::ServerContext* context, const std::strin
   }
   w.result.set_software_version(options_.software_version);
   w.result.set_replica(options_.replica);
-  w.Time("total", std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                             w.start)
-                      .count());
+  w.Time("total",
+         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - w.start)
+             .count());
   v1::WorkEvent done;
   *done.mutable_result() = std::move(w.result);
   if (!emit(done)) return stopped_status();
@@ -406,7 +416,7 @@ Status ProcessingService::ProcessFrame(grpc::ServerContext* context,
   const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
   return RunWork(context, "ProcessFrame", emit, {}, [&](Work& w) {
     // Every field is checked before any work.
-    const cv::Mat grey = FrameOf(request->frame(), "frame");
+    const cv::Mat grey = FrameOf(request->frame(), "frame", options_.max_frame_pixels);
     const pattern::Side side = SideOf(request->side(), "side");
     CheckTag(request->request_tag());
     std::shared_ptr<const CachedCalibration> cal;
@@ -422,7 +432,7 @@ Status ProcessingService::ProcessFrame(grpc::ServerContext* context,
     reconstruction::SideGeometry geometry;
     if (cal) geometry = &cal->calibration;
     const reconstruction::SideOutcome outcome =
-        reconstruction::ProcessSide(grey, side, geometry, params);
+        reconstruction::ProcessSide(grey, side, geometry, params, w.observer.cancellation());
     const decoder::DecodeResult& d = outcome.decode;
     if (!d.ok) Refuse(StatusCode::FAILED_PRECONDITION, "frame: " + d.error);
     w.observer.CheckCancelled("sending the results");
@@ -456,8 +466,8 @@ Status ProcessingService::ReconstructSession(grpc::ServerContext* context,
                                              grpc::ServerWriter<v1::WorkEvent>* writer) {
   const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
   return RunWork(context, "ReconstructSession", emit, {}, [&](Work& w) {
-    const cv::Mat left = FrameOf(request->left(), "left");
-    const cv::Mat right = FrameOf(request->right(), "right");
+    const cv::Mat left = FrameOf(request->left(), "left", options_.max_frame_pixels);
+    const cv::Mat right = FrameOf(request->right(), "right", options_.max_frame_pixels);
     CheckTag(request->request_tag());
     const auto left_cal = ResolveCalibration(request->left_calibration(), "left_calibration");
     const auto right_cal = ResolveCalibration(request->right_calibration(), "right_calibration");
@@ -529,7 +539,8 @@ Status ProcessingService::Measure(grpc::ServerContext* context, const v1::Measur
   return RunWork(context, "Measure", emit, {}, [&](Work& w) {
     CheckTag(request->request_tag());
     measurement::MeasurementPlan plan = PlanOf(request->measurements(), options_.max_measurements);
-    if (plan.empty()) Refuse(StatusCode::INVALID_ARGUMENT, "measurements: give at least one figure");
+    if (plan.empty())
+      Refuse(StatusCode::INVALID_ARGUMENT, "measurements: give at least one figure");
     geometry::SurfaceMesh surface;
     try {
       surface = io::DecodePly(request->surface_ply(), "surface_ply");
@@ -547,7 +558,7 @@ Status ProcessingService::Measure(grpc::ServerContext* context, const v1::Measur
     w.observer.Report("measure", 0.0);
     measurement::MeasurementOutcome m;
     try {
-      m = measurement::MeasurePlan(surface, plan);
+      m = measurement::MeasurePlan(surface, plan, w.observer.cancellation());
     } catch (const measurement::MeasurementError& e) {
       Refuse(StatusCode::FAILED_PRECONDITION, std::string("surface_ply: ") + e.what());
     }
@@ -568,7 +579,8 @@ Status ProcessingService::Calibrate(
   if (!stream->Read(&first))
     return Status(StatusCode::INVALID_ARGUMENT, "Calibrate: the upload ended before the manifest");
   if (first.part_case() != v1::CalibrateRequest::kManifest)
-    return Status(StatusCode::INVALID_ARGUMENT, "Calibrate: the first message must be the manifest");
+    return Status(StatusCode::INVALID_ARGUMENT,
+                  "Calibrate: the first message must be the manifest");
   if (first.manifest().yaml().size() > options_.max_manifest_bytes)
     return Status(StatusCode::INVALID_ARGUMENT,
                   "manifest.yaml: " + std::to_string(first.manifest().yaml().size()) +
@@ -627,9 +639,9 @@ Status ProcessingService::Calibrate(
                                                  std::to_string(sizes[path]) + " bytes");
       total += chunk.data().size();
       if (total > options_.max_upload_bytes)
-        Refuse(StatusCode::INVALID_ARGUMENT,
-               "Calibrate: the upload exceeds " + std::to_string(options_.max_upload_bytes) +
-                   " bytes");
+        Refuse(StatusCode::INVALID_ARGUMENT, "Calibrate: the upload exceeds " +
+                                                 std::to_string(options_.max_upload_bytes) +
+                                                 " bytes");
       out.write(chunk.data().data(), static_cast<std::streamsize>(chunk.data().size()));
       sizes[path] += chunk.data().size();
       if (chunk.last()) {
@@ -662,8 +674,8 @@ Status ProcessingService::Calibrate(
     }
     // The manifest may only name files of the upload.
     const fs::path root = fs::weakly_canonical(folder.path());
-    for (const auto* views : {&manifest.camera_views, &manifest.screen_views,
-                              &manifest.reference_views})
+    for (const auto* views :
+         {&manifest.camera_views, &manifest.screen_views, &manifest.reference_views})
       for (const calibration::ManifestView& view : *views) {
         const fs::path image = fs::weakly_canonical(view.image);
         const auto [end, _] = std::mismatch(root.begin(), root.end(), image.begin(), image.end());
@@ -675,8 +687,8 @@ Status ProcessingService::Calibrate(
       }
     calibration::SideCalibration result;
     try {
-      result = calibration::CalibrateSide(
-          manifest, {}, [&w](const std::string& view, double fraction) {
+      result =
+          calibration::CalibrateSide(manifest, {}, [&w](const std::string& view, double fraction) {
             if (w.observer.cancelled && w.observer.cancelled()) return false;
             w.observer.Report("calibrate " + view, 0.05 + 0.9 * fraction);
             return true;

@@ -22,14 +22,17 @@ SessionPart FramePart(Side side) {
 // Thesis 5.2: one side decoded and reconstructed; SessionError naming the side.
 reconstruction::SideOutcome ReconstructOneSide(const cv::Mat& grey, Side side,
                                                const calibration::SideCalibration& calibration,
-                                               const reconstruction::SidePipelineParams& params) {
+                                               const reconstruction::SidePipelineParams& params,
+                                               const Cancellation& cancel) {
   reconstruction::SideOutcome outcome;
   try {
-    outcome = reconstruction::ProcessSide(grey, side, &calibration, params);
+    outcome = reconstruction::ProcessSide(grey, side, &calibration, params, cancel);
   } catch (const std::invalid_argument& e) {
-    throw SessionError(SessionErrorReason::kInvalidInput, FramePart(side), FrameName(side) + ": " + e.what());
+    throw SessionError(SessionErrorReason::kInvalidInput, FramePart(side),
+                       FrameName(side) + ": " + e.what());
   } catch (const reconstruction::ReconstructionError& e) {
-    throw SessionError(SessionErrorReason::kNotProcessed, FramePart(side), FrameName(side) + ": " + e.what());
+    throw SessionError(SessionErrorReason::kNotProcessed, FramePart(side),
+                       FrameName(side) + ": " + e.what());
   }
   if (!outcome.decode.ok)
     throw SessionError(SessionErrorReason::kNotProcessed, FramePart(side),
@@ -86,8 +89,7 @@ SessionOutcome ReconstructSession(const cv::Mat& left, const calibration::SideCa
   out.shared_frame = calibration::SharesWorldFrame(left_cal, right_cal, &out.shared_frame_note);
   if (params.join == JoinMode::kShared && !out.shared_frame)
     throw SessionError(SessionErrorReason::kInvalidInput, SessionPart::kCalibrations,
-                       "the calibrations do not share a world frame: " +
-                           out.shared_frame_note);
+                       "the calibrations do not share a world frame: " + out.shared_frame_note);
   if (out.shared_frame) out.shared_frame_note.clear();
   out.by_features =
       params.join == JoinMode::kFeatures || (params.join == JoinMode::kAuto && !out.shared_frame);
@@ -98,19 +100,19 @@ SessionOutcome ReconstructSession(const cv::Mat& left, const calibration::SideCa
   side_params.decode.measure_ahead = false;
   const double measure_share = params.measurements.empty() ? 0.0 : 0.15;
   observer.CheckCancelled("the sides");
+  const Cancellation cancel = observer.cancellation();
   observer.Report("both sides", 0.0);
   // The sides are independent until the join: one core each.
   std::tie(out.left, out.right) = RunBothSides(
-      [&] { return ReconstructOneSide(left, Side::kLeft, left_cal, side_params); },
-      [&] { return ReconstructOneSide(right, Side::kRight, right_cal, side_params); });
+      [&] { return ReconstructOneSide(left, Side::kLeft, left_cal, side_params, cancel); },
+      [&] { return ReconstructOneSide(right, Side::kRight, right_cal, side_params, cancel); });
   observer.CheckCancelled("the join");
   observer.Report("join", 0.8 - measure_share);
   try {
-    out.joined = out.by_features
-                     ? joining::JoinByFeatures(*out.left.surface, *out.right.surface,
-                                               params.join_params)
-                     : joining::JoinSharedFrame(*out.left.surface, *out.right.surface,
-                                                params.join_params);
+    out.joined =
+        out.by_features
+            ? joining::JoinByFeatures(*out.left.surface, *out.right.surface, params.join_params)
+            : joining::JoinSharedFrame(*out.left.surface, *out.right.surface, params.join_params);
   } catch (const joining::JoinError& e) {
     throw SessionError(SessionErrorReason::kNotProcessed, SessionPart::kJoin,
                        std::string("join: ") + e.what());
@@ -119,7 +121,7 @@ SessionOutcome ReconstructSession(const cv::Mat& left, const calibration::SideCa
     observer.CheckCancelled("the measurements");
     observer.Report("measure", 1.0 - measure_share);
     try {
-      out.measurements = measurement::MeasurePlan(out.joined.mesh, params.measurements);
+      out.measurements = measurement::MeasurePlan(out.joined.mesh, params.measurements, cancel);
     } catch (const measurement::MeasurementError& e) {
       throw SessionError(SessionErrorReason::kNotProcessed, SessionPart::kMeasurements,
                          std::string("measurements: ") + e.what());

@@ -26,16 +26,16 @@
 #define BSLS_DECODER_DECODER_H_
 
 #include <map>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
+#include "bsls/common/cancellation.h"
 #include "bsls/extraction/feature_extraction.h"
+#include "bsls/extraction/ridge_points.h"
 #include "bsls/extraction/stripe_centre.h"
 #include "bsls/extraction/stripe_pitch.h"
-#include "bsls/extraction/ridge_points.h"
 #include "bsls/interpretation/interpreter.h"
 #include "bsls/interpretation/ridge_tracks.h"
 #include "bsls/interpretation/track_labelling.h"
@@ -67,7 +67,7 @@ struct TrackChainParams {
   double tuned_pitch = 15.0;
   double native_pitch_min = 10.0;
   double native_pitch_max = 22.0;
-  double min_scale = 1.0;  // (0, 1]
+  double min_scale = 1.0;        // (0, 1]
   double smoothing_sigma = 1.0;  // px, Gaussian applied before the ridge points, > 0
   extraction::RidgeParams ridge;
   interpretation::TrackParams tracks;
@@ -107,9 +107,9 @@ struct DecodeParams {
   // Pixel lengths below and in `centre` are for the working resolution (see
   // tuned_pitch): on a binned frame they are multiplied by the binning.
   extraction::StripeCentreParams centre;
-  int junction_fit_rows = 7;   // rows each side of a junction fitted to place it
+  int junction_fit_rows = 7;     // rows each side of a junction fitted to place it
   int segment_fit_columns = 50;  // columns of a segment measured to place its junction
-  int junction_clearance = 3;  // px each side of a junction where the other stroke biases centres
+  int junction_clearance = 3;    // px each side of a junction where the other stroke biases centres
   // px: a line centre further from its neighbours' fit is dropped.
   double max_centre_residual = 0.35;
   // Rows skipped beside a segment are refilled from the line's fit only where
@@ -148,8 +148,8 @@ struct DecodeParams {
   double region_rise = 6.0;  // grey levels, >= 0
   int region_margin = 32;    // working px, >= 0
   // The skeleton chain: where OpenCV has a second thread
-  // (cv::getNumThreads() > 1) and the frame is not binned, the sub-pixel centres across the extraction's skeleton
-  // runs are measured on a thread of their own while the interpretation runs
+  // (cv::getNumThreads() > 1) and the frame is not binned, the sub-pixel centres across the
+  // extraction's skeleton runs are measured on a thread of their own while the interpretation runs
   // (docs/decoding.md, "Centres measured ahead"); the output is the same
   // either way. Off where the caller already keeps every core busy (both
   // sides of a session decoded side by side).
@@ -200,8 +200,8 @@ struct DecodeResult {
   int width = 0;
   int height = 0;
   bool q_absolute = false;
-  std::vector<DecodedJunction> junctions;  // ordered by p, then q
-  std::vector<DecodedLine> lines;          // ordered by p
+  std::vector<DecodedJunction> junctions;      // ordered by p, then q
+  std::vector<DecodedLine> lines;              // ordered by p
   std::vector<UnlabelledJunction> unlabelled;  // ordered by y
   StageTimes times;
   // Diagnostics.
@@ -210,7 +210,7 @@ struct DecodeResult {
   // The track chain's working frame: full-frame px per working px (above 1
   // reduced, below 1 enlarged; 1: the frame itself).
   double scale = 1.0;
-  cv::Rect region;     // the part of the frame they ran on (DecodeParams::region_rise)
+  cv::Rect region;  // the part of the frame they ran on (DecodeParams::region_rise)
   // Sub-pixel centres measured ahead while the frame was interpreted
   // (DecodeParams::measure_ahead; 0: none). The output does not depend on it.
   int centres_measured_ahead = 0;
@@ -236,8 +236,10 @@ std::optional<DecodeChain> ChainFor(std::optional<DecodeChain> named, const Deco
 // Decodes a CV_8UC1 frame of the brick slide of `side`. A blank or saturated
 // frame, or one whose reference line cannot be found, comes back with
 // ok == false and a reason; nothing is guessed. Throws std::invalid_argument
-// for an empty or non-CV_8UC1 frame or invalid params.
-DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams& params = {});
+// for an empty or non-CV_8UC1 frame or invalid params, and bsls::Cancelled
+// when `cancel` asks to stop (asked between stages and inside the long ones).
+DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams& params = {},
+                    const Cancellation& cancel = {});
 
 }  // namespace bsls::decoder
 

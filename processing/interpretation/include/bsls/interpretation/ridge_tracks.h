@@ -17,11 +17,11 @@
 #ifndef BSLS_INTERPRETATION_RIDGE_TRACKS_H_
 #define BSLS_INTERPRETATION_RIDGE_TRACKS_H_
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
+#include "bsls/common/cancellation.h"
 #include "bsls/extraction/ridge_points.h"
 #include "bsls/pattern/brick_pattern.h"
 
@@ -67,8 +67,8 @@ struct Track {
 };
 
 struct TrackJunction {
-  int line = -1;     // the vertical line's track
-  int segment = -1;  // the segment's track
+  int line = -1;              // the vertical line's track
+  int segment = -1;           // the segment's track
   bool segment_left = false;  // the segment lies to the left of the line in the image
   pattern::JunctionKind kind = pattern::JunctionKind::kDirect;
   // Where the segment's end meets the line: the line's ridge point in that
@@ -77,12 +77,12 @@ struct TrackJunction {
 };
 
 struct TrackNetwork {
-  extraction::RidgePoints rows;     // ridge points along the rows: the lines' crossings
+  extraction::RidgePoints rows;  // ridge points along the rows: the lines' crossings
   // Ridge points along the columns (extraction::FindColumnRidgePoints): a point's
   // x is an image row, its y an image column.
   extraction::RidgePoints columns;
-  std::vector<Track> lines;     // tracks through `rows`
-  std::vector<Track> segments;  // tracks through `columns`
+  std::vector<Track> lines;        // tracks through `rows`
+  std::vector<Track> segments;     // tracks through `columns`
   std::vector<int> line_of_point;  // for each point of `rows`: its line track, or -1
   std::vector<TrackJunction> junctions;
   std::vector<std::vector<int>> junctions_on_line;  // per line track: its junctions by increasing y
@@ -105,9 +105,11 @@ std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
                                      std::vector<Track> segments, const TrackParams& params);
 
 // Links both sets of ridge points and finds the junctions of the brick
-// slide of `side`. Throws std::invalid_argument for invalid params.
+// slide of `side`. Throws std::invalid_argument for invalid params and
+// bsls::Cancelled when `cancel` asks to stop.
 TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePoints columns,
-                               pattern::Side side, const TrackParams& params = {});
+                               pattern::Side side, const TrackParams& params = {},
+                               const Cancellation& cancel = {});
 
 }  // namespace bsls::interpretation
 

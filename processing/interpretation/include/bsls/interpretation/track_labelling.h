@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/cancellation.h"
 #include "bsls/interpretation/ridge_tracks.h"
 #include "bsls/pattern/brick_pattern.h"
 
@@ -68,21 +69,22 @@ constexpr int kUnlabelled = INT_MIN;
 
 struct TrackLabels {
   bool ok = false;
-  std::string error;     // why nothing could be labelled (ok == false)
-  std::vector<int> p;    // per junction of the network: its line, or kUnlabelled
-  std::vector<int> v;    // per junction: its slide row (relative), or kUnlabelled
-  std::vector<int> line_p;  // per line track: the p most of its labelled junctions carry, or -1
+  std::string error;           // why nothing could be labelled (ok == false)
+  std::vector<int> p;          // per junction of the network: its line, or kUnlabelled
+  std::vector<int> v;          // per junction: its slide row (relative), or kUnlabelled
+  std::vector<int> line_p;     // per line track: the p most of its labelled junctions carry, or -1
   std::vector<int> reference;  // the line tracks taken for line 0
-  int conflicts = 0;     // labels dropped because their neighbours disagreed
-  double row_spacing = 0;  // px between rows along a line: the median over the frame
+  int conflicts = 0;           // labels dropped because their neighbours disagreed
+  double row_spacing = 0;      // px between rows along a line: the median over the frame
 };
 
 // Labels the junctions and line tracks of `network` for the brick slide of
 // `side`. Fails (ok == false, with the reason) when no line 0 carrying
 // enough direct junctions is found. Throws std::invalid_argument for invalid
-// params.
+// params, bsls::Cancelled when `cancel` asks to stop.
 TrackLabels LabelTracks(const TrackNetwork& network, pattern::Side side,
-                        const pattern::PatternSpec& spec, const TrackLabellingParams& params = {});
+                        const pattern::PatternSpec& spec, const TrackLabellingParams& params = {},
+                        const Cancellation& cancel = {});
 
 }  // namespace bsls::interpretation
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/cancellation.h"
 #include "bsls/geometry/surface_mesh.h"
 #include "bsls/measurement/baseline_registration.h"
 #include "bsls/measurement/lesion_measure.h"
@@ -25,9 +26,9 @@
 namespace bsls::measurement {
 
 struct MeasurementPlan {
-  std::vector<Eigen::Vector2d> heights;  // height above the base plane z = 0
+  std::vector<Eigen::Vector2d> heights;                   // height above the base plane z = 0
   std::vector<std::array<Eigen::Vector2d, 2>> distances;  // straight and along the surface
-  std::vector<Polygon2d> areas;    // surface area inside (>= 3 points each)
+  std::vector<Polygon2d> areas;                           // surface area inside (>= 3 points each)
   std::vector<Polygon2d> lesions;  // lump or cavity inside (>= 3 points each)
   LesionMeasureParams lesion;
   // An earlier scan of the same face the lesions are measured against
@@ -51,8 +52,10 @@ struct MeasurementOutcome {
 
 // Measures every figure of `plan` on `mesh`. Throws MeasurementError naming
 // the figure and the reason (a point off the surface, a region with no
-// ring...), std::invalid_argument for a plan that is not valid.
-MeasurementOutcome MeasurePlan(const geometry::SurfaceMesh& mesh, const MeasurementPlan& plan);
+// ring...), std::invalid_argument for a plan that is not valid, and
+// bsls::Cancelled when `cancel` asks to stop (asked before each figure).
+MeasurementOutcome MeasurePlan(const geometry::SurfaceMesh& mesh, const MeasurementPlan& plan,
+                               const Cancellation& cancel = {});
 
 }  // namespace bsls::measurement
 

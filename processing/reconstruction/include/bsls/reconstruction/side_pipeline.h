@@ -60,9 +60,10 @@ struct SideOutcome {
 // Throws ReconstructionError when the frame decodes but cannot be
 // reconstructed, std::invalid_argument for invalid params or a calibration
 // of the other side or another image size; a frame that does not decode comes
-// back with decode.ok == false and its reason.
+// back with decode.ok == false and its reason. Throws bsls::Cancelled when
+// `cancel` asks to stop.
 SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeometry& geometry,
-                        const SidePipelineParams& params = {});
+                        const SidePipelineParams& params = {}, const Cancellation& cancel = {});
 
 }  // namespace bsls::reconstruction
 

@@ -40,6 +40,10 @@ struct ProcessingServiceOptions {
   int max_upload_files = 256;
   std::size_t max_manifest_bytes = 1u << 20;
   int max_measurements = 100;  // figures in one MeasurementPlan
+  // Pixels (width x height) of a frame that is worked on; a larger one is
+  // refused with INVALID_ARGUMENT before any work (decoding is linear in
+  // pixels: 8 Mpx is about 2 s of the worst frame on one core).
+  std::int64_t max_frame_pixels = std::int64_t{8} << 20;
 };
 
 class ProcessingService final : public v1::Processing::Service {
@@ -61,9 +65,9 @@ class ProcessingService final : public v1::Processing::Service {
                                   grpc::ServerWriter<v1::WorkEvent>* writer) override;
   grpc::Status Measure(grpc::ServerContext* context, const v1::MeasureRequest* request,
                        grpc::ServerWriter<v1::WorkEvent>* writer) override;
-  grpc::Status Calibrate(grpc::ServerContext* context,
-                         grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream)
-      override;
+  grpc::Status Calibrate(
+      grpc::ServerContext* context,
+      grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream) override;
   grpc::Status PutCalibration(grpc::ServerContext* context,
                               const v1::PutCalibrationRequest* request,
                               v1::CalibrationInfo* response) override;

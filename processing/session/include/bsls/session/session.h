@@ -22,6 +22,7 @@
 #include <string_view>
 
 #include "bsls/calibration/side_calibration.h"
+#include "bsls/common/cancellation.h"
 #include "bsls/joining/join.h"
 #include "bsls/measurement/plan.h"
 #include "bsls/reconstruction/side_pipeline.h"
@@ -29,10 +30,7 @@
 namespace bsls::session {
 
 // The caller gave up (WorkObserver::cancelled said so); nothing is returned.
-class Cancelled : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using Cancelled = bsls::Cancelled;
 
 // Why a session could not be reconstructed.
 enum class SessionErrorReason {
@@ -70,6 +68,9 @@ class SessionError : public std::runtime_error {
 struct WorkObserver {
   std::function<void(std::string_view stage, double fraction)> progress;
   std::function<bool()> cancelled;
+
+  // The stages' view of `cancelled` (never asks to stop without one).
+  Cancellation cancellation() const { return Cancellation(cancelled); }
 
   // Reports that `stage` starts with `fraction` of the work done.
   void Report(std::string_view stage, double fraction) const;

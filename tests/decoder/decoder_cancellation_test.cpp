@@ -1,0 +1,70 @@
+// Decoding stops when its caller asks (bsls::Cancellation): at every stage
+// of both chains, with bsls::Cancelled, and nothing half-decoded returned.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <string>
+
+#include "bsls/common/cancellation.h"
+#include "bsls/decoder/decoder.h"
+#include "decoder_evaluation.h"
+
+namespace bsls::decoder::test {
+namespace {
+
+// A cancellation that asks to stop from its `stop_at`-th question on, and
+// counts the questions.
+struct CountingCancellation {
+  std::atomic<int> asked{0};
+  int stop_at = 1 << 30;
+  Cancellation Token() {
+    return Cancellation([this] { return ++asked >= stop_at; });
+  }
+};
+
+class DecoderCancellation : public ::testing::TestWithParam<DecodeChain> {
+ protected:
+  DecodeParams Params() const {
+    DecodeParams params;
+    params.chain = GetParam();
+    return params;
+  }
+};
+
+TEST_P(DecoderCancellation, ADefaultCancellationNeverStopsTheDecode) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 1);
+  const DecodeResult r = Decode(frame.image, Side::kLeft, Params(), Cancellation());
+  EXPECT_TRUE(r.ok) << r.error;
+}
+
+TEST_P(DecoderCancellation, EveryStageAsksAndStopsWhenTold) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 1);
+  CountingCancellation counting;
+  const DecodeResult whole = Decode(frame.image, Side::kLeft, Params(), counting.Token());
+  ASSERT_TRUE(whole.ok) << whole.error;
+  const int questions = counting.asked;
+  // Asked after the pitch, the extraction and the interpretation at least.
+  EXPECT_GE(questions, 3);
+  for (int stop_at = 1; stop_at <= questions; ++stop_at) {
+    CountingCancellation stopping;
+    stopping.stop_at = stop_at;
+    try {
+      (void)Decode(frame.image, Side::kLeft, Params(), stopping.Token());
+      ADD_FAILURE() << "question " << stop_at << " of " << questions << " said stop; no stop";
+    } catch (const Cancelled& e) {
+      EXPECT_EQ(stopping.asked, stop_at) << "the decode went on asking after it was told";
+      EXPECT_NE(std::string(e.what()).find("cancelled during"), std::string::npos) << e.what();
+    }
+  }
+}
+
+std::string ChainName(const ::testing::TestParamInfo<DecodeChain>& chain) {
+  return chain.param == DecodeChain::kTracks ? "Tracks" : "Skeleton";
+}
+
+INSTANTIATE_TEST_SUITE_P(BothChains, DecoderCancellation,
+                         ::testing::Values(DecodeChain::kTracks, DecodeChain::kSkeleton),
+                         ChainName);
+
+}  // namespace
+}  // namespace bsls::decoder::test
