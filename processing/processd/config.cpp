@@ -21,9 +21,11 @@ Config Parse(const YAML::Node& root) {
                {"listen", "workers", "queue", "calibration_cache_entries", "replica",
                 "scratch_dir", "max_upload_bytes", "drain_timeout_ms", "log_level"});
   const YAML::Node listen = root["listen"];
-  io::OnlyKeys(listen, "listen",
-               {"unix_socket", "tcp", "plaintext_loopback", "tls_certificate", "tls_key",
-                "tls_client_ca", "max_receive_message_bytes", "max_send_message_bytes"});
+  std::set<std::string> listen_keys = {
+      "unix_socket", "tcp",           "plaintext_loopback",        "tls_certificate",
+      "tls_key",     "tls_client_ca", "max_receive_message_bytes", "max_send_message_bytes"};
+  listen_keys.insert(rpc::Http2LimitKeys().begin(), rpc::Http2LimitKeys().end());
+  io::OnlyKeys(listen, "listen", listen_keys);
   if (listen) {
     ListenConfig& l = c.listen;
     io::ReadKey(listen, "listen", "unix_socket", l.unix_socket);
@@ -36,6 +38,7 @@ Config Parse(const YAML::Node& root) {
                        1 << 20, 1 << 30);
     io::ReadKeyInRange(listen, "listen", "max_send_message_bytes", l.max_send_message_bytes,
                        2 << 20, 1 << 30);
+    rpc::ReadHttp2Limits(listen, "listen", l.http2);
   }
   io::ReadKeyInRange(root, "", "workers", c.workers, 0, 256);
   io::ReadKeyInRange(root, "", "queue", c.queue, -1, 4096);
@@ -111,6 +114,7 @@ std::string Dump(const Config& c) {
   out << YAML::Key << "max_receive_message_bytes" << YAML::Value
       << c.listen.max_receive_message_bytes;
   out << YAML::Key << "max_send_message_bytes" << YAML::Value << c.listen.max_send_message_bytes;
+  rpc::DumpHttp2Limits(out, c.listen.http2);
   out << YAML::EndMap;
   out << YAML::Key << "workers" << YAML::Value << Workers(c);
   out << YAML::Key << "queue" << YAML::Value << Queue(c);

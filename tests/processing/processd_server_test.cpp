@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include "bsls/processing/processing_client.h"
 #include "bsls/testing/certificates.h"
@@ -58,6 +59,27 @@ TEST_F(ProcessdServer, ServesTheUnixSocketAndPlainLoopback) {
   }
   server->Drain();
   EXPECT_FALSE(fs::exists(config.listen.unix_socket));
+}
+
+// Issue 26: the HTTP/2 limits reach the server: a connection without calls
+// is closed after listen.max_connection_idle_ms and the client reconnects.
+TEST_F(ProcessdServer, AConnectionWithoutCallsIsClosedAfterTheIdleLimit) {
+  Config config;
+  config.listen.unix_socket = (dir_ / "processd.sock").string();
+  config.listen.http2.max_connection_idle_ms = 500;
+  config.workers = 1;
+  auto server = Server::Start(config, "test");
+  std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateChannel("unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials());
+  v1::ServerInfo info;
+  ASSERT_TRUE(Info(channel, &info).ok());
+  ASSERT_EQ(channel->GetState(false), GRPC_CHANNEL_READY);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (channel->GetState(false) == GRPC_CHANNEL_READY && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_NE(channel->GetState(false), GRPC_CHANNEL_READY) << "the idle connection stayed open";
+  EXPECT_TRUE(Info(channel, &info).ok());
+  server->Drain();
 }
 
 // One instance per socket: a second server on a socket that a live one
