@@ -139,8 +139,9 @@ void ParseRoles(const YAML::Node& node, RolesConfig& out) {
 }
 
 void ParseLimits(const YAML::Node& node, Config& out) {
-  OnlyKeys(node, "limits", {"max_preview_streams", "max_event_streams", "default_deadline_ms",
-                            "max_deadline_ms", "drain_timeout_ms"});
+  OnlyKeys(node, "limits",
+           {"max_preview_streams", "max_event_streams", "default_deadline_ms", "max_deadline_ms",
+            "drain_timeout_ms", "stream_write_timeout_ms"});
   if (!node) return;
   ReadInRange(node, "limits", "max_preview_streams", out.limits.max_preview_streams, 1, 256);
   ReadInRange(node, "limits", "max_event_streams", out.limits.max_event_streams, 1, 1024);
@@ -153,6 +154,9 @@ void ParseLimits(const YAML::Node& node, Config& out) {
   ms = out.drain_timeout.count();
   ReadInRange(node, "limits", "drain_timeout_ms", ms, 0LL, 600000LL);
   out.drain_timeout = std::chrono::milliseconds(ms);
+  ms = out.limits.stream_write_timeout.count();
+  ReadInRange(node, "limits", "stream_write_timeout_ms", ms, 100LL, 600000LL);
+  out.limits.stream_write_timeout = std::chrono::milliseconds(ms);
 }
 
 void ParseSlides(const YAML::Node& node, SlidesConfig& out) {
@@ -407,6 +411,8 @@ std::string Dump(const Config& config) {
       << config.limits.default_deadline.count();
   out << YAML::Key << "max_deadline_ms" << YAML::Value << config.limits.max_deadline.count();
   out << YAML::Key << "drain_timeout_ms" << YAML::Value << config.drain_timeout.count();
+  out << YAML::Key << "stream_write_timeout_ms" << YAML::Value
+      << config.limits.stream_write_timeout.count();
   out << YAML::EndMap;
   out << YAML::Key << "log_level" << YAML::Value << config.log_level;
   out << YAML::EndMap;
