@@ -1,12 +1,16 @@
-// UnixListener when the process runs out of descriptors (issue 26): the
-// accept loop sheds the waiting callers at once and does not spin. The
+// UnixListener under hostile callers (issue 26). Out of descriptors, the
+// accept loop sheds the waiting callers at once and does not spin (the
 // listener runs in a child process whose descriptor limit is set just above
-// what it holds, so that each further connection meets EMFILE.
+// what it holds, so that each further connection meets EMFILE). Beyond the
+// connection limits, per user and in total, connections are closed at once.
 #include "bsls/service/unix_listener.h"
 
+#include <grp.h>
+#include <grpcpp/create_channel.h>
 #include <grpcpp/server.h>
 #include <grpcpp/server_builder.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
@@ -15,6 +19,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -149,6 +154,119 @@ TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
   EXPECT_TRUE(third.ok()) << third.status().message();
   third->reset();
   std::filesystem::remove(path);
+}
+
+// True when the server closes `fd` (end of file or a reset) within `ms`;
+// what it sends meanwhile (its HTTP/2 settings) is read and dropped.
+bool ClosedWithin(int fd, int ms) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        until - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    pollfd wait{fd, POLLIN, 0};
+    if (::poll(&wait, 1, static_cast<int>(left.count())) <= 0) continue;
+    char buffer[256];
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
+    if (n == 0 || (n < 0 && errno == ECONNRESET)) return true;
+  }
+}
+
+// A connection to `path` made with effective uid `uid` (SO_PEERCRED gives
+// the listener the euid of the connecting process), or -1.
+int ConnectAs(uid_t uid, const std::string& path) {
+  if (uid != 0 && ::seteuid(uid) != 0) return -1;
+  const int fd = Connect(path);
+  if (uid != 0 && ::seteuid(0) != 0) std::abort();  // the test cannot go on as another user
+  return fd;
+}
+
+// The limits on connections open at once (issue 26): one user beyond its
+// share and everybody beyond the total are closed at once, while others are
+// still served. The listener runs in a child process (gRPC is not used in
+// this one before it forks the caller of another uid).
+TEST(UnixListener, ConnectionsBeyondTheUsersShareOrTheTotalAreClosedAtOnce) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to connect as other uids";
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("bsls_listener_limits_" + std::to_string(::getpid()) + ".sock"))
+                               .string();
+  std::filesystem::remove(path);
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t server_child = ::fork();
+  ASSERT_GE(server_child, 0);
+  if (server_child == 0) {
+    ::close(ready[0]);
+    v1::CaptureDaemon::Service unimplemented;  // answers UNIMPLEMENTED: an answer
+    grpc::ServerBuilder builder;
+    builder.RegisterService(&unimplemented);
+    std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+    UnixListenerOptions options;
+    options.path = path;
+    options.mode = 0666;
+    options.max_connections = 6;
+    options.max_connections_per_user = 3;
+    auto listener = UnixListener::Create(options);
+    if (!server || !listener.ok()) ::_exit(2);
+    PeerRegistry registry;
+    RolePolicy policy;
+    (*listener)->Start(server.get(), &registry, &policy);
+    const char byte = 1;
+    if (::write(ready[1], &byte, 1) != 1) ::_exit(4);
+    for (;;) ::pause();
+  }
+  ::close(ready[1]);
+  char byte = 0;
+  ASSERT_EQ(::read(ready[0], &byte, 1), 1) << "the listener did not start";
+  ::close(ready[0]);
+  std::vector<int> open;
+  auto stop = [&] {
+    for (int fd : open) ::close(fd);
+    ::kill(server_child, SIGKILL);
+    int status = 0;
+    ::waitpid(server_child, &status, 0);
+    std::filesystem::remove(path);
+  };
+
+  // Root takes its share: three stay open, the fourth and fifth are closed.
+  for (int i = 0; i < 3; ++i) open.push_back(ConnectAs(0, path));
+  for (int fd : open) EXPECT_FALSE(ClosedWithin(fd, 300)) << "a connection within the share";
+  for (int i = 0; i < 2; ++i) {
+    const int extra = ConnectAs(0, path);
+    EXPECT_TRUE(ClosedWithin(extra, 2000)) << "a connection beyond root's share stayed open";
+    ::close(extra);
+  }
+
+  // Another user is still served meanwhile.
+  const pid_t caller = ::fork();
+  ASSERT_GE(caller, 0);
+  if (caller == 0) {
+    if (::setgroups(0, nullptr) != 0 || ::setgid(60001) != 0 || ::setuid(60001) != 0) ::_exit(3);
+    auto stub = v1::CaptureDaemon::NewStub(
+        grpc::CreateChannel("unix:" + path, grpc::InsecureChannelCredentials()));
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    v1::DeviceStatus reply;
+    const grpc::Status status = stub->GetStatus(&context, {}, &reply);
+    ::_exit(status.error_code() == grpc::StatusCode::UNIMPLEMENTED ? 0 : 10 + status.error_code());
+  }
+  int status = 0;
+  ::waitpid(caller, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+      << "uid 60001 was not answered while root held its share (exit " << WEXITSTATUS(status)
+      << ")";
+  // Its connection goes with it.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+
+  // The total: root's three and uid 60002's three fill it; uid 60003 is refused.
+  for (int i = 0; i < 3; ++i) {
+    open.push_back(ConnectAs(60002, path));
+    EXPECT_FALSE(ClosedWithin(open.back(), 300)) << "uid 60002's connection " << i;
+  }
+  const int beyond = ConnectAs(60003, path);
+  EXPECT_TRUE(ClosedWithin(beyond, 2000)) << "a connection beyond the total stayed open";
+  ::close(beyond);
+  stop();
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <grpcpp/server_posix.h>
 #include <poll.h>
 #include <pwd.h>
+#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/un.h>
@@ -156,10 +157,20 @@ void UnixListener::AcceptLoop(grpc::Server* server, PeerRegistry* registry,
     }
     ucred credentials{};
     socklen_t length = sizeof(credentials);
-    if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &credentials, &length) != 0) {
+    struct stat socket_file {};
+    if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &credentials, &length) != 0 ||
+        ::fstat(connection, &socket_file) != 0) {
       ::close(connection);
       continue;
     }
+    ForgetClosed();
+    if (const std::string why = OverLimit(credentials.uid); !why.empty()) {
+      ::close(connection);
+      ++refused_;
+      LogRefusal(credentials.uid, why);
+      continue;
+    }
+    handed_[connection] = {socket_file.st_ino, credentials.uid};
     Caller caller;
     caller.uid = credentials.uid;
     caller.name = UserName(credentials.uid);
@@ -170,6 +181,38 @@ void UnixListener::AcceptLoop(grpc::Server* server, PeerRegistry* registry,
     ++accepted_;
     grpc::AddInsecureChannelFromFd(server, connection);
   }
+}
+
+void UnixListener::ForgetClosed() {
+  for (auto it = handed_.begin(); it != handed_.end();) {
+    struct stat now {};
+    const bool same =
+        ::fstat(it->first, &now) == 0 && S_ISSOCK(now.st_mode) && now.st_ino == it->second.inode;
+    it = same ? std::next(it) : handed_.erase(it);
+  }
+}
+
+std::string UnixListener::OverLimit(uid_t uid) const {
+  if (static_cast<int>(handed_.size()) >= options_.max_connections)
+    return std::to_string(handed_.size()) + " connections are open (listen.max_connections " +
+           std::to_string(options_.max_connections) + ")";
+  int mine = 0;
+  for (const auto& [fd, handed] : handed_) mine += handed.uid == uid ? 1 : 0;
+  if (mine >= options_.max_connections_per_user)
+    return "the user has " + std::to_string(mine) +
+           " connections open (listen.max_connections_per_user " +
+           std::to_string(options_.max_connections_per_user) + ")";
+  return "";
+}
+
+void UnixListener::LogRefusal(uid_t uid, const std::string& why) {
+  ++refused_unlogged_;
+  const auto now = std::chrono::steady_clock::now();
+  if (now - last_refusal_log_ < std::chrono::seconds(1)) return;
+  spdlog::warn("refused {} connection(s) on {} since the last report; the last of {} (uid {}): {}",
+               refused_unlogged_, options_.path, UserName(uid), uid, why);
+  refused_unlogged_ = 0;
+  last_refusal_log_ = now;
 }
 
 }  // namespace bsls::service

@@ -17,6 +17,7 @@
 #include <sys/types.h>
 
 #include <atomic>
+#include <chrono>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -54,6 +55,11 @@ struct UnixListenerOptions {
   mode_t mode = 0660;         // permissions of the socket file
   std::optional<gid_t> group; // owning group of the socket file (else the daemon's)
   int backlog = 64;
+  // Connections open at once (handed to gRPC and not yet closed by it), in
+  // all and per peer uid; a connection beyond either is closed as soon as
+  // it is accepted, so that one user cannot take every descriptor.
+  int max_connections = 128;
+  int max_connections_per_user = 32;
 };
 
 class UnixListener {
@@ -81,10 +87,26 @@ class UnixListener {
   // and closed at once, so that its caller hears at once, and the loop
   // waits a moment before it accepts again instead of spinning.
   std::uint64_t shed() const { return shed_; }
+  // Connections closed at once because their user or everyone together had
+  // as many open as allowed (options.max_connections*).
+  std::uint64_t refused() const { return refused_; }
 
  private:
+  // A connection handed to gRPC: the socket's inode tells whether the
+  // descriptor still is that connection (gRPC closes it without telling).
+  struct Handed {
+    ino_t inode;
+    uid_t uid;
+  };
+
   UnixListener(UnixListenerOptions options, int fd);
   void AcceptLoop(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
+  // Forgets the connections gRPC has closed since (accept loop only).
+  void ForgetClosed();
+  // Why a new connection of `uid` would exceed a limit ("" when it would not).
+  std::string OverLimit(uid_t uid) const;
+  // Logs a refusal, at most once a second with the count since the last line.
+  void LogRefusal(uid_t uid, const std::string& why);
 
   UnixListenerOptions options_;
   int fd_ = -1;
@@ -93,6 +115,10 @@ class UnixListener {
   std::thread thread_;
   std::atomic<std::uint64_t> accepted_{0};
   std::atomic<std::uint64_t> shed_{0};
+  std::atomic<std::uint64_t> refused_{0};
+  std::map<int, Handed> handed_;  // by descriptor; accept loop only
+  std::uint64_t refused_unlogged_ = 0;
+  std::chrono::steady_clock::time_point last_refusal_log_{};
 };
 
 }  // namespace bsls::service
