@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "bsls/calibration/calibration_file.h"
+#include "bsls/rpc/malformed_requests.h"
 #include "bsls/rpc/server_limits.h"
 #include "bsls/rpc/tls.h"
 
@@ -152,6 +153,7 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
   builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
   rpc::ApplyHttp2Limits(config.listen.http2, builder);
+  rpc::ReportMalformedRequests(builder);
   grpc::ResourceQuota quota("bslsd");
   quota.SetMaxThreads(64);
   builder.SetResourceQuota(quota);

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "bsls/rpc/malformed_requests.h"
 #include "bsls/rpc/server_limits.h"
 #include "bsls/rpc/tls.h"
 #include "bsls/rpc/unix_socket.h"
@@ -44,6 +45,7 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
   builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
   builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
   rpc::ApplyHttp2Limits(config.listen.http2, builder);
+  rpc::ReportMalformedRequests(builder);
   // Handler threads: every worker and queue place, plus quick calls.
   grpc::ResourceQuota quota("bsls-processd");
   quota.SetMaxThreads(options.workers + options.queue + 16);

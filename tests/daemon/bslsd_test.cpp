@@ -18,6 +18,7 @@
 
 #include "bsls/testing/certificates.h"
 #include "daemon_process.h"
+#include "raw_calls.h"
 
 namespace bsls::testing {
 namespace {
@@ -26,6 +27,10 @@ using std::chrono::milliseconds;
 using std::chrono::seconds;
 
 constexpr const char* kSimulatedSlides = "slides:\n  backend: simulated\n";
+
+// Bytes that are no message of any type: field 1, length-delimited, with a
+// length of 4 GiB that does not follow.
+constexpr char kNotAMessage[] = "\x0a\xff\xff\xff\xff\x0f";
 
 std::string Hex(const unsigned char* digest, std::size_t n) {
   static const char* kDigits = "0123456789abcdef";
@@ -602,6 +607,32 @@ TEST_F(Bslsd, StartedAsRootItBecomesTheConfiguredUserWithoutPrivileges) {
   struct stat store {};
   ASSERT_EQ(::stat((dir_ / "store").c_str(), &store), 0);
   EXPECT_EQ(store.st_uid, kUid);
+}
+
+// Issue 26: bytes that are not the request message get INVALID_ARGUMENT
+// naming the message type, on every method of bslsd (they got INTERNAL with
+// an empty message), before any role is checked; the daemon still answers.
+TEST_F(Bslsd, AMalformedRequestIsInvalidArgumentWithAMessage) {
+  Start("malformed");
+  grpc::GenericStub stub(daemon_->Channel());
+  const google::protobuf::ServiceDescriptor* service =
+      google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
+          v1::CaptureDaemon::service_full_name());
+  ASSERT_NE(service, nullptr);
+  for (int i = 0; i < service->method_count(); ++i) {
+    const google::protobuf::MethodDescriptor* method = service->method(i);
+    ASSERT_FALSE(method->client_streaming()) << method->name();
+    processing::test::RawCall call;
+    call.method = "/" + service->full_name() + "/" + method->name();
+    call.messages = {std::string(kNotAMessage, sizeof kNotAMessage - 1)};
+    call.deadline_ms = 10000;
+    const processing::test::RawOutcome outcome = processing::test::SendRaw(stub, call);
+    EXPECT_EQ(outcome.code, grpc::StatusCode::INVALID_ARGUMENT) << call.method;
+    EXPECT_NE(outcome.message.find(method->input_type()->full_name()), std::string::npos)
+        << call.method << ": " << outcome.message;
+  }
+  v1::DeviceStatus status;
+  EXPECT_TRUE(daemon_->Stub()->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
 }
 
 // Issue 26: HTTP/2 limits are set on the server: a connection without calls
