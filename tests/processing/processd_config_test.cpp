@@ -45,8 +45,8 @@ TEST(ProcessdConfig, ErrorsNameTheKey) {
   EXPECT_NE(ErrorOf({"scratch_dir=/nonexistent/x"}).find("scratch_dir"), std::string::npos);
 }
 
-// Issue 26: the HTTP/2 limits have defaults, are read under listen: and
-// are bounded (a key out of range is named).
+// Issue 26: the HTTP/2 and connection limits have defaults, are read under
+// listen: and are bounded (a key out of range is named).
 TEST(ProcessdConfig, Http2LimitsHaveBoundedDefaults) {
   const Config defaults = LoadConfig(std::nullopt, {});
   EXPECT_EQ(defaults.listen.http2.max_ping_strikes, 2);
@@ -62,6 +62,10 @@ TEST(ProcessdConfig, Http2LimitsHaveBoundedDefaults) {
   EXPECT_NE(ErrorOf({"listen.max_concurrent_streams=100000"}).find("max_concurrent_streams"),
             std::string::npos);
   EXPECT_NE(Dump(c).find("max_connection_idle_ms: 1000"), std::string::npos) << Dump(c);
+  EXPECT_EQ(defaults.listen.max_connections, 128);
+  EXPECT_EQ(defaults.listen.max_connections_per_user, 32);
+  EXPECT_NE(ErrorOf({"listen.max_connections_per_user=200"}).find("max_connections_per_user"),
+            std::string::npos);
 }
 
 TEST(RpcTargets, LoopbackIsRecognised) {

@@ -1,8 +1,9 @@
 // The Unix-socket front door of bslsd. gRPC C++ does not expose the peer's
-// credentials, so the daemon accepts local connections itself: it reads the
-// peer's uid with SO_PEERCRED, maps it to a role, remembers the caller under
-// the connection's gRPC peer name ("fd:<n>") and only then hands the socket
-// to the gRPC server (grpc::AddInsecureChannelFromFd).
+// credentials, so the daemon accepts local connections itself
+// (rpc::UnixAcceptor, which also limits them): it reads the peer's uid with
+// SO_PEERCRED, maps it to a role, remembers the caller under the
+// connection's gRPC peer name ("fd:<n>") and only then hands the socket to
+// the gRPC server (grpc::AddInsecureChannelFromFd).
 //
 // A connection's file descriptor stays open until gRPC has finished every
 // call on it (the transport owns the endpoint, each call holds the
@@ -16,16 +17,14 @@
 
 #include <sys/types.h>
 
-#include <atomic>
-#include <chrono>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 
 #include "bsls/framestore/status.h"
+#include "bsls/rpc/unix_acceptor.h"
 #include "bsls/service/roles.h"
 
 namespace grpc {
@@ -49,7 +48,7 @@ class PeerRegistry {
   std::map<std::string, Caller> callers_;
 };
 
-// Where and how the socket is created.
+// Where and how the socket is created, and the limits on its connections.
 struct UnixListenerOptions {
   std::string path;           // socket path; its directory must exist
   mode_t mode = 0660;         // permissions of the socket file
@@ -62,6 +61,9 @@ struct UnixListenerOptions {
   int max_connections_per_user = 32;
 };
 
+// bslsd's front door: rpc::UnixAcceptor (limits, descriptor exhaustion,
+// one instance per socket) with each caller recorded before gRPC gets the
+// connection.
 class UnixListener {
  public:
   // Binds and listens on options.path (a stale socket file left by a dead
@@ -76,49 +78,25 @@ class UnixListener {
   // outlive Stop().
   void Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
   // Stops accepting (connections already handed over stay with gRPC) and
-  // removes the socket file.
+  // removes the socket file if it still is the one Create made.
   void Stop();
   // The socket path.
-  const std::string& path() const { return options_.path; }
+  const std::string& path() const { return acceptor_->path(); }
   // Connections accepted so far.
-  std::uint64_t accepted() const { return accepted_; }
+  std::uint64_t accepted() const { return acceptor_->accepted(); }
   // Connections shed because the process had no descriptor left for them
   // (EMFILE, ENFILE): each is accepted on a descriptor kept spare for this
   // and closed at once, so that its caller hears at once, and the loop
   // waits a moment before it accepts again instead of spinning.
-  std::uint64_t shed() const { return shed_; }
+  std::uint64_t shed() const { return acceptor_->shed(); }
   // Connections closed at once because their user or everyone together had
   // as many open as allowed (options.max_connections*).
-  std::uint64_t refused() const { return refused_; }
+  std::uint64_t refused() const { return acceptor_->refused(); }
 
  private:
-  // A connection handed to gRPC: the socket's inode tells whether the
-  // descriptor still is that connection (gRPC closes it without telling).
-  struct Handed {
-    ino_t inode;
-    uid_t uid;
-  };
+  explicit UnixListener(std::unique_ptr<rpc::UnixAcceptor> acceptor);
 
-  UnixListener(UnixListenerOptions options, int fd);
-  void AcceptLoop(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
-  // Forgets the connections gRPC has closed since (accept loop only).
-  void ForgetClosed();
-  // Why a new connection of `uid` would exceed a limit ("" when it would not).
-  std::string OverLimit(uid_t uid) const;
-  // Logs a refusal, at most once a second with the count since the last line.
-  void LogRefusal(uid_t uid, const std::string& why);
-
-  UnixListenerOptions options_;
-  int fd_ = -1;
-  int wake_[2] = {-1, -1};  // a pipe that wakes the accept loop to stop
-  int spare_ = -1;          // /dev/null, given up to shed a connection at EMFILE
-  std::thread thread_;
-  std::atomic<std::uint64_t> accepted_{0};
-  std::atomic<std::uint64_t> shed_{0};
-  std::atomic<std::uint64_t> refused_{0};
-  std::map<int, Handed> handed_;  // by descriptor; accept loop only
-  std::uint64_t refused_unlogged_ = 0;
-  std::chrono::steady_clock::time_point last_refusal_log_{};
+  std::unique_ptr<rpc::UnixAcceptor> acceptor_;
 };
 
 }  // namespace bsls::service
