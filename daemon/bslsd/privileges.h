@@ -1,8 +1,10 @@
-// Least privilege for bslsd (issue 4): the daemon may start with
-// CAP_SYS_RAWIO (for /dev/port or ioperm) and nothing else; it opens the
-// devices that need it while it is still single-threaded, then drops every
-// capability for good. Capabilities are per thread in Linux, so the drop
-// must come before any thread exists (gRPC, libusb, the capture thread).
+// Least privilege for bslsd (issues 4 and 26): the daemon may start with
+// CAP_SYS_RAWIO (for /dev/port or ioperm) and nothing else, or as root; it
+// opens the devices that need a privilege and its socket while it is still
+// single-threaded, then (started as root) becomes the configured user and
+// drops every capability for good. Ids and capabilities are per thread in
+// Linux, so the drop must come before any thread exists (gRPC, libusb, the
+// capture thread).
 #ifndef BSLS_BSLSD_PRIVILEGES_H_
 #define BSLS_BSLSD_PRIVILEGES_H_
 
