@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bsls/testing/certificates.h"
+#include "bsls/testing/raw_connections.h"
 #include "daemon_process.h"
 #include "raw_calls.h"
 
@@ -633,6 +634,39 @@ TEST_F(Bslsd, AMalformedRequestIsInvalidArgumentWithAMessage) {
   }
   v1::DeviceStatus status;
   EXPECT_TRUE(daemon_->Stub()->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
+}
+
+// Issue 26: the configured connection limits reach bslsd's socket: one
+// user's connections beyond listen.max_connections_per_user are closed at
+// once, and once they are gone the daemon answers that user again.
+TEST_F(Bslsd, AUsersConnectionsBeyondItsShareAreClosedAtOnce) {
+  Start("connections", kSimulatedSlides,
+        {"--set", "listen.max_connections_per_user=3", "--set", "listen.max_connections=100"});
+  // The start-up probe's connection goes first.
+  std::this_thread::sleep_for(milliseconds(500));
+  std::vector<int> open;
+  int closed = 0;
+  for (int i = 0; i < 5; ++i) {
+    const int fd = ConnectUnixAs(0, daemon_->socket().string());
+    ASSERT_GE(fd, 0);
+    if (ClosedWithin(fd, 1000)) {
+      ++closed;
+      ::close(fd);
+    } else {
+      open.push_back(fd);
+    }
+  }
+  EXPECT_EQ(open.size(), 3u) << daemon_->Log();
+  EXPECT_EQ(closed, 2);
+  for (int fd : open) ::close(fd);
+  grpc::Status answered;
+  v1::DeviceStatus status;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    answered = daemon_->Stub()->GetStatus(Deadline(milliseconds(2000)).get(), {}, &status);
+    if (answered.ok()) break;
+    std::this_thread::sleep_for(milliseconds(100));
+  }
+  EXPECT_TRUE(answered.ok()) << answered.error_message();
 }
 
 // Issue 26: HTTP/2 limits are set on the server: a connection without calls

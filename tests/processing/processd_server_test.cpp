@@ -17,6 +17,7 @@
 
 #include "bsls/processing/processing_client.h"
 #include "bsls/testing/certificates.h"
+#include "bsls/testing/raw_connections.h"
 #include "raw_calls.h"
 #include "server.h"
 
@@ -127,40 +128,6 @@ TEST_F(ProcessdServer, AMalformedRequestIsInvalidArgumentWithAMessage) {
   server->Drain();
 }
 
-// A raw connection to the Unix socket at `path` made with effective uid
-// `uid` (SO_PEERCRED gives the server the euid of the connecting process).
-int ConnectAs(uid_t uid, const std::string& path) {
-  if (uid != 0 && ::seteuid(uid) != 0) return -1;
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
-  const bool connected =
-      ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
-  if (uid != 0 && ::seteuid(0) != 0) std::abort();  // the test cannot go on as another user
-  if (!connected) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
-}
-
-// True when the server closes `fd` (end of file or a reset) within `ms`;
-// what it sends meanwhile (its HTTP/2 settings) is read and dropped.
-bool ClosedWithin(int fd, int ms) {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        until - std::chrono::steady_clock::now());
-    if (left.count() <= 0) return false;
-    pollfd wait{fd, POLLIN, 0};
-    if (::poll(&wait, 1, static_cast<int>(left.count())) <= 0) continue;
-    char buffer[256];
-    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
-    if (n == 0 || (n < 0 && errno == ECONNRESET)) return true;
-  }
-}
-
 // Issue 26: the Unix socket's connections are limited per user and in all
 // (listen.max_connections*); connections beyond are closed at once while
 // other users are still let in, and the service answers after.
@@ -176,17 +143,19 @@ TEST_F(ProcessdServer, UnixConnectionsBeyondTheLimitsAreClosedAtOnce) {
   ::chmod(dir_.c_str(), 0755);
   ::chmod(config.listen.unix_socket.c_str(), 0666);
   std::vector<int> open;
-  for (int i = 0; i < 2; ++i) open.push_back(ConnectAs(0, config.listen.unix_socket));
-  for (int fd : open) EXPECT_FALSE(ClosedWithin(fd, 300)) << "a connection within root's share";
-  const int beyond_share = ConnectAs(0, config.listen.unix_socket);
-  EXPECT_TRUE(ClosedWithin(beyond_share, 2000)) << "root's third connection stayed open";
+  for (int i = 0; i < 2; ++i) open.push_back(testing::ConnectUnixAs(0, config.listen.unix_socket));
+  for (int fd : open)
+    EXPECT_FALSE(testing::ClosedWithin(fd, 300)) << "a connection within root's share";
+  const int beyond_share = testing::ConnectUnixAs(0, config.listen.unix_socket);
+  EXPECT_TRUE(testing::ClosedWithin(beyond_share, 2000)) << "root's third connection stayed open";
   ::close(beyond_share);
   for (uid_t uid : {60001u, 60002u}) {
-    open.push_back(ConnectAs(uid, config.listen.unix_socket));
-    EXPECT_FALSE(ClosedWithin(open.back(), 300)) << "uid " << uid << " was not let in";
+    open.push_back(testing::ConnectUnixAs(uid, config.listen.unix_socket));
+    EXPECT_FALSE(testing::ClosedWithin(open.back(), 300)) << "uid " << uid << " was not let in";
   }
-  const int beyond_total = ConnectAs(60003, config.listen.unix_socket);
-  EXPECT_TRUE(ClosedWithin(beyond_total, 2000)) << "a connection beyond the total stayed open";
+  const int beyond_total = testing::ConnectUnixAs(60003, config.listen.unix_socket);
+  EXPECT_TRUE(testing::ClosedWithin(beyond_total, 2000))
+      << "a connection beyond the total stayed open";
   ::close(beyond_total);
   for (int fd : open) ::close(fd);
   // Once they are gone, the service answers again.

@@ -28,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "bsls/testing/raw_connections.h"
 #include "bsls/v1/capture.grpc.pb.h"
 
 namespace bsls::service {
@@ -43,19 +44,6 @@ double CpuSeconds(pid_t pid) {
   for (int i = 3; i <= 15 && fields >> field; ++i)
     if (i == 14 || i == 15) ticks += std::stol(field);  // utime, stime
   return static_cast<double>(ticks) / static_cast<double>(::sysconf(_SC_CLK_TCK));
-}
-
-// A connected client socket to `path`, or -1.
-int Connect(const std::string& path) {
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
-  if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
 }
 
 // Descriptors open in this process.
@@ -106,7 +94,7 @@ TEST(UnixListener, OutOfDescriptorsItShedsCallersAndDoesNotSpin) {
   // Far more callers than the child has descriptors for.
   std::vector<int> clients;
   for (int i = 0; i < 40; ++i) {
-    const int fd = Connect(path);
+    const int fd = testing::ConnectUnixAs(0, path);
     if (fd >= 0) clients.push_back(fd);
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
@@ -145,7 +133,7 @@ TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
   auto second = UnixListener::Create({path, 0600});
   ASSERT_FALSE(second.ok());
   EXPECT_EQ(second.status().code(), framestore::ErrorCode::kAlreadyExists);
-  const int client = Connect(path);
+  const int client = testing::ConnectUnixAs(0, path);
   EXPECT_GE(client, 0) << "the first listener's socket was taken";
   if (client >= 0) ::close(client);
   first->reset();  // closed without Start/Stop: the file stays, stale
@@ -154,31 +142,6 @@ TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
   EXPECT_TRUE(third.ok()) << third.status().message();
   third->reset();
   std::filesystem::remove(path);
-}
-
-// True when the server closes `fd` (end of file or a reset) within `ms`;
-// what it sends meanwhile (its HTTP/2 settings) is read and dropped.
-bool ClosedWithin(int fd, int ms) {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
-  for (;;) {
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-        until - std::chrono::steady_clock::now());
-    if (left.count() <= 0) return false;
-    pollfd wait{fd, POLLIN, 0};
-    if (::poll(&wait, 1, static_cast<int>(left.count())) <= 0) continue;
-    char buffer[256];
-    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
-    if (n == 0 || (n < 0 && errno == ECONNRESET)) return true;
-  }
-}
-
-// A connection to `path` made with effective uid `uid` (SO_PEERCRED gives
-// the listener the euid of the connecting process), or -1.
-int ConnectAs(uid_t uid, const std::string& path) {
-  if (uid != 0 && ::seteuid(uid) != 0) return -1;
-  const int fd = Connect(path);
-  if (uid != 0 && ::seteuid(0) != 0) std::abort();  // the test cannot go on as another user
-  return fd;
 }
 
 // The limits on connections open at once (issue 26): one user beyond its
@@ -229,11 +192,13 @@ TEST(UnixListener, ConnectionsBeyondTheUsersShareOrTheTotalAreClosedAtOnce) {
   };
 
   // Root takes its share: three stay open, the fourth and fifth are closed.
-  for (int i = 0; i < 3; ++i) open.push_back(ConnectAs(0, path));
-  for (int fd : open) EXPECT_FALSE(ClosedWithin(fd, 300)) << "a connection within the share";
+  for (int i = 0; i < 3; ++i) open.push_back(testing::ConnectUnixAs(0, path));
+  for (int fd : open)
+    EXPECT_FALSE(testing::ClosedWithin(fd, 300)) << "a connection within the share";
   for (int i = 0; i < 2; ++i) {
-    const int extra = ConnectAs(0, path);
-    EXPECT_TRUE(ClosedWithin(extra, 2000)) << "a connection beyond root's share stayed open";
+    const int extra = testing::ConnectUnixAs(0, path);
+    EXPECT_TRUE(testing::ClosedWithin(extra, 2000))
+        << "a connection beyond root's share stayed open";
     ::close(extra);
   }
 
@@ -260,11 +225,11 @@ TEST(UnixListener, ConnectionsBeyondTheUsersShareOrTheTotalAreClosedAtOnce) {
 
   // The total: root's three and uid 60002's three fill it; uid 60003 is refused.
   for (int i = 0; i < 3; ++i) {
-    open.push_back(ConnectAs(60002, path));
-    EXPECT_FALSE(ClosedWithin(open.back(), 300)) << "uid 60002's connection " << i;
+    open.push_back(testing::ConnectUnixAs(60002, path));
+    EXPECT_FALSE(testing::ClosedWithin(open.back(), 300)) << "uid 60002's connection " << i;
   }
-  const int beyond = ConnectAs(60003, path);
-  EXPECT_TRUE(ClosedWithin(beyond, 2000)) << "a connection beyond the total stayed open";
+  const int beyond = testing::ConnectUnixAs(60003, path);
+  EXPECT_TRUE(testing::ClosedWithin(beyond, 2000)) << "a connection beyond the total stayed open";
   ::close(beyond);
   stop();
 }
