@@ -85,6 +85,8 @@ processing:
   calibration_left: $calibrations/calibration_left.yaml
   calibration_right: $calibrations/calibration_right.yaml
 log_level: warn
+# The demo's own account: started as root, bslsd would switch to user bsls.
+user: "$(id -u):$(id -g)"
 EOF
 build/release/daemon/bslsd/bslsd --config "$run/bslsd.yaml" 2>"$run/bslsd.log" &
 daemon_pid=$!

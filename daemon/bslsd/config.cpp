@@ -89,9 +89,19 @@ void ParseStore(const YAML::Node& node, store::CaptureStoreOptions& out) {
 }
 
 void ParseListen(const YAML::Node& node, ListenConfig& out) {
-  OnlyKeys(node, "listen",
-           {"unix_socket", "socket_group", "socket_mode", "tcp", "tls_certificate", "tls_key", "tls_client_ca",
-            "max_receive_message_bytes", "max_send_message_bytes"});
+  std::set<std::string> keys = {"unix_socket",
+                                "socket_group",
+                                "socket_mode",
+                                "max_connections",
+                                "max_connections_per_user",
+                                "tcp",
+                                "tls_certificate",
+                                "tls_key",
+                                "tls_client_ca",
+                                "max_receive_message_bytes",
+                                "max_send_message_bytes"};
+  keys.insert(rpc::Http2LimitKeys().begin(), rpc::Http2LimitKeys().end());
+  OnlyKeys(node, "listen", keys);
   if (!node) return;
   Read(node, "listen", "unix_socket", out.unix_socket);
   Read(node, "listen", "socket_group", out.socket_group);
@@ -106,8 +116,16 @@ void ParseListen(const YAML::Node& node, ListenConfig& out) {
     }
     if (used != text.size() || mode < 0 || mode > 0777)
       Fail("listen.socket_mode", "'" + text + "' is not an octal mode 000..777");
+    if (mode & 0002)
+      Fail("listen.socket_mode",
+           "'" + text +
+               "' lets every local user connect (world-writable); give the callers a group "
+               "(listen.socket_group) and a mode such as 0660");
     out.socket_mode = mode;
   }
+  ReadInRange(node, "listen", "max_connections", out.max_connections, 1, 65536);
+  ReadInRange(node, "listen", "max_connections_per_user", out.max_connections_per_user, 1, 65536);
+  rpc::ReadHttp2Limits(node, "listen", out.http2);
   Read(node, "listen", "tcp", out.tcp);
   Read(node, "listen", "tls_certificate", out.tls_certificate);
   Read(node, "listen", "tls_key", out.tls_key);
@@ -139,8 +157,9 @@ void ParseRoles(const YAML::Node& node, RolesConfig& out) {
 }
 
 void ParseLimits(const YAML::Node& node, Config& out) {
-  OnlyKeys(node, "limits", {"max_preview_streams", "max_event_streams", "default_deadline_ms",
-                            "max_deadline_ms", "drain_timeout_ms"});
+  OnlyKeys(node, "limits",
+           {"max_preview_streams", "max_event_streams", "default_deadline_ms", "max_deadline_ms",
+            "drain_timeout_ms", "stream_write_timeout_ms"});
   if (!node) return;
   ReadInRange(node, "limits", "max_preview_streams", out.limits.max_preview_streams, 1, 256);
   ReadInRange(node, "limits", "max_event_streams", out.limits.max_event_streams, 1, 1024);
@@ -153,6 +172,9 @@ void ParseLimits(const YAML::Node& node, Config& out) {
   ms = out.drain_timeout.count();
   ReadInRange(node, "limits", "drain_timeout_ms", ms, 0LL, 600000LL);
   out.drain_timeout = std::chrono::milliseconds(ms);
+  ms = out.limits.stream_write_timeout.count();
+  ReadInRange(node, "limits", "stream_write_timeout_ms", ms, 100LL, 600000LL);
+  out.limits.stream_write_timeout = std::chrono::milliseconds(ms);
 }
 
 void ParseSlides(const YAML::Node& node, SlidesConfig& out) {
@@ -218,7 +240,7 @@ Config Parse(const YAML::Node& root) {
   Config config = DefaultConfig();
   if (!root || root.IsNull()) return config;
   OnlyKeys(root, "",
-           {"framestore", "store", "listen", "roles", "slides", "processing", "limits",
+           {"framestore", "store", "listen", "roles", "slides", "processing", "limits", "user",
             "log_level"});
   ParseFramestore(root["framestore"], config.framestore);
   ParseStore(root["store"], config.store);
@@ -227,6 +249,8 @@ Config Parse(const YAML::Node& root) {
   ParseSlides(root["slides"], config.slides);
   ParseProcessing(root["processing"], config.processing);
   ParseLimits(root["limits"], config);
+  Read(root, "", "user", config.user);
+  if (config.user.empty()) Fail("user", "is empty: name the account bslsd runs as (e.g. bsls)");
   Read(root, "", "log_level", config.log_level);
   return config;
 }
@@ -266,6 +290,10 @@ Status Validate(const Config& config) {
   };
   std::string error;
   if (!config.store.IsValid(&error)) return fail("store: " + error);
+  if (config.listen.socket_mode & 0002)
+    return fail("listen.socket_mode: a world-writable mode lets every local user connect");
+  if (config.listen.max_connections_per_user > config.listen.max_connections)
+    return fail("listen.max_connections_per_user is above listen.max_connections");
   if (config.listen.unix_socket.empty() && config.listen.tcp.empty())
     return fail("listen.unix_socket and listen.tcp are both empty: nobody could connect");
   if (!config.listen.tcp.empty() &&
@@ -373,6 +401,10 @@ std::string Dump(const Config& config) {
   char mode[8];
   std::snprintf(mode, sizeof mode, "%04o", config.listen.socket_mode);
   out << YAML::Key << "socket_mode" << YAML::Value << YAML::DoubleQuoted << mode;
+  out << YAML::Key << "max_connections" << YAML::Value << config.listen.max_connections;
+  out << YAML::Key << "max_connections_per_user" << YAML::Value
+      << config.listen.max_connections_per_user;
+  rpc::DumpHttp2Limits(out, config.listen.http2);
   out << YAML::Key << "tcp" << YAML::Value << config.listen.tcp;
   out << YAML::Key << "tls_certificate" << YAML::Value << config.listen.tls_certificate;
   out << YAML::Key << "tls_key" << YAML::Value << config.listen.tls_key;
@@ -407,7 +439,10 @@ std::string Dump(const Config& config) {
       << config.limits.default_deadline.count();
   out << YAML::Key << "max_deadline_ms" << YAML::Value << config.limits.max_deadline.count();
   out << YAML::Key << "drain_timeout_ms" << YAML::Value << config.drain_timeout.count();
+  out << YAML::Key << "stream_write_timeout_ms" << YAML::Value
+      << config.limits.stream_write_timeout.count();
   out << YAML::EndMap;
+  out << YAML::Key << "user" << YAML::Value << config.user;
   out << YAML::Key << "log_level" << YAML::Value << config.log_level;
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bsls/framestore/status.h"
+#include "bsls/rpc/server_limits.h"
 #include "bsls/service/capture_service.h"
 #include "bsls/service/roles.h"
 #include "bsls/slides/slide_controller.h"
@@ -41,8 +42,16 @@ struct RolesConfig {
 
 struct ListenConfig {
   std::string unix_socket = "/run/bsls/bslsd.sock";
-  std::string socket_group;   // owning group of the socket ("" : the daemon's group)
-  int socket_mode = 0660;     // permissions of the socket file (never world-writable in service)
+  // Owning group of the socket, a name or a number ("" : the daemon's group).
+  std::string socket_group;
+  // Permissions of the socket file; world-writable modes (o+w) are refused:
+  // any local user could then call the daemon.
+  int socket_mode = 0660;
+  // Connections of the Unix socket open at once, in all and per user (peer
+  // uid); more are closed as soon as they are accepted.
+  int max_connections = 128;
+  int max_connections_per_user = 32;
+  rpc::Http2Limits http2;     // keep-alive, pings, idle connections, streams
   std::string tcp;            // "host:port" with mutual TLS; "" : no TCP (the default)
   std::string tls_certificate;  // PEM files, required with tcp
   std::string tls_key;
@@ -82,6 +91,9 @@ struct Config {
   ProcessingConfig processing;
   service::ServiceLimits limits;
   std::chrono::milliseconds drain_timeout{5000};  // SIGTERM: in-flight calls get this long
+  // The account bslsd switches to when started as root (a name, or
+  // "uid:gid" numbers); started as any other user it keeps that one.
+  std::string user = "bsls";
   std::string log_level = "info";
 };
 

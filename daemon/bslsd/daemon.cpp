@@ -8,6 +8,8 @@
 #include <tuple>
 
 #include "bsls/calibration/calibration_file.h"
+#include "bsls/rpc/malformed_requests.h"
+#include "bsls/rpc/server_limits.h"
 #include "bsls/rpc/tls.h"
 
 #ifndef BSLS_VERSION
@@ -28,8 +30,33 @@ v1::Camera ToProto(framestore::Camera camera) {
 
 }  // namespace
 
+Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& config) {
+  if (config.listen.unix_socket.empty()) return std::unique_ptr<service::UnixListener>();
+  service::UnixListenerOptions options;
+  options.path = config.listen.unix_socket;
+  options.mode = static_cast<mode_t>(config.listen.socket_mode);
+  options.max_connections = config.listen.max_connections;
+  options.max_connections_per_user = config.listen.max_connections_per_user;
+  const std::string& group = config.listen.socket_group;
+  if (!group.empty()) {
+    if (group.find_first_not_of("0123456789") == std::string::npos && group.size() <= 9) {
+      options.group = static_cast<gid_t>(std::stoul(group));  // a gid without a name
+    } else if (struct group* entry = ::getgrnam(group.c_str()); entry != nullptr) {
+      options.group = entry->gr_gid;
+    } else {
+      return Status(ErrorCode::kInvalidArgument,
+                    "listen.socket_group: group '" + group + "' does not exist");
+    }
+  }
+  Result<std::unique_ptr<service::UnixListener>> listener = service::UnixListener::Create(options);
+  if (!listener.ok())
+    return Status(listener.status().code(), "listen.unix_socket: " + listener.status().message());
+  return listener;
+}
+
 Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDevices privileged,
-                                              std::function<void()> tick) {
+                                              std::function<void()> tick,
+                                              std::unique_ptr<service::UnixListener> listener) {
   std::unique_ptr<Daemon> d(new Daemon);
   d->config_ = config;
   Result<service::RolePolicy> policy = ResolveRoles(config.roles);
@@ -125,6 +152,8 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   grpc::ServerBuilder builder;
   builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
   builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
+  rpc::ApplyHttp2Limits(config.listen.http2, builder);
+  rpc::ReportMalformedRequests(builder);
   grpc::ResourceQuota quota("bslsd");
   quota.SetMaxThreads(64);
   builder.SetResourceQuota(quota);
@@ -147,22 +176,13 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
                   "the gRPC server could not start" +
                       (config.listen.tcp.empty() ? std::string()
                                                  : " on TCP " + config.listen.tcp));
-  if (!config.listen.unix_socket.empty()) {
-    service::UnixListenerOptions options;
-    options.path = config.listen.unix_socket;
-    options.mode = static_cast<mode_t>(config.listen.socket_mode);
-    if (!config.listen.socket_group.empty()) {
-      group* entry = ::getgrnam(config.listen.socket_group.c_str());
-      if (entry == nullptr)
-        return Status(ErrorCode::kInvalidArgument, "listen.socket_group: group '" +
-                                                       config.listen.socket_group +
-                                                       "' does not exist");
-      options.group = entry->gr_gid;
-    }
-    Result<std::unique_ptr<service::UnixListener>> listener =
-        service::UnixListener::Create(options);
-    if (!listener.ok()) return listener.status();
-    d->listener_ = std::move(listener).value();
+  if (!listener) {
+    Result<std::unique_ptr<service::UnixListener>> socket = OpenUnixListener(config);
+    if (!socket.ok()) return socket.status();
+    listener = std::move(socket).value();
+  }
+  if (listener) {
+    d->listener_ = std::move(listener);
     d->listener_->Start(d->server_.get(), &d->peers_, &d->policy_);
   }
   return d;

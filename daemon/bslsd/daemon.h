@@ -22,15 +22,23 @@
 
 namespace bsls::bslsd {
 
+// The Unix socket of `config.listen` bound, with its mode and group set and
+// listening, but not yet accepting (nullptr when listen.unix_socket is
+// empty). main() opens it before dropping privileges: setting the socket's
+// group to one the daemon's user is not in needs CAP_CHOWN. Errors name the
+// key (kInvalidArgument for an unknown group) or the socket and the reason.
+framestore::Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& config);
+
 class Daemon {
  public:
   // Opens everything `config` names (after the privileged devices, already
-  // opened, are handed in) and starts serving. `tick` is called from the
-  // capture loop (the watchdog). Errors name the part that failed;
+  // opened, are handed in) and starts serving; `listener` is the socket
+  // from OpenUnixListener (opened here when nullptr). `tick` is called from
+  // the capture loop (the watchdog). Errors name the part that failed;
   // kInvalidArgument for what the configuration got wrong.
-  static framestore::Result<std::unique_ptr<Daemon>> Start(const Config& config,
-                                                            PrivilegedDevices privileged,
-                                                            std::function<void()> tick = {});
+  static framestore::Result<std::unique_ptr<Daemon>> Start(
+      const Config& config, PrivilegedDevices privileged, std::function<void()> tick = {},
+      std::unique_ptr<service::UnixListener> listener = nullptr);
   // Drains (see Drain) if not done yet.
   ~Daemon();
   Daemon(const Daemon&) = delete;

@@ -4,9 +4,11 @@
 // mutual TLS.
 //
 // Start-up order matters for least privilege: the configuration is read, the
-// devices that need CAP_SYS_RAWIO are opened while the process has a single
-// thread, every capability is dropped (bslsd refuses to go on otherwise), and
-// only then are threads started and network input parsed.
+// devices that need CAP_SYS_RAWIO and the Unix socket (with its group) are
+// set up while the process has a single thread, bslsd becomes the configured
+// user when started as root, every capability is dropped (bslsd refuses to
+// go on otherwise), and only then are threads started and network input
+// parsed.
 //
 // Exit codes: 0 after a clean SIGTERM/SIGINT, 1 for runtime failures,
 // 78 (EX_CONFIG) for what a restart cannot fix: a bad configuration, kernel
@@ -16,14 +18,17 @@
 #include <grp.h>
 #include <signal.h>
 #include <systemd/sd-daemon.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <spdlog/spdlog.h>
 
+#include "bsls/rpc/server_limits.h"
 #include "config.h"
 #include "daemon.h"
 #include "privileges.h"
@@ -69,18 +74,45 @@ int Run(const bslsd::Config& config) {
     return kExitConfig;
   }
 
-  // 1. Devices that need a privilege, while single-threaded.
+  // Started as root, bslsd becomes `user` (never serves as root by accident).
+  std::optional<bslsd::Identity> identity;
+  if (::geteuid() == 0) {
+    framestore::Result<bslsd::Identity> resolved = bslsd::ResolveIdentity(config.user);
+    if (!resolved.ok()) {
+      spdlog::critical("{}", resolved.status().message());
+      return kExitConfig;
+    }
+    identity = std::move(resolved).value();
+    if (identity->uid == 0)
+      spdlog::warn(
+          "user: '{}' is root: bslsd keeps uid 0 (without capabilities); for tests "
+          "and development only",
+          config.user);
+  }
+
+  // 1. Devices that need a privilege, and the socket (its group may be one
+  // the user is not in), while single-threaded.
   framestore::Result<bslsd::PrivilegedDevices> privileged = bslsd::OpenPrivileged(config);
   if (!privileged.ok()) {
     spdlog::critical("{}", privileged.status().message());
     return privileged.status().code() == framestore::ErrorCode::kPermissionDenied ? kExitConfig
                                                                                 : kExitRuntime;
   }
-  // 2. No privilege from here on.
-  if (framestore::Status dropped = bslsd::DropAllCapabilities(); !dropped.ok()) {
+  framestore::Result<std::unique_ptr<service::UnixListener>> listener =
+      bslsd::OpenUnixListener(config);
+  if (!listener.ok()) {
+    spdlog::critical("{}", listener.status().message());
+    return listener.status().code() == framestore::ErrorCode::kInvalidArgument ? kExitConfig
+                                                                               : kExitRuntime;
+  }
+  // 2. No privilege from here on: the user's identity, no capabilities, no_new_privs.
+  if (framestore::Status dropped = bslsd::DropAllCapabilities(identity); !dropped.ok()) {
     spdlog::critical("{}", dropped.message());
     return kExitConfig;
   }
+  if (identity)
+    spdlog::info("running as user '{}' (uid {}, gid {})", identity->name, identity->uid,
+                 identity->gid);
 
   // Signals are taken by sigwait below; every thread started from here inherits the mask.
   sigset_t signals;
@@ -93,7 +125,8 @@ int Run(const bslsd::Config& config) {
   // 3. Everything else, then serve.
   Watchdog watchdog;
   framestore::Result<std::unique_ptr<bslsd::Daemon>> started = bslsd::Daemon::Start(
-      config, std::move(privileged).value(), [&watchdog] { watchdog.Feed(); });
+      config, std::move(privileged).value(), [&watchdog] { watchdog.Feed(); },
+      std::move(listener).value());
   if (!started.ok()) {
     spdlog::critical("{}", started.status().message());
     return started.status().code() == framestore::ErrorCode::kInvalidArgument ? kExitConfig
@@ -106,15 +139,22 @@ int Run(const bslsd::Config& config) {
                                   : "");
   sd_notify(0, "READY=1\nSTATUS=serving");
 
-  // 4. Until SIGTERM/SIGINT; retention runs once a minute meanwhile.
+  // 4. Until SIGTERM/SIGINT. Meanwhile freed memory goes back to the system
+  // every 10 s (a flood of calls must not leave the daemon large), and
+  // retention runs once a minute.
+  auto retention_due = std::chrono::steady_clock::now() + std::chrono::minutes(1);
   for (;;) {
-    timespec minute{60, 0};
-    const int signal = sigtimedwait(&signals, nullptr, &minute);
+    timespec wait{10, 0};
+    const int signal = sigtimedwait(&signals, nullptr, &wait);
     if (signal == SIGTERM || signal == SIGINT) {
       spdlog::info("signal {}: draining", signal);
       break;
     }
-    daemon->ApplyRetention();
+    rpc::ReturnFreedMemory();
+    if (std::chrono::steady_clock::now() >= retention_due) {
+      daemon->ApplyRetention();
+      retention_due = std::chrono::steady_clock::now() + std::chrono::minutes(1);
+    }
   }
   sd_notify(0, "STOPPING=1\nSTATUS=draining");
   daemon->Drain();
@@ -125,6 +165,7 @@ int Run(const bslsd::Config& config) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  bsls::rpc::TuneAllocator();
   CLI::App app{"bslsd: the BSLS capture daemon"};
   std::optional<std::string> config_path;
   std::vector<std::string> overrides;
@@ -157,6 +198,14 @@ int main(int argc, char** argv) {
     if (!policy.ok()) {
       std::fprintf(stderr, "bslsd: %s\n", policy.status().message().c_str());
       return kExitConfig;
+    }
+    if (::geteuid() == 0) {
+      bsls::framestore::Result<bsls::bslsd::Identity> identity =
+          bsls::bslsd::ResolveIdentity(config->user);
+      if (!identity.ok()) {
+        std::fprintf(stderr, "bslsd: %s\n", identity.status().message().c_str());
+        return kExitConfig;
+      }
     }
     std::fputs(bsls::bslsd::Dump(*config).c_str(), stdout);
     std::fputs("# configuration OK\n", stdout);

@@ -1,12 +1,18 @@
 #include "privileges.h"
 
+#include <grp.h>
+#include <pwd.h>
 #include <sys/capability.h>
 #include <sys/prctl.h>
+#include <unistd.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <sstream>
+#include <string_view>
 
 namespace bsls::bslsd {
 
@@ -43,7 +49,65 @@ int ThreadCount() {
   return -1;
 }
 
-Status DropAllCapabilities() {
+namespace {
+
+// The unsigned number that is the whole of `text`.
+std::optional<unsigned> WholeNumber(std::string_view text) {
+  unsigned value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || error != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return value;
+}
+
+std::string Errno(const std::string& what) { return what + ": " + std::strerror(errno); }
+
+// The ids as getresuid/getresgid see them: all three equal to `uid`/`gid`.
+bool IdsAre(uid_t uid, gid_t gid) {
+  uid_t ruid, euid, suid;
+  gid_t rgid, egid, sgid;
+  return ::getresuid(&ruid, &euid, &suid) == 0 && ::getresgid(&rgid, &egid, &sgid) == 0 &&
+         ruid == uid && euid == uid && suid == uid && rgid == gid && egid == gid && sgid == gid;
+}
+
+}  // namespace
+
+Result<Identity> ResolveIdentity(const std::string& user) {
+  Identity identity;
+  identity.name = user;
+  if (const std::size_t colon = user.find(':'); colon != std::string::npos) {
+    const std::optional<unsigned> uid = WholeNumber(std::string_view(user).substr(0, colon));
+    const std::optional<unsigned> gid = WholeNumber(std::string_view(user).substr(colon + 1));
+    if (!uid || !gid)
+      return Status(ErrorCode::kInvalidArgument,
+                    "user: '" + user + "' is neither a user name nor UID:GID numbers");
+    identity.uid = *uid;
+    identity.gid = *gid;
+    return identity;
+  }
+  std::vector<char> buffer(16384);
+  passwd entry{};
+  passwd* found = nullptr;
+  if (::getpwnam_r(user.c_str(), &entry, buffer.data(), buffer.size(), &found) != 0 ||
+      found == nullptr)
+    return Status(ErrorCode::kInvalidArgument,
+                  "user: '" + user +
+                      "' does not exist on this machine; bslsd started as root switches to it "
+                      "and refuses to serve as root (create it, e.g. with systemd-sysusers and "
+                      "bsls.sysusers.conf, or name another account in `user:`)");
+  identity.uid = found->pw_uid;
+  identity.gid = found->pw_gid;
+  int count = 32;
+  for (;;) {
+    identity.groups.resize(count);
+    const int previous = count;
+    if (::getgrouplist(user.c_str(), identity.gid, identity.groups.data(), &count) >= 0) break;
+    if (count <= previous) count = previous * 2;  // older glibc: no size given back
+  }
+  identity.groups.resize(count);
+  return identity;
+}
+
+Status DropAllCapabilities(const std::optional<Identity>& identity) {
   if (const int threads = ThreadCount(); threads != 1)
     return Status(ErrorCode::kInternal,
                   "capabilities must be dropped while bslsd has one thread; it has " +
@@ -59,6 +123,26 @@ Status DropAllCapabilities() {
     if (setpcap == CAP_SET) {
       for (cap_value_t cap = 0; cap <= CAP_LAST_CAP; ++cap) ::prctl(PR_CAPBSET_DROP, cap, 0, 0, 0);
     }
+  }
+  // The identity next, while CAP_SETGID and CAP_SETUID are still held:
+  // groups, then the gid, then the uid (after which they are gone).
+  if (identity) {
+    if (::setgroups(identity->groups.size(), identity->groups.data()) != 0)
+      return Status(ErrorCode::kPermissionDenied,
+                    Errno("setting the supplementary groups of user '" + identity->name + "'"));
+    if (::setresgid(identity->gid, identity->gid, identity->gid) != 0)
+      return Status(ErrorCode::kPermissionDenied,
+                    Errno("switching to gid " + std::to_string(identity->gid) + " of user '" +
+                          identity->name + "'"));
+    if (::setresuid(identity->uid, identity->uid, identity->uid) != 0)
+      return Status(ErrorCode::kPermissionDenied,
+                    Errno("switching to uid " + std::to_string(identity->uid) + " of user '" +
+                          identity->name + "'"));
+    if (!IdsAre(identity->uid, identity->gid))
+      return Status(ErrorCode::kPermissionDenied, "bslsd did not become user '" + identity->name +
+                                                      "' (uid " + std::to_string(identity->uid) +
+                                                      ", gid " + std::to_string(identity->gid) +
+                                                      ")");
   }
   if (::prctl(PR_CAP_AMBIENT, PR_CAP_AMBIENT_CLEAR_ALL, 0, 0, 0) != 0 && errno != EINVAL)
     return Status(ErrorCode::kPermissionDenied,

@@ -21,9 +21,18 @@ Config Parse(const YAML::Node& root) {
                {"listen", "workers", "queue", "calibration_cache_entries", "replica", "scratch_dir",
                 "max_upload_bytes", "max_frame_pixels", "drain_timeout_ms", "log_level"});
   const YAML::Node listen = root["listen"];
-  io::OnlyKeys(listen, "listen",
-               {"unix_socket", "tcp", "plaintext_loopback", "tls_certificate", "tls_key",
-                "tls_client_ca", "max_receive_message_bytes", "max_send_message_bytes"});
+  std::set<std::string> listen_keys = {"unix_socket",
+                                       "tcp",
+                                       "plaintext_loopback",
+                                       "tls_certificate",
+                                       "tls_key",
+                                       "tls_client_ca",
+                                       "max_receive_message_bytes",
+                                       "max_send_message_bytes",
+                                       "max_connections",
+                                       "max_connections_per_user"};
+  listen_keys.insert(rpc::Http2LimitKeys().begin(), rpc::Http2LimitKeys().end());
+  io::OnlyKeys(listen, "listen", listen_keys);
   if (listen) {
     ListenConfig& l = c.listen;
     io::ReadKey(listen, "listen", "unix_socket", l.unix_socket);
@@ -36,6 +45,10 @@ Config Parse(const YAML::Node& root) {
                        1 << 20, 1 << 30);
     io::ReadKeyInRange(listen, "listen", "max_send_message_bytes", l.max_send_message_bytes,
                        2 << 20, 1 << 30);
+    io::ReadKeyInRange(listen, "listen", "max_connections", l.max_connections, 1, 65536);
+    io::ReadKeyInRange(listen, "listen", "max_connections_per_user", l.max_connections_per_user, 1,
+                       65536);
+    rpc::ReadHttp2Limits(listen, "listen", l.http2);
   }
   io::ReadKeyInRange(root, "", "workers", c.workers, 0, 256);
   io::ReadKeyInRange(root, "", "queue", c.queue, -1, 4096);
@@ -85,6 +98,9 @@ void Validate(const Config& c) {
                         ": TCP is mutual TLS only: give listen.tls_certificate, listen.tls_key "
                         "and listen.tls_client_ca");
   }
+  if (l.max_connections_per_user > l.max_connections)
+    throw ConfigError(
+        "configuration: listen.max_connections_per_user is above listen.max_connections");
   static const std::set<std::string> levels = {"trace", "debug", "info", "warn", "error", "off"};
   if (!levels.count(c.log_level))
     throw ConfigError("configuration: log_level '" + c.log_level +
@@ -112,6 +128,10 @@ std::string Dump(const Config& c) {
   out << YAML::Key << "max_receive_message_bytes" << YAML::Value
       << c.listen.max_receive_message_bytes;
   out << YAML::Key << "max_send_message_bytes" << YAML::Value << c.listen.max_send_message_bytes;
+  out << YAML::Key << "max_connections" << YAML::Value << c.listen.max_connections;
+  out << YAML::Key << "max_connections_per_user" << YAML::Value
+      << c.listen.max_connections_per_user;
+  rpc::DumpHttp2Limits(out, c.listen.http2);
   out << YAML::EndMap;
   out << YAML::Key << "workers" << YAML::Value << Workers(c);
   out << YAML::Key << "queue" << YAML::Value << Queue(c);

@@ -1,7 +1,6 @@
 // bsls-processd: the BSLS processing service (issue 5). Runs unprivileged;
 // configuration errors exit 78 (EX_CONFIG) so systemd does not restart into
 // the same mistake.
-#include <malloc.h>
 #include <signal.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -11,6 +10,7 @@
 #include <cstdio>
 #include <iostream>
 
+#include "bsls/rpc/server_limits.h"
 #include "bsls/rpc/tls.h"
 #include "config.h"
 #include "server.h"
@@ -64,12 +64,8 @@ int Run(const bsls::processd::Config& config) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Memory comes back after a burst of work: large buffers (frames, meshes,
-  // artifacts) are mapped and unmapped on their own instead of growing the
-  // heaps, and two arenas instead of one per core and thread keep freed
-  // blocks from piling up in idle ones (the pool also trims after each call).
-  mallopt(M_MMAP_THRESHOLD, 256 << 10);
-  mallopt(M_ARENA_MAX, 2);
+  // Memory comes back after a burst of work (the pool also trims after each call).
+  bsls::rpc::TuneAllocator();
   // Logs on stderr: stdout carries only the tcp_port=N line scripts read.
   spdlog::set_default_logger(spdlog::stderr_color_mt("bsls-processd"));
   CLI::App app{"bsls-processd: the BSLS processing service (frames to junctions, surfaces, "

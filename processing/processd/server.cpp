@@ -1,27 +1,16 @@
 #include "server.h"
 
+#include <grpcpp/server_posix.h>
 #include <spdlog/spdlog.h>
-#include <sys/stat.h>
 
-#include <filesystem>
-#include <optional>
 #include <stdexcept>
 #include <thread>
 
+#include "bsls/rpc/malformed_requests.h"
+#include "bsls/rpc/server_limits.h"
 #include "bsls/rpc/tls.h"
-#include "bsls/rpc/unix_socket.h"
 
 namespace bsls::processd {
-namespace {
-
-// The (device, inode) of the file at `path`, if there is one.
-std::optional<std::pair<dev_t, ino_t>> FileId(const std::string& path) {
-  struct stat st {};
-  if (::lstat(path.c_str(), &st) != 0) return std::nullopt;
-  return std::make_pair(st.st_dev, st.st_ino);
-}
-
-}  // namespace
 
 std::unique_ptr<Server> Server::Start(const Config& config, const std::string& software_version) {
   Validate(config);
@@ -43,17 +32,22 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
   grpc::ServerBuilder builder;
   builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
   builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
+  rpc::ApplyHttp2Limits(config.listen.http2, builder);
+  rpc::ReportMalformedRequests(builder);
   // Handler threads: every worker and queue place, plus quick calls.
   grpc::ResourceQuota quota("bsls-processd");
   quota.SetMaxThreads(options.workers + options.queue + 16);
   builder.SetResourceQuota(quota);
   builder.RegisterService(s->service_.get());
   if (!config.listen.unix_socket.empty()) {
-    if (const std::string taken = rpc::ClaimUnixSocketPath(config.listen.unix_socket);
-        !taken.empty())
-      throw std::runtime_error("listen.unix_socket: " + taken);
-    builder.AddListeningPort("unix:" + config.listen.unix_socket,
-                             grpc::InsecureServerCredentials());
+    rpc::UnixAcceptorOptions socket;
+    socket.path = config.listen.unix_socket;
+    socket.mode = 0660;
+    socket.max_connections = config.listen.max_connections;
+    socket.max_connections_per_user = config.listen.max_connections_per_user;
+    rpc::UnixAcceptorError error;
+    s->acceptor_ = rpc::UnixAcceptor::Create(socket, &error);
+    if (!s->acceptor_) throw std::runtime_error("listen.unix_socket: " + error.message);
   }
   if (!config.listen.tcp.empty()) {
     rpc::TlsFiles tls{config.listen.tls_client_ca, config.listen.tls_certificate,
@@ -66,14 +60,17 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
                              &s->tcp_port_);
   }
   s->server_ = builder.BuildAndStart();
-  if (s->server_ && !config.listen.unix_socket.empty())
-    s->socket_file_ = FileId(config.listen.unix_socket);
   if (!s->server_ || (!config.listen.tcp.empty() && s->tcp_port_ == 0))
     throw std::runtime_error(
         "the gRPC server could not start" +
         (config.listen.tcp.empty() ? std::string() : " on TCP " + config.listen.tcp) +
         (config.listen.unix_socket.empty() ? std::string()
                                            : " (socket " + config.listen.unix_socket + ")"));
+  if (s->acceptor_) {
+    grpc::Server* server = s->server_.get();
+    s->acceptor_->Start(
+        [server](int fd, const ucred&) { grpc::AddInsecureChannelFromFd(server, fd); });
+  }
   spdlog::info(
       "serving: {} workers, {} queue places{}{}", options.workers, options.queue,
       config.listen.unix_socket.empty() ? "" : ", unix:" + config.listen.unix_socket,
@@ -90,6 +87,8 @@ void Server::Drain() {
   if (drained_) return;
   drained_ = true;
   if (service_) service_->BeginDrain();
+  // No new connections; the socket file goes if it still is the one made here.
+  if (acceptor_) acceptor_->Stop();
   if (server_) {
     // Work under way stops at its next stage; wait for that (at most the
     // drain timeout), then shut down at once: gRPC's own deadline would also
@@ -103,12 +102,6 @@ void Server::Drain() {
     }
     server_->Shutdown(std::chrono::system_clock::now() + std::chrono::milliseconds(100));
     server_->Wait();
-  }
-  // Only the file this server made: another instance may have replaced a
-  // socket it found stale.
-  if (socket_file_ && FileId(config_.listen.unix_socket) == socket_file_) {
-    std::error_code ec;
-    std::filesystem::remove(config_.listen.unix_socket, ec);
   }
 }
 

@@ -1,6 +1,7 @@
 // bsls-processd assembled: the processing service on a gRPC server with its
 // size caps, the health service, and the listeners of the configuration (a
-// Unix socket for this machine, TCP with mutual TLS or plain on loopback).
+// Unix socket for this machine, accepted by rpc::UnixAcceptor within the
+// connection limits; TCP with mutual TLS or plain on loopback).
 // main() wraps it with signals and systemd notification; the tests and the
 // benchmark start replicas in-process through the same class.
 #ifndef BSLS_PROCESSD_SERVER_H_
@@ -15,6 +16,7 @@
 #include <utility>
 
 #include "bsls/processing/processing_service.h"
+#include "bsls/rpc/unix_acceptor.h"
 #include "config.h"
 
 namespace bsls::processd {
@@ -45,11 +47,11 @@ class Server {
   Config config_;
   std::unique_ptr<processing::ProcessingService> service_;
   std::unique_ptr<grpc::Server> server_;
+  // The Unix socket: its connections are accepted here (within the
+  // listen.max_connections* limits) and handed to server_.
+  std::unique_ptr<rpc::UnixAcceptor> acceptor_;
   int tcp_port_ = 0;
   bool drained_ = false;
-  // The Unix socket file this server made (device, inode): removed on
-  // Drain only while it is still that file, never a later instance's.
-  std::optional<std::pair<dev_t, ino_t>> socket_file_;
 };
 
 }  // namespace bsls::processd

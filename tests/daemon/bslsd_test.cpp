@@ -1,8 +1,9 @@
 // bslsd as its users meet it: the real executable started on a temporary
 // socket and store, driven over gRPC (issue 4, "Done means").
+#include <grp.h>
 #include <gtest/gtest.h>
 #include <openssl/sha.h>
-#include <grp.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -12,9 +13,13 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 #include "bsls/testing/certificates.h"
+#include "bsls/testing/raw_connections.h"
 #include "daemon_process.h"
+#include "raw_calls.h"
 
 namespace bsls::testing {
 namespace {
@@ -23,6 +28,10 @@ using std::chrono::milliseconds;
 using std::chrono::seconds;
 
 constexpr const char* kSimulatedSlides = "slides:\n  backend: simulated\n";
+
+// Bytes that are no message of any type: field 1, length-delimited, with a
+// length of 4 GiB that does not follow.
+constexpr char kNotAMessage[] = "\x0a\xff\xff\xff\xff\x0f";
 
 std::string Hex(const unsigned char* digest, std::size_t n) {
   static const char* kDigits = "0123456789abcdef";
@@ -507,7 +516,10 @@ TEST_F(Bslsd, EveryRoleOnEveryCallHasNoUnauthorizedSuccess) {
     if (child == 0) {
       ::dup2(pipe_fds[1], 1);
       ::close(pipe_fds[0]);
-      if (::setgroups(0, nullptr) != 0 || ::setgid(uid) != 0 || ::setuid(uid) != 0) ::_exit(3);
+      // The socket's group (mode 0660) lets the probe connect; its role comes from its uid.
+      const gid_t socket_group = kTestSocketGroup;
+      if (::setgroups(1, &socket_group) != 0 || ::setgid(uid) != 0 || ::setuid(uid) != 0)
+        ::_exit(3);
       ::execl(ROLE_PROBE_PATH, ROLE_PROBE_PATH, daemon_->socket().c_str(), nullptr);
       ::_exit(127);
     }
@@ -538,6 +550,143 @@ TEST_F(Bslsd, EveryRoleOnEveryCallHasNoUnauthorizedSuccess) {
   EXPECT_TRUE(daemon_->Stub()->GetStatus(Deadline(milliseconds(5000)).get(), {}, &device).ok());
 }
 
+// The fields of a /proc/<pid>/task/<tid>/status, each split at white space.
+std::map<std::string, std::vector<std::string>> StatusFields(const fs::path& status) {
+  std::ifstream in(status);
+  std::map<std::string, std::vector<std::string>> fields;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string key;
+    words >> key;
+    for (std::string word; words >> word;) fields[key].push_back(word);
+  }
+  return fields;
+}
+
+// Issue 26: started as root, bslsd sets up its socket (with a group root is
+// needed for) and becomes the configured user: uid, gid and groups, no
+// capabilities, no_new_privs, in every thread; it still grabs and stores.
+TEST_F(Bslsd, StartedAsRootItBecomesTheConfiguredUserWithoutPrivileges) {
+  if (::geteuid() != 0)
+    GTEST_SKIP() << "needs root: bslsd switches users only when started as root";
+  constexpr uid_t kUid = 60010;
+  constexpr gid_t kGid = 60011;
+  dir_ = MakeDaemonDir("identity");
+  ASSERT_EQ(::chown(dir_.c_str(), kUid, kGid), 0);  // its store and socket live here
+  config_ = WriteDaemonConfig(dir_, "roles:\n  admin: [root]\n" + std::string(kSimulatedSlides));
+  daemon_ = std::make_unique<DaemonProcess>(
+      dir_, config_,
+      std::vector<std::string>{
+          "--set", "user=\"" + std::to_string(kUid) + ":" + std::to_string(kGid) + "\""});
+  ASSERT_TRUE(daemon_->ready()) << daemon_->Log();
+  const std::vector<std::string> uid(4, std::to_string(kUid));
+  const std::vector<std::string> gid(4, std::to_string(kGid));
+  const std::vector<std::string> no_capability = {"0000000000000000"};
+  std::size_t threads = 0;
+  for (const auto& task :
+       fs::directory_iterator("/proc/" + std::to_string(daemon_->pid()) + "/task")) {
+    auto fields = StatusFields(task.path() / "status");
+    EXPECT_EQ(fields["Uid:"], uid) << task.path();
+    EXPECT_EQ(fields["Gid:"], gid) << task.path();
+    EXPECT_TRUE(fields["Groups:"].empty()) << task.path();
+    EXPECT_EQ(fields["CapEff:"], no_capability) << task.path();
+    EXPECT_EQ(fields["CapPrm:"], no_capability) << task.path();
+    EXPECT_EQ(fields["CapAmb:"], no_capability) << task.path();
+    EXPECT_EQ(fields["NoNewPrivs:"], std::vector<std::string>{"1"}) << task.path();
+    ++threads;
+  }
+  EXPECT_GT(threads, 1u);
+  // The socket got its group while bslsd could still set it.
+  struct stat socket_file {};
+  ASSERT_EQ(::stat(daemon_->socket().c_str(), &socket_file), 0);
+  EXPECT_EQ(socket_file.st_gid, kTestSocketGroup);
+  EXPECT_EQ(socket_file.st_mode & 0777, 0660u);
+  auto stub = daemon_->Stub();
+  grpc::Status grab;
+  GrabBoth(*stub, "identity", &grab);
+  ASSERT_TRUE(grab.ok()) << grab.error_message();
+  struct stat store {};
+  ASSERT_EQ(::stat((dir_ / "store").c_str(), &store), 0);
+  EXPECT_EQ(store.st_uid, kUid);
+}
+
+// Issue 26: bytes that are not the request message get INVALID_ARGUMENT
+// naming the message type, on every method of bslsd (they got INTERNAL with
+// an empty message), before any role is checked; the daemon still answers.
+TEST_F(Bslsd, AMalformedRequestIsInvalidArgumentWithAMessage) {
+  Start("malformed");
+  grpc::GenericStub stub(daemon_->Channel());
+  const google::protobuf::ServiceDescriptor* service =
+      google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
+          v1::CaptureDaemon::service_full_name());
+  ASSERT_NE(service, nullptr);
+  for (int i = 0; i < service->method_count(); ++i) {
+    const google::protobuf::MethodDescriptor* method = service->method(i);
+    ASSERT_FALSE(method->client_streaming()) << method->name();
+    processing::test::RawCall call;
+    call.method = "/" + service->full_name() + "/" + method->name();
+    call.messages = {std::string(kNotAMessage, sizeof kNotAMessage - 1)};
+    call.deadline_ms = 10000;
+    const processing::test::RawOutcome outcome = processing::test::SendRaw(stub, call);
+    EXPECT_EQ(outcome.code, grpc::StatusCode::INVALID_ARGUMENT) << call.method;
+    EXPECT_NE(outcome.message.find(method->input_type()->full_name()), std::string::npos)
+        << call.method << ": " << outcome.message;
+  }
+  v1::DeviceStatus status;
+  EXPECT_TRUE(daemon_->Stub()->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
+}
+
+// Issue 26: the configured connection limits reach bslsd's socket: one
+// user's connections beyond listen.max_connections_per_user are closed at
+// once, and once they are gone the daemon answers that user again.
+TEST_F(Bslsd, AUsersConnectionsBeyondItsShareAreClosedAtOnce) {
+  Start("connections", kSimulatedSlides,
+        {"--set", "listen.max_connections_per_user=3", "--set", "listen.max_connections=100"});
+  // The start-up probe's connection goes first.
+  std::this_thread::sleep_for(milliseconds(500));
+  std::vector<int> open;
+  int closed = 0;
+  for (int i = 0; i < 5; ++i) {
+    const int fd = ConnectUnixAs(0, daemon_->socket().string());
+    ASSERT_GE(fd, 0);
+    if (ClosedWithin(fd, 1000)) {
+      ++closed;
+      ::close(fd);
+    } else {
+      open.push_back(fd);
+    }
+  }
+  EXPECT_EQ(open.size(), 3u) << daemon_->Log();
+  EXPECT_EQ(closed, 2);
+  for (int fd : open) ::close(fd);
+  grpc::Status answered;
+  v1::DeviceStatus status;
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    answered = daemon_->Stub()->GetStatus(Deadline(milliseconds(2000)).get(), {}, &status);
+    if (answered.ok()) break;
+    std::this_thread::sleep_for(milliseconds(100));
+  }
+  EXPECT_TRUE(answered.ok()) << answered.error_message();
+}
+
+// Issue 26: HTTP/2 limits are set on the server: a connection without calls
+// is closed after listen.max_connection_idle_ms, and the client reconnects.
+TEST_F(Bslsd, AConnectionWithoutCallsIsClosedAfterTheIdleLimit) {
+  Start("idle", kSimulatedSlides, {"--set", "listen.max_connection_idle_ms=500"});
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);
+  std::shared_ptr<grpc::Channel> channel = daemon_->Channel(args);
+  auto stub = v1::CaptureDaemon::NewStub(channel);
+  v1::DeviceStatus status;
+  ASSERT_TRUE(stub->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
+  ASSERT_EQ(channel->GetState(false), GRPC_CHANNEL_READY);
+  const auto until = std::chrono::steady_clock::now() + seconds(10);
+  while (channel->GetState(false) == GRPC_CHANNEL_READY && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(milliseconds(50));
+  EXPECT_NE(channel->GetState(false), GRPC_CHANNEL_READY) << "the idle connection stayed open";
+  EXPECT_TRUE(stub->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
+}
+
 TEST(BslsdConfig, CheckConfigNamesTheBadKeyAndExitsWithConfigError) {
   const fs::path dir = MakeDaemonDir("check");
   const fs::path config = WriteDaemonConfig(dir);
@@ -560,6 +709,48 @@ TEST(BslsdConfig, CheckConfigNamesTheBadKeyAndExitsWithConfigError) {
   while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
   EXPECT_EQ(WEXITSTATUS(::pclose(pipe)), 0) << output;
   EXPECT_NE(output.find("configuration OK"), std::string::npos) << output;
+}
+
+// Runs `command` (stderr with stdout): its exit code and what it printed.
+std::pair<int, std::string> RunCommand(const std::string& command) {
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return {-1, "popen failed"};
+  std::string output;
+  char buffer[1024];
+  while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
+// Issue 26: a world-writable socket would let every local user call the
+// daemon; such a mode is refused, naming the key and the reason.
+TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
+  const fs::path dir = MakeDaemonDir("mode");
+  const fs::path config = WriteDaemonConfig(dir);
+  for (const char* mode : {"0666", "0602", "0777", "2"}) {
+    const auto [code, output] =
+        RunCommand(std::string(BSLSD_PATH) + " --check-config --config " + config.string() +
+                   " --set 'listen.socket_mode=\"" + mode + "\"'");
+    EXPECT_EQ(code, 78) << mode << ": " << output;
+    EXPECT_NE(output.find("listen.socket_mode"), std::string::npos) << output;
+    EXPECT_NE(output.find("world-writable"), std::string::npos) << output;
+  }
+  const auto [code, output] = RunCommand(std::string(BSLSD_PATH) + " --check-config --config " +
+                                         config.string() + " --set 'listen.socket_mode=\"0660\"'");
+  EXPECT_EQ(code, 0) << output;
+}
+
+// Issue 26: started as root with a `user` that does not exist, bslsd
+// refuses to start (it never serves as root by accident) and names it.
+TEST(BslsdConfig, StartedAsRootWithAnUnknownUserItRefusesToStart) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root: the user matters only when started as root";
+  const fs::path dir = MakeDaemonDir("nouser");
+  const fs::path config = WriteDaemonConfig(dir);
+  const auto [code, output] = RunCommand(std::string(BSLSD_PATH) + " --config " + config.string() +
+                                         " --set user=no-such-bsls-user");
+  EXPECT_EQ(code, 78) << output;
+  EXPECT_NE(output.find("'no-such-bsls-user' does not exist"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "bslsd.sock")) << "it opened its socket before refusing";
 }
 
 }  // namespace

@@ -41,13 +41,25 @@ inline fs::path MakeDaemonDir(const std::string& name) {
   return dir;
 }
 
+// The group of the test daemons' sockets when the tests run as root: the
+// probes of other uids get it as a supplementary group (a socket is never
+// world-writable, bslsd refuses that).
+constexpr gid_t kTestSocketGroup = 60000;
+
 // The configuration file of a test daemon: simulated devices unless
-// `extra` says otherwise (YAML appended verbatim, top-level keys).
+// `extra` says otherwise (YAML appended verbatim, top-level keys). The
+// daemon keeps the test's own uid and gid (`user:`; as root it would
+// otherwise become `bsls`), its socket is mode 0660 and, as root, of group
+// kTestSocketGroup.
 inline fs::path WriteDaemonConfig(const fs::path& dir, const std::string& extra = {}) {
   const fs::path path = dir / "bslsd.yaml";
   std::ofstream out(path);
   out << "store:\n  root: " << (dir / "store").string() << "\n  reserve_mib: 16\n"
-      << "listen:\n  unix_socket: " << (dir / "bslsd.sock").string() << "\n  socket_mode: \"0666\"\n"
+      << "listen:\n  unix_socket: " << (dir / "bslsd.sock").string()
+      << "\n  socket_mode: \"0660\"\n"
+      << (::geteuid() == 0 ? "  socket_group: \"" + std::to_string(kTestSocketGroup) + "\"\n"
+                           : std::string())
+      << "user: \"" << ::geteuid() << ":" << ::getegid() << "\"\n"
       << "log_level: warn\n"
       // A still head: one rendered view per camera and slide (rendering is
       // the simulated framestore's only slow step).

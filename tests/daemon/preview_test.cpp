@@ -1,5 +1,6 @@
 // Preview to four clients at once, one of them reading slowly (issue 4, "Done
-// means"): the others keep the camera's 25 frames/s. Timing depends on the
+// means"): the others keep the camera's 25 frames/s; a reader that reads
+// nothing gives its slot back (issue 26). Timing depends on the
 // machine, so this test is labelled `timing` (not run under the sanitizers).
 #include <gtest/gtest.h>
 
@@ -90,6 +91,64 @@ TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
               static_cast<unsigned long long>(figures[3].dropped));
   EXPECT_GT(figures[3].dropped, 0u);  // it was told what it missed
   EXPECT_LE(slow_fps, 5.0);
+  EXPECT_EQ(daemon.Terminate(), 0) << daemon.Log();
+}
+
+// Issue 26: a reader that reads nothing and set no deadline held one of the
+// preview slots for ever. Now a write it does not take within
+// limits.stream_write_timeout_ms ends its stream with RESOURCE_EXHAUSTED
+// and the next reader gets the slot and its frames.
+TEST(BslsdPreview, AReaderThatReadsNothingGivesItsSlotBack) {
+  const fs::path dir = MakeDaemonDir("preview_stalled");
+  const fs::path config = WriteDaemonConfig(dir, "roles:\n  admin: [root]\n");
+  DaemonProcess daemon(
+      dir, config,
+      {"--set", "limits.max_preview_streams=1", "--set", "limits.stream_write_timeout_ms=1000"});
+  ASSERT_TRUE(daemon.ready()) << daemon.Log();
+
+  // The stalled reader: no deadline, a receive window of about one frame,
+  // and not a single Read.
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 512 * 512);
+  auto stalled_stub = daemon.Stub(args);
+  grpc::ClientContext stalled;
+  auto stalled_reader = stalled_stub->StreamPreview(&stalled, {});
+  std::this_thread::sleep_for(milliseconds(300));
+
+  // The one slot is taken at first; within a few seconds it is free again.
+  bool refused_at_first = false;
+  bool got_frame = false;
+  const Clock::time_point until = Clock::now() + std::chrono::seconds(30);
+  for (int attempt = 0; !got_frame && Clock::now() < until; ++attempt) {
+    auto stub = daemon.Stub();
+    auto context = Deadline(milliseconds(10000));
+    auto reader = stub->StreamPreview(context.get(), {});
+    v1::PreviewFrame frame;
+    if (reader->Read(&frame)) {
+      got_frame = frame.frame().width() > 0;
+      context->TryCancel();
+      while (reader->Read(&frame)) {
+      }
+      reader->Finish().IgnoreError();
+      break;
+    }
+    const grpc::Status status = reader->Finish();
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
+    if (attempt == 0) refused_at_first = true;
+    std::this_thread::sleep_for(milliseconds(200));
+  }
+  EXPECT_TRUE(refused_at_first) << "the stalled reader did not hold the slot to begin with";
+  EXPECT_TRUE(got_frame) << "the stalled reader kept the only preview slot";
+
+  // The stalled reader, reading at last, finds its stream ended with the reason.
+  v1::PreviewFrame frame;
+  while (stalled_reader->Read(&frame)) {
+  }
+  const grpc::Status ended = stalled_reader->Finish();
+  EXPECT_EQ(ended.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << ended.error_message();
+  EXPECT_NE(ended.error_message().find("stream_write_timeout_ms"), std::string::npos)
+      << ended.error_message();
   EXPECT_EQ(daemon.Terminate(), 0) << daemon.Log();
 }
 

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The hardened unit's exposure as systemd rates it (issue 4: at most 2.5), and
-# the unit, sysusers and tmpfiles files as systemd parses them.
+# The hardened unit's exposure as systemd rates it (issue 4: at most 2.5), the
+# resource limits and sandbox settings issue 26 requires, and the unit,
+# sysusers and tmpfiles files as systemd parses them.
 set -euo pipefail
 unit=$1
 limit=$2
@@ -21,6 +22,17 @@ if ! awk -v e="$exposure" -v l="$limit" 'BEGIN { exit !(e <= l) }'; then
   echo "FAIL: exposure $exposure of $name is above $limit"
   exit 1
 fi
+# The resource limits and the sandbox every BSLS service unit must set
+# (issue 26): what a flood or a bug can take, and the system calls it may make.
+for setting in '^LimitNOFILE=[0-9]+$' '^MemoryMax=[0-9]+[KMGT]?$' '^TasksMax=[0-9]+$' \
+               '^NoNewPrivileges=yes$' '^SystemCallArchitectures=native$' \
+               '^SystemCallFilter=@system-service( |$)' '^CapabilityBoundingSet=' \
+               '^ProtectSystem=strict$'; do
+  if ! grep -Eq "$setting" "$unit"; then
+    echo "FAIL: $name does not set $setting"
+    exit 1
+  fi
+done
 # The unit parses without warnings about unknown settings.
 if systemd-analyze verify --man=no "$work/$name" 2>&1 | grep -i "unknown\|invalid\|failed to parse"; then
   echo "FAIL: systemd-analyze verify complains about $name"

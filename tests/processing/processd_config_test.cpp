@@ -45,6 +45,29 @@ TEST(ProcessdConfig, ErrorsNameTheKey) {
   EXPECT_NE(ErrorOf({"scratch_dir=/nonexistent/x"}).find("scratch_dir"), std::string::npos);
 }
 
+// Issue 26: the HTTP/2 and connection limits have defaults, are read under
+// listen: and are bounded (a key out of range is named).
+TEST(ProcessdConfig, Http2LimitsHaveBoundedDefaults) {
+  const Config defaults = LoadConfig(std::nullopt, {});
+  EXPECT_EQ(defaults.listen.http2.max_ping_strikes, 2);
+  EXPECT_EQ(defaults.listen.http2.max_connection_idle_ms, 300000);
+  const Config c = LoadConfig(
+      std::nullopt, {"listen.max_connection_idle_ms=1000", "listen.max_concurrent_streams=8"});
+  EXPECT_EQ(c.listen.http2.max_connection_idle_ms, 1000);
+  EXPECT_EQ(c.listen.http2.max_concurrent_streams, 8);
+  EXPECT_NE(ErrorOf({"listen.max_ping_strikes=0"}).find("listen.max_ping_strikes"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf({"listen.min_ping_interval_ms=1"}).find("listen.min_ping_interval_ms"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf({"listen.max_concurrent_streams=100000"}).find("max_concurrent_streams"),
+            std::string::npos);
+  EXPECT_NE(Dump(c).find("max_connection_idle_ms: 1000"), std::string::npos) << Dump(c);
+  EXPECT_EQ(defaults.listen.max_connections, 128);
+  EXPECT_EQ(defaults.listen.max_connections_per_user, 32);
+  EXPECT_NE(ErrorOf({"listen.max_connections_per_user=200"}).find("max_connections_per_user"),
+            std::string::npos);
+}
+
 TEST(RpcTargets, LoopbackIsRecognised) {
   EXPECT_TRUE(rpc::IsLoopbackTarget("127.0.0.1:7000"));
   EXPECT_TRUE(rpc::IsLoopbackTarget("ipv4:127.0.0.1:7001,127.0.0.2:7002"));

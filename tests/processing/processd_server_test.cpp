@@ -2,22 +2,33 @@
 // for one machine, mutual TLS for the network (every handshake without a
 // certificate of the configured CA fails), draining.
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <thread>
+#include <vector>
 
 #include "bsls/processing/processing_client.h"
 #include "bsls/testing/certificates.h"
+#include "bsls/testing/raw_connections.h"
+#include "raw_calls.h"
 #include "server.h"
 
 namespace bsls::processd {
 namespace {
 
 namespace fs = std::filesystem;
+
+// Bytes that are no message of any type: field 1, length-delimited, with a
+// length of 4 GiB that does not follow.
+constexpr char kNotAMessage[] = "\x0a\xff\xff\xff\xff\x0f";
 
 class ProcessdServer : public ::testing::Test {
  protected:
@@ -56,6 +67,105 @@ TEST_F(ProcessdServer, ServesTheUnixSocketAndPlainLoopback) {
     EXPECT_EQ(info.workers(), 1u);
     EXPECT_EQ(info.queue(), 2u);
   }
+  server->Drain();
+  EXPECT_FALSE(fs::exists(config.listen.unix_socket));
+}
+
+// Issue 26: the HTTP/2 limits reach the server: a connection without calls
+// is closed after listen.max_connection_idle_ms and the client reconnects.
+TEST_F(ProcessdServer, AConnectionWithoutCallsIsClosedAfterTheIdleLimit) {
+  Config config;
+  config.listen.unix_socket = (dir_ / "processd.sock").string();
+  config.listen.http2.max_connection_idle_ms = 500;
+  config.workers = 1;
+  auto server = Server::Start(config, "test");
+  std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateChannel("unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials());
+  v1::ServerInfo info;
+  ASSERT_TRUE(Info(channel, &info).ok());
+  ASSERT_EQ(channel->GetState(false), GRPC_CHANNEL_READY);
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (channel->GetState(false) == GRPC_CHANNEL_READY && std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  EXPECT_NE(channel->GetState(false), GRPC_CHANNEL_READY) << "the idle connection stayed open";
+  EXPECT_TRUE(Info(channel, &info).ok());
+  server->Drain();
+}
+
+// Issue 26: bytes that are not the request message get INVALID_ARGUMENT
+// naming the message type, on every method that takes one request (they
+// got INTERNAL with an empty message); the service still answers after.
+// (In a request stream a malformed message reads as the stream's end.)
+TEST_F(ProcessdServer, AMalformedRequestIsInvalidArgumentWithAMessage) {
+  Config config;
+  config.listen.unix_socket = (dir_ / "processd.sock").string();
+  config.workers = 1;
+  auto server = Server::Start(config, "test");
+  std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateChannel("unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials());
+  grpc::GenericStub stub(channel);
+  const google::protobuf::ServiceDescriptor* service =
+      google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
+          v1::Processing::service_full_name());
+  ASSERT_NE(service, nullptr);
+  int tried = 0;
+  for (int i = 0; i < service->method_count(); ++i) {
+    const google::protobuf::MethodDescriptor* method = service->method(i);
+    if (method->client_streaming()) continue;  // a bad message ends the stream's reads
+    processing::test::RawCall call;
+    call.method = "/" + service->full_name() + "/" + method->name();
+    call.messages = {std::string(kNotAMessage, sizeof kNotAMessage - 1)};
+    call.deadline_ms = 10000;
+    const processing::test::RawOutcome outcome = processing::test::SendRaw(stub, call);
+    EXPECT_EQ(outcome.code, grpc::StatusCode::INVALID_ARGUMENT) << call.method;
+    EXPECT_NE(outcome.message.find(method->input_type()->full_name()), std::string::npos)
+        << call.method << ": " << outcome.message;
+    ++tried;
+  }
+  EXPECT_GE(tried, 6);
+  v1::ServerInfo info;
+  EXPECT_TRUE(Info(channel, &info).ok());
+  server->Drain();
+}
+
+// Issue 26: the Unix socket's connections are limited per user and in all
+// (listen.max_connections*); connections beyond are closed at once while
+// other users are still let in, and the service answers after.
+TEST_F(ProcessdServer, UnixConnectionsBeyondTheLimitsAreClosedAtOnce) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to connect as other uids";
+  Config config;
+  config.listen.unix_socket = (dir_ / "processd.sock").string();
+  config.listen.max_connections = 4;
+  config.listen.max_connections_per_user = 2;
+  config.workers = 1;
+  auto server = Server::Start(config, "test");
+  // Other uids reach the socket: the folder is searchable, the socket 0660 of root's group.
+  ::chmod(dir_.c_str(), 0755);
+  ::chmod(config.listen.unix_socket.c_str(), 0666);
+  std::vector<int> open;
+  for (int i = 0; i < 2; ++i) open.push_back(testing::ConnectUnixAs(0, config.listen.unix_socket));
+  for (int fd : open)
+    EXPECT_FALSE(testing::ClosedWithin(fd, 300)) << "a connection within root's share";
+  const int beyond_share = testing::ConnectUnixAs(0, config.listen.unix_socket);
+  EXPECT_TRUE(testing::ClosedWithin(beyond_share, 2000)) << "root's third connection stayed open";
+  ::close(beyond_share);
+  for (uid_t uid : {60001u, 60002u}) {
+    open.push_back(testing::ConnectUnixAs(uid, config.listen.unix_socket));
+    EXPECT_FALSE(testing::ClosedWithin(open.back(), 300)) << "uid " << uid << " was not let in";
+  }
+  const int beyond_total = testing::ConnectUnixAs(60003, config.listen.unix_socket);
+  EXPECT_TRUE(testing::ClosedWithin(beyond_total, 2000))
+      << "a connection beyond the total stayed open";
+  ::close(beyond_total);
+  for (int fd : open) ::close(fd);
+  // Once they are gone, the service answers again.
+  std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateChannel("unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials());
+  v1::ServerInfo info;
+  grpc::Status status;
+  for (int attempt = 0; attempt < 20 && !(status = Info(channel, &info)).ok(); ++attempt)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_TRUE(status.ok()) << status.error_message();
   server->Drain();
   EXPECT_FALSE(fs::exists(config.listen.unix_socket));
 }

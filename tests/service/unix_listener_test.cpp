@@ -1,12 +1,16 @@
-// UnixListener when the process runs out of descriptors (issue 26): the
-// accept loop sheds the waiting callers at once and does not spin. The
+// UnixListener under hostile callers (issue 26). Out of descriptors, the
+// accept loop sheds the waiting callers at once and does not spin (the
 // listener runs in a child process whose descriptor limit is set just above
-// what it holds, so that each further connection meets EMFILE.
+// what it holds, so that each further connection meets EMFILE). Beyond the
+// connection limits, per user and in total, connections are closed at once.
 #include "bsls/service/unix_listener.h"
 
+#include <grp.h>
+#include <grpcpp/create_channel.h>
 #include <grpcpp/server.h>
 #include <grpcpp/server_builder.h>
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
@@ -15,6 +19,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +28,7 @@
 #include <thread>
 #include <vector>
 
+#include "bsls/testing/raw_connections.h"
 #include "bsls/v1/capture.grpc.pb.h"
 
 namespace bsls::service {
@@ -38,19 +44,6 @@ double CpuSeconds(pid_t pid) {
   for (int i = 3; i <= 15 && fields >> field; ++i)
     if (i == 14 || i == 15) ticks += std::stol(field);  // utime, stime
   return static_cast<double>(ticks) / static_cast<double>(::sysconf(_SC_CLK_TCK));
-}
-
-// A connected client socket to `path`, or -1.
-int Connect(const std::string& path) {
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
-  if (::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
-    ::close(fd);
-    return -1;
-  }
-  return fd;
 }
 
 // Descriptors open in this process.
@@ -101,7 +94,7 @@ TEST(UnixListener, OutOfDescriptorsItShedsCallersAndDoesNotSpin) {
   // Far more callers than the child has descriptors for.
   std::vector<int> clients;
   for (int i = 0; i < 40; ++i) {
-    const int fd = Connect(path);
+    const int fd = testing::ConnectUnixAs(0, path);
     if (fd >= 0) clients.push_back(fd);
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
@@ -140,7 +133,7 @@ TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
   auto second = UnixListener::Create({path, 0600});
   ASSERT_FALSE(second.ok());
   EXPECT_EQ(second.status().code(), framestore::ErrorCode::kAlreadyExists);
-  const int client = Connect(path);
+  const int client = testing::ConnectUnixAs(0, path);
   EXPECT_GE(client, 0) << "the first listener's socket was taken";
   if (client >= 0) ::close(client);
   first->reset();  // closed without Start/Stop: the file stays, stale
@@ -149,6 +142,96 @@ TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
   EXPECT_TRUE(third.ok()) << third.status().message();
   third->reset();
   std::filesystem::remove(path);
+}
+
+// The limits on connections open at once (issue 26): one user beyond its
+// share and everybody beyond the total are closed at once, while others are
+// still served. The listener runs in a child process (gRPC is not used in
+// this one before it forks the caller of another uid).
+TEST(UnixListener, ConnectionsBeyondTheUsersShareOrTheTotalAreClosedAtOnce) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to connect as other uids";
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("bsls_listener_limits_" + std::to_string(::getpid()) + ".sock"))
+                               .string();
+  std::filesystem::remove(path);
+  int ready[2];
+  ASSERT_EQ(::pipe(ready), 0);
+  const pid_t server_child = ::fork();
+  ASSERT_GE(server_child, 0);
+  if (server_child == 0) {
+    ::close(ready[0]);
+    v1::CaptureDaemon::Service unimplemented;  // answers UNIMPLEMENTED: an answer
+    grpc::ServerBuilder builder;
+    builder.RegisterService(&unimplemented);
+    std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+    UnixListenerOptions options;
+    options.path = path;
+    options.mode = 0666;
+    options.max_connections = 6;
+    options.max_connections_per_user = 3;
+    auto listener = UnixListener::Create(options);
+    if (!server || !listener.ok()) ::_exit(2);
+    PeerRegistry registry;
+    RolePolicy policy;
+    (*listener)->Start(server.get(), &registry, &policy);
+    const char byte = 1;
+    if (::write(ready[1], &byte, 1) != 1) ::_exit(4);
+    for (;;) ::pause();
+  }
+  ::close(ready[1]);
+  char byte = 0;
+  ASSERT_EQ(::read(ready[0], &byte, 1), 1) << "the listener did not start";
+  ::close(ready[0]);
+  std::vector<int> open;
+  auto stop = [&] {
+    for (int fd : open) ::close(fd);
+    ::kill(server_child, SIGKILL);
+    int status = 0;
+    ::waitpid(server_child, &status, 0);
+    std::filesystem::remove(path);
+  };
+
+  // Root takes its share: three stay open, the fourth and fifth are closed.
+  for (int i = 0; i < 3; ++i) open.push_back(testing::ConnectUnixAs(0, path));
+  for (int fd : open)
+    EXPECT_FALSE(testing::ClosedWithin(fd, 300)) << "a connection within the share";
+  for (int i = 0; i < 2; ++i) {
+    const int extra = testing::ConnectUnixAs(0, path);
+    EXPECT_TRUE(testing::ClosedWithin(extra, 2000))
+        << "a connection beyond root's share stayed open";
+    ::close(extra);
+  }
+
+  // Another user is still served meanwhile.
+  const pid_t caller = ::fork();
+  ASSERT_GE(caller, 0);
+  if (caller == 0) {
+    if (::setgroups(0, nullptr) != 0 || ::setgid(60001) != 0 || ::setuid(60001) != 0) ::_exit(3);
+    auto stub = v1::CaptureDaemon::NewStub(
+        grpc::CreateChannel("unix:" + path, grpc::InsecureChannelCredentials()));
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    v1::DeviceStatus reply;
+    const grpc::Status status = stub->GetStatus(&context, {}, &reply);
+    ::_exit(status.error_code() == grpc::StatusCode::UNIMPLEMENTED ? 0 : 10 + status.error_code());
+  }
+  int status = 0;
+  ::waitpid(caller, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0)
+      << "uid 60001 was not answered while root held its share (exit " << WEXITSTATUS(status)
+      << ")";
+  // Its connection goes with it.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+
+  // The total: root's three and uid 60002's three fill it; uid 60003 is refused.
+  for (int i = 0; i < 3; ++i) {
+    open.push_back(testing::ConnectUnixAs(60002, path));
+    EXPECT_FALSE(testing::ClosedWithin(open.back(), 300)) << "uid 60002's connection " << i;
+  }
+  const int beyond = testing::ConnectUnixAs(60003, path);
+  EXPECT_TRUE(testing::ClosedWithin(beyond, 2000)) << "a connection beyond the total stayed open";
+  ::close(beyond);
+  stop();
 }
 
 }  // namespace

@@ -96,7 +96,9 @@ class Bslsd(ServiceProcess):
                       f"  tls_client_ca: {self.pki('ca.pem')}\n"
                       f"roles:\n{roles}"
                       "framestore:\n  simulated_breathing_mm: 0\n"
-                      "slides:\n  backend: simulated\nlog_level: warn\n" + extra)
+                      "slides:\n  backend: simulated\nlog_level: warn\n"
+                      # The test's own account: started as root, bslsd would become `bsls`.
+                      f"user: \"{os.geteuid()}:{os.getegid()}\"\n" + extra)
         self._log = open(os.path.join(self.dir, "bslsd.log"), "w")
         self.process = subprocess.Popen([bslsd, "--config", config], stdout=self._log,
                                         stderr=subprocess.STDOUT)

@@ -182,7 +182,8 @@ CaptureService::CaptureService(CaptureDevice* device, store::CaptureStore* store
       policy_(policy),
       limits_(limits),
       software_version_(std::move(software_version)),
-      processing_(processing) {}
+      processing_(processing),
+      stalled_writes_(limits.stream_write_timeout) {}
 
 void CaptureService::FillCapture(const store::CaptureInfo& info, v1::CaptureInfo* reply) {
   FillInfo(info, reply);
@@ -342,7 +343,8 @@ grpc::Status CaptureService::StreamPreview(grpc::ServerContext* context,
     FillFrame(*frame, true, "", message.mutable_frame());
     message.set_dropped(skipped);
     skipped = 0;
-    if (!writer->Write(message)) break;  // the client went away
+    StalledWrites::Watch watch(stalled_writes_, context, "preview");
+    if (!writer->Write(message)) break;  // the client went away or stopped reading
   }
   return draining_ ? Draining() : grpc::Status::OK;
 }
@@ -499,7 +501,10 @@ grpc::Status CaptureService::GetCaptureResult(grpc::ServerContext* context,
   for (const auto& [name, bytes] : *files) {
     const bool sent = rpc::EmitArtifact(
         name, name.ends_with(".json") ? "application/json" : "application/octet-stream", bytes,
-        [writer](const v1::WorkEvent& event) { return writer->Write(event.artifact()); });
+        [this, context, writer](const v1::WorkEvent& event) {
+          StalledWrites::Watch watch(stalled_writes_, context, "result");
+          return writer->Write(event.artifact());
+        });
     if (!sent) return grpc::Status(grpc::StatusCode::CANCELLED, "the caller went away");
   }
   return grpc::Status::OK;
@@ -627,8 +632,10 @@ grpc::Status CaptureService::WatchEvents(grpc::ServerContext* context,
       *lost.mutable_time() = event->time();
       lost.mutable_error()->set_message(std::to_string(dropped) +
                                         " events were dropped: this watcher read too slowly");
+      StalledWrites::Watch watch(stalled_writes_, context, "events");
       if (!writer->Write(lost)) break;
     }
+    StalledWrites::Watch watch(stalled_writes_, context, "events");
     if (!writer->Write(*event)) break;
   }
   return draining_ ? Draining() : grpc::Status::OK;

@@ -1,20 +1,11 @@
 #include "bsls/service/unix_listener.h"
 
-#include <fcntl.h>
 #include <grpcpp/server.h>
 #include <grpcpp/server_posix.h>
-#include <poll.h>
 #include <pwd.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
-#include <sys/un.h>
-#include <unistd.h>
 
-#include <cerrno>
-#include <cstring>
 #include <vector>
-
-#include "bsls/rpc/unix_socket.h"
 
 namespace bsls::service {
 
@@ -41,12 +32,6 @@ std::size_t PeerRegistry::size() const {
 
 namespace {
 
-// How long the accept loop waits after shedding a connection for want of
-// descriptors (EMFILE, ENFILE), before it accepts again.
-constexpr int kDescriptorBackoffMs = 50;
-
-std::string Errno(const std::string& what) { return what + ": " + std::strerror(errno); }
-
 std::string UserName(uid_t uid) {
   std::vector<char> buffer(16384);
   passwd entry{};
@@ -58,118 +43,50 @@ std::string UserName(uid_t uid) {
 
 }  // namespace
 
-UnixListener::UnixListener(UnixListenerOptions options, int fd)
-    : options_(std::move(options)), fd_(fd) {}
+UnixListener::UnixListener(std::unique_ptr<rpc::UnixAcceptor> acceptor)
+    : acceptor_(std::move(acceptor)) {}
 
 Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOptions& options) {
-  sockaddr_un address{};
-  address.sun_family = AF_UNIX;
-  if (options.path.empty() || options.path.size() >= sizeof(address.sun_path))
-    return Status(ErrorCode::kInvalidArgument,
-                  "socket path '" + options.path + "' is empty or longer than " +
-                      std::to_string(sizeof(address.sun_path) - 1) + " bytes");
-  std::memcpy(address.sun_path, options.path.c_str(), options.path.size() + 1);
-
-  if (const std::string taken = rpc::ClaimUnixSocketPath(options.path); !taken.empty())
-    return Status(ErrorCode::kAlreadyExists, "socket path: " + taken);
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
-  if (fd < 0) return Status(ErrorCode::kUnavailable, Errno("socket(AF_UNIX)"));
-  // The file is created with the umask applied; permissions are set next,
-  // before anyone is accepted.
-  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
-    Status status(errno == EACCES ? ErrorCode::kPermissionDenied : ErrorCode::kUnavailable,
-                  Errno("bind " + options.path));
-    ::close(fd);
-    return status;
+  rpc::UnixAcceptorOptions socket;
+  socket.path = options.path;
+  socket.mode = options.mode;
+  socket.group = options.group;
+  socket.backlog = options.backlog;
+  socket.max_connections = options.max_connections;
+  socket.max_connections_per_user = options.max_connections_per_user;
+  rpc::UnixAcceptorError error;
+  std::unique_ptr<rpc::UnixAcceptor> acceptor = rpc::UnixAcceptor::Create(socket, &error);
+  if (!acceptor) {
+    switch (error.kind) {
+      case rpc::UnixAcceptorError::Kind::kInvalidPath:
+        return Status(ErrorCode::kInvalidArgument, error.message);
+      case rpc::UnixAcceptorError::Kind::kTaken:
+        return Status(ErrorCode::kAlreadyExists, error.message);
+      case rpc::UnixAcceptorError::Kind::kPermissionDenied:
+        return Status(ErrorCode::kPermissionDenied, error.message);
+      case rpc::UnixAcceptorError::Kind::kSystem:
+        break;
+    }
+    return Status(ErrorCode::kUnavailable, error.message);
   }
-  if (::chmod(options.path.c_str(), options.mode) != 0 ||
-      (options.group &&
-       ::chown(options.path.c_str(), static_cast<uid_t>(-1), *options.group) != 0)) {
-    Status status(ErrorCode::kPermissionDenied, Errno("setting owner/mode of " + options.path));
-    ::close(fd);
-    ::unlink(options.path.c_str());
-    return status;
-  }
-  if (::listen(fd, options.backlog) != 0) {
-    Status status(ErrorCode::kUnavailable, Errno("listen " + options.path));
-    ::close(fd);
-    ::unlink(options.path.c_str());
-    return status;
-  }
-  std::unique_ptr<UnixListener> listener(new UnixListener(options, fd));
-  if (::pipe2(listener->wake_, O_CLOEXEC) != 0)
-    return Status(ErrorCode::kUnavailable, Errno("pipe"));
-  listener->spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-  if (listener->spare_ < 0) return Status(ErrorCode::kUnavailable, Errno("open /dev/null"));
-  return listener;
+  return std::unique_ptr<UnixListener>(new UnixListener(std::move(acceptor)));
 }
 
-UnixListener::~UnixListener() {
-  Stop();
-  if (fd_ >= 0) ::close(fd_);
-  for (int& end : wake_)
-    if (end >= 0) ::close(end);
-  if (spare_ >= 0) ::close(spare_);
-}
+UnixListener::~UnixListener() { Stop(); }
 
 void UnixListener::Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy) {
-  thread_ = std::thread([this, server, registry, policy] { AcceptLoop(server, registry, policy); });
-}
-
-void UnixListener::Stop() {
-  if (thread_.joinable()) {
-    const char byte = 0;
-    [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
-    thread_.join();
-    ::unlink(options_.path.c_str());
-  }
-}
-
-void UnixListener::AcceptLoop(grpc::Server* server, PeerRegistry* registry,
-                              const RolePolicy* policy) {
-  for (;;) {
-    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
-      if (errno == EINTR) continue;
-      return;
-    }
-    if (fds[1].revents != 0) return;
-    const int connection = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-    if (connection < 0) {
-      if (errno == EMFILE || errno == ENFILE) {
-        // Out of descriptors: the waiting connection would keep poll awake
-        // and this loop spinning. Shed it through the spare descriptor,
-        // then wait a moment (or for Stop).
-        if (spare_ >= 0) {
-          ::close(spare_);
-          const int shed = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
-          if (shed >= 0) {
-            ::close(shed);
-            ++shed_;
-          }
-          spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-        }
-        pollfd wake = {wake_[0], POLLIN, 0};
-        if (::poll(&wake, 1, kDescriptorBackoffMs) > 0) return;
-      }
-      continue;  // EAGAIN, ECONNABORTED: try the next one
-    }
-    ucred credentials{};
-    socklen_t length = sizeof(credentials);
-    if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &credentials, &length) != 0) {
-      ::close(connection);
-      continue;
-    }
+  acceptor_->Start([server, registry, policy](int fd, const ucred& peer) {
     Caller caller;
-    caller.uid = credentials.uid;
-    caller.name = UserName(credentials.uid);
+    caller.uid = peer.uid;
+    caller.name = UserName(peer.uid);
     caller.transport = "unix";
-    caller.role = policy->RoleOfUid(credentials.uid);
+    caller.role = policy->RoleOfUid(peer.uid);
     // gRPC names the connection after the descriptor it is given.
-    registry->Add("fd:" + std::to_string(connection), std::move(caller));
-    ++accepted_;
-    grpc::AddInsecureChannelFromFd(server, connection);
-  }
+    registry->Add("fd:" + std::to_string(fd), std::move(caller));
+    grpc::AddInsecureChannelFromFd(server, fd);
+  });
 }
+
+void UnixListener::Stop() { acceptor_->Stop(); }
 
 }  // namespace bsls::service

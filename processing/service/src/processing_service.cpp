@@ -1,6 +1,5 @@
 #include "bsls/processing/processing_service.h"
 
-#include <malloc.h>
 #include <spdlog/spdlog.h>
 #include <stdlib.h>
 #include <yaml-cpp/yaml.h>
@@ -23,6 +22,7 @@
 #include "bsls/measurement/measurement_error.h"
 #include "bsls/rpc/artifacts.h"
 #include "bsls/rpc/frame_message.h"
+#include "bsls/rpc/server_limits.h"
 #include "bsls/session/session.h"
 
 namespace bsls::processing {
@@ -340,7 +340,7 @@ Status ProcessingService::RunWork(grpc::ServerContext* context, const std::strin
   struct TrimOnExit {
     bool admitted;
     ~TrimOnExit() {
-      if (admitted) ::malloc_trim(0);
+      if (admitted) rpc::ReturnFreedMemory();
     }
   } trim{ticket.has_value()};
   if (!ticket) {

@@ -20,6 +20,7 @@
 #include "bsls/service/event_hub.h"
 #include "bsls/service/processing_queue.h"
 #include "bsls/service/roles.h"
+#include "bsls/service/stalled_writes.h"
 #include "bsls/service/unix_listener.h"
 #include "bsls/slides/slide_controller.h"
 #include "bsls/store/capture_store.h"
@@ -35,6 +36,10 @@ struct ServiceLimits {
   std::chrono::milliseconds default_deadline{10000};
   // Longest deadline honoured for a grab or slide change.
   std::chrono::milliseconds max_deadline{60000};
+  // A stream message (preview frame, event, result chunk) that the caller
+  // does not take within this ends its stream with RESOURCE_EXHAUSTED: a
+  // reader that reads nothing gives back its slot.
+  std::chrono::milliseconds stream_write_timeout{10000};
 };
 
 // The grpc::StatusCode of a layer error code.
@@ -112,6 +117,7 @@ class CaptureService final : public v1::CaptureDaemon::Service {
   std::atomic<int> preview_streams_{0};
   std::atomic<int> event_streams_{0};
   std::atomic<std::uint64_t> grabs_acknowledged_{0};
+  StalledWrites stalled_writes_;  // last: its thread stops first
 };
 
 }  // namespace bsls::service

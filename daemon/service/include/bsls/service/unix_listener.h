@@ -1,8 +1,9 @@
 // The Unix-socket front door of bslsd. gRPC C++ does not expose the peer's
-// credentials, so the daemon accepts local connections itself: it reads the
-// peer's uid with SO_PEERCRED, maps it to a role, remembers the caller under
-// the connection's gRPC peer name ("fd:<n>") and only then hands the socket
-// to the gRPC server (grpc::AddInsecureChannelFromFd).
+// credentials, so the daemon accepts local connections itself
+// (rpc::UnixAcceptor, which also limits them): it reads the peer's uid with
+// SO_PEERCRED, maps it to a role, remembers the caller under the
+// connection's gRPC peer name ("fd:<n>") and only then hands the socket to
+// the gRPC server (grpc::AddInsecureChannelFromFd).
 //
 // A connection's file descriptor stays open until gRPC has finished every
 // call on it (the transport owns the endpoint, each call holds the
@@ -16,15 +17,14 @@
 
 #include <sys/types.h>
 
-#include <atomic>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
-#include <thread>
 
 #include "bsls/framestore/status.h"
+#include "bsls/rpc/unix_acceptor.h"
 #include "bsls/service/roles.h"
 
 namespace grpc {
@@ -48,14 +48,22 @@ class PeerRegistry {
   std::map<std::string, Caller> callers_;
 };
 
-// Where and how the socket is created.
+// Where and how the socket is created, and the limits on its connections.
 struct UnixListenerOptions {
   std::string path;           // socket path; its directory must exist
   mode_t mode = 0660;         // permissions of the socket file
   std::optional<gid_t> group; // owning group of the socket file (else the daemon's)
   int backlog = 64;
+  // Connections open at once (handed to gRPC and not yet closed by it), in
+  // all and per peer uid; a connection beyond either is closed as soon as
+  // it is accepted, so that one user cannot take every descriptor.
+  int max_connections = 128;
+  int max_connections_per_user = 32;
 };
 
+// bslsd's front door: rpc::UnixAcceptor (limits, descriptor exhaustion,
+// one instance per socket) with each caller recorded before gRPC gets the
+// connection.
 class UnixListener {
  public:
   // Binds and listens on options.path (a stale socket file left by a dead
@@ -70,29 +78,25 @@ class UnixListener {
   // outlive Stop().
   void Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
   // Stops accepting (connections already handed over stay with gRPC) and
-  // removes the socket file.
+  // removes the socket file if it still is the one Create made.
   void Stop();
   // The socket path.
-  const std::string& path() const { return options_.path; }
+  const std::string& path() const { return acceptor_->path(); }
   // Connections accepted so far.
-  std::uint64_t accepted() const { return accepted_; }
+  std::uint64_t accepted() const { return acceptor_->accepted(); }
   // Connections shed because the process had no descriptor left for them
   // (EMFILE, ENFILE): each is accepted on a descriptor kept spare for this
   // and closed at once, so that its caller hears at once, and the loop
   // waits a moment before it accepts again instead of spinning.
-  std::uint64_t shed() const { return shed_; }
+  std::uint64_t shed() const { return acceptor_->shed(); }
+  // Connections closed at once because their user or everyone together had
+  // as many open as allowed (options.max_connections*).
+  std::uint64_t refused() const { return acceptor_->refused(); }
 
  private:
-  UnixListener(UnixListenerOptions options, int fd);
-  void AcceptLoop(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
+  explicit UnixListener(std::unique_ptr<rpc::UnixAcceptor> acceptor);
 
-  UnixListenerOptions options_;
-  int fd_ = -1;
-  int wake_[2] = {-1, -1};  // a pipe that wakes the accept loop to stop
-  int spare_ = -1;          // /dev/null, given up to shed a connection at EMFILE
-  std::thread thread_;
-  std::atomic<std::uint64_t> accepted_{0};
-  std::atomic<std::uint64_t> shed_{0};
+  std::unique_ptr<rpc::UnixAcceptor> acceptor_;
 };
 
 }  // namespace bsls::service

@@ -1,0 +1,73 @@
+// What both services (bslsd, bsls-processd) do the same way to stay within
+// bounds whatever their callers send (issue 26): HTTP/2 keep-alive, ping and
+// stream limits set on the gRPC server through channel arguments, read from
+// the same configuration keys under `listen:`, and the allocator discipline
+// that gives memory back after a burst of requests or a flood.
+//
+// Thread-safety: ReadHttp2Limits, DumpHttp2Limits and ApplyHttp2Limits are
+// pure; TuneAllocator is called once, from main, before any thread starts;
+// ReturnFreedMemory is safe from any thread.
+#ifndef BSLS_RPC_SERVER_LIMITS_H_
+#define BSLS_RPC_SERVER_LIMITS_H_
+
+#include <yaml-cpp/yaml.h>
+
+#include <set>
+#include <string>
+
+namespace grpc {
+class ServerBuilder;
+}
+
+namespace bsls::rpc {
+
+// The HTTP/2 limits of one server, per connection. Times in milliseconds.
+struct Http2Limits {
+  // The server pings a connection that sent nothing for this long...
+  int keepalive_time_ms = 60000;
+  // ...and closes it when the ping is not answered within this.
+  int keepalive_timeout_ms = 20000;
+  // A client's pings closer together than this while no data flows count
+  // as strikes (gRPC's own default is 5 minutes; ours allow clients that
+  // keep their connection alive every 10 s)...
+  int min_ping_interval_ms = 10000;
+  // ...and after this many strikes the connection is closed (GOAWAY
+  // ENHANCE_YOUR_CALM): a ping flood costs one connection, not the server.
+  int max_ping_strikes = 2;
+  // A connection without any call for this long is closed (the client
+  // reconnects when it needs to): idle connections do not pile up.
+  int max_connection_idle_ms = 300000;
+  // Calls open at once on one connection; more wait for one to end.
+  int max_concurrent_streams = 100;
+};
+
+// The configuration keys of Http2Limits (for io::OnlyKeys of `listen:`).
+const std::set<std::string>& Http2LimitKeys();
+
+// Reads the keys of Http2Limits present in the map `node` (at `where`, e.g.
+// "listen") into `out`; throws io::ConfigKeyError naming the key when a value
+// has the wrong type or lies outside its range.
+void ReadHttp2Limits(const YAML::Node& node, const std::string& where, Http2Limits& out);
+
+// Writes the keys of `limits` into the open map of `out` (--check-config).
+void DumpHttp2Limits(YAML::Emitter& out, const Http2Limits& limits);
+
+// Sets `limits` on `builder` as gRPC channel arguments (keep-alive, ping
+// strikes, idle connections, concurrent streams).
+void ApplyHttp2Limits(const Http2Limits& limits, grpc::ServerBuilder& builder);
+
+// Sets glibc's allocator for a long-running server: blocks of 256 KiB and
+// more (frames, meshes, artifacts) are mapped and unmapped on their own
+// instead of growing the heaps, and two arenas instead of one per core and
+// thread keep freed blocks from piling up in idle ones. Call once from main
+// before any thread starts.
+void TuneAllocator();
+
+// Hands freed heap memory back to the system (malloc_trim): called after
+// work and periodically, so resident memory returns to its level after a
+// burst or a flood.
+void ReturnFreedMemory();
+
+}  // namespace bsls::rpc
+
+#endif  // BSLS_RPC_SERVER_LIMITS_H_

@@ -1,0 +1,119 @@
+// The Unix-socket front door of both services (bslsd, bsls-processd): the
+// service accepts its local connections itself and hands each to its gRPC
+// server (grpc::AddInsecureChannelFromFd), so that what gRPC does not do is
+// done before: the peer's credentials (SO_PEERCRED) for bslsd's roles, and
+// limits no caller can get around (issue 26):
+//  - connections open at once, in all and per peer uid; one beyond either
+//    is closed as soon as it is accepted (gRPC 1.51 has no such limit);
+//  - out of descriptors (EMFILE, ENFILE), the waiting caller is shed
+//    through a descriptor kept spare for it and the loop waits a moment
+//    instead of spinning;
+//  - one live instance per socket (rpc::ClaimUnixSocketPath), and the
+//    socket file is removed on Stop only while it is the one made here.
+// gRPC closes a connection without telling: the acceptor recognises a
+// handed-over descriptor by its socket's inode and forgets those that no
+// longer are that socket.
+//
+// Thread-safety: Create, Start and Stop from one thread; the counters from
+// any thread. The hand-over function runs on the accept thread.
+#ifndef BSLS_RPC_UNIX_ACCEPTOR_H_
+#define BSLS_RPC_UNIX_ACCEPTOR_H_
+
+#include <sys/socket.h>
+#include <sys/types.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+
+namespace bsls::rpc {
+
+// Where and how the socket is made, and the limits on its connections.
+struct UnixAcceptorOptions {
+  std::string path;            // socket path; its directory must exist
+  mode_t mode = 0660;          // permissions of the socket file
+  std::optional<gid_t> group;  // owning group of the socket file (else the process's)
+  int backlog = 64;
+  int max_connections = 128;          // open at once, in all
+  int max_connections_per_user = 32;  // open at once, per peer uid
+};
+
+// Why a socket could not be made.
+struct UnixAcceptorError {
+  enum class Kind { kInvalidPath, kTaken, kPermissionDenied, kSystem };
+  Kind kind = Kind::kSystem;
+  std::string message;  // names the path and the reason
+};
+
+class UnixAcceptor {
+ public:
+  // Takes a connection (the descriptor is its own from then on) and the
+  // peer's credentials.
+  using HandOver = std::function<void(int fd, const ucred& peer)>;
+
+  // Binds and listens on options.path with its mode and group (a stale
+  // socket file left by a dead server is replaced; a live one is kTaken).
+  // nullptr with `error` filled when it cannot.
+  static std::unique_ptr<UnixAcceptor> Create(const UnixAcceptorOptions& options,
+                                              UnixAcceptorError* error);
+  // Stops (see Stop) and closes the socket.
+  ~UnixAcceptor();
+  UnixAcceptor(const UnixAcceptor&) = delete;
+  UnixAcceptor& operator=(const UnixAcceptor&) = delete;
+
+  // Starts accepting on a thread of its own; each connection within the
+  // limits goes to `hand_over`.
+  void Start(HandOver hand_over);
+  // Stops accepting (connections already handed over stay) and removes the
+  // socket file if it still is the one Create made.
+  void Stop();
+
+  // The socket path.
+  const std::string& path() const { return options_.path; }
+  // Connections handed over so far.
+  std::uint64_t accepted() const { return accepted_; }
+  // Connections shed for want of descriptors (EMFILE, ENFILE).
+  std::uint64_t shed() const { return shed_; }
+  // Connections closed at once because their user or everyone together had
+  // as many open as allowed.
+  std::uint64_t refused() const { return refused_; }
+
+ private:
+  // A connection handed over: its socket's inode and its peer's uid.
+  struct Handed {
+    ino_t inode;
+    uid_t uid;
+  };
+
+  UnixAcceptor(UnixAcceptorOptions options, int fd);
+  void AcceptLoop(const HandOver& hand_over);
+  // Forgets the connections closed since (accept thread only).
+  void ForgetClosed();
+  // Why one more connection of `uid` would exceed a limit ("" when it would not).
+  std::string OverLimit(uid_t uid) const;
+  // Logs a refusal, at most once a second with the count since the last line.
+  void LogRefusal(uid_t uid, const std::string& why);
+
+  UnixAcceptorOptions options_;
+  int fd_ = -1;
+  int wake_[2] = {-1, -1};  // a pipe that wakes the accept loop to stop
+  int spare_ = -1;          // /dev/null, given up to shed a connection at EMFILE
+  std::optional<std::pair<dev_t, ino_t>> socket_file_;  // the file Create made
+  std::thread thread_;
+  std::atomic<std::uint64_t> accepted_{0};
+  std::atomic<std::uint64_t> shed_{0};
+  std::atomic<std::uint64_t> refused_{0};
+  std::map<int, Handed> handed_;  // by descriptor; accept thread only
+  std::uint64_t refused_unlogged_ = 0;
+  std::chrono::steady_clock::time_point last_refusal_log_{};
+};
+
+}  // namespace bsls::rpc
+
+#endif  // BSLS_RPC_UNIX_ACCEPTOR_H_

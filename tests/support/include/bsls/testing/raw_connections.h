@@ -1,0 +1,58 @@
+// Raw connections to a service's Unix socket for the connection-limit tests
+// (issue 26): made as another effective uid (SO_PEERCRED gives the server
+// the euid of the connecting process), and whether the server closes one
+// at once (header only).
+#ifndef BSLS_TESTING_RAW_CONNECTIONS_H_
+#define BSLS_TESTING_RAW_CONNECTIONS_H_
+
+#include <poll.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+
+namespace bsls::testing {
+
+// A connection to the Unix socket at `path` made with effective uid `uid`
+// (0: as this process), or -1. Switching the euid needs root; the test
+// aborts if it cannot switch back.
+inline int ConnectUnixAs(uid_t uid, const std::string& path) {
+  if (uid != 0 && ::seteuid(uid) != 0) return -1;
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
+  const bool connected =
+      fd >= 0 && ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
+  if (uid != 0 && ::seteuid(0) != 0) std::abort();  // the test cannot go on as another user
+  if (!connected) {
+    if (fd >= 0) ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// True when the server closes `fd` (end of file or a reset) within `ms`;
+// what it sends meanwhile (its HTTP/2 settings) is read and dropped.
+inline bool ClosedWithin(int fd, int ms) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+        until - std::chrono::steady_clock::now());
+    if (left.count() <= 0) return false;
+    pollfd wait{fd, POLLIN, 0};
+    if (::poll(&wait, 1, static_cast<int>(left.count())) <= 0) continue;
+    char buffer[256];
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
+    if (n == 0 || (n < 0 && errno == ECONNRESET)) return true;
+  }
+}
+
+}  // namespace bsls::testing
+
+#endif  // BSLS_TESTING_RAW_CONNECTIONS_H_
