@@ -28,7 +28,6 @@ namespace fs = std::filesystem;
 
 // Bytes that are no message of any type: field 1, length-delimited, with a
 // length of 4 GiB that does not follow.
-constexpr char kNotAMessage[] = "\x0a\xff\xff\xff\xff\x0f";
 
 class ProcessdServer : public ::testing::Test {
  protected:
@@ -108,20 +107,7 @@ TEST_F(ProcessdServer, AMalformedRequestIsInvalidArgumentWithAMessage) {
       google::protobuf::DescriptorPool::generated_pool()->FindServiceByName(
           v1::Processing::service_full_name());
   ASSERT_NE(service, nullptr);
-  int tried = 0;
-  for (int i = 0; i < service->method_count(); ++i) {
-    const google::protobuf::MethodDescriptor* method = service->method(i);
-    if (method->client_streaming()) continue;  // a bad message ends the stream's reads
-    processing::test::RawCall call;
-    call.method = "/" + service->full_name() + "/" + method->name();
-    call.messages = {std::string(kNotAMessage, sizeof kNotAMessage - 1)};
-    call.deadline_ms = 10000;
-    const processing::test::RawOutcome outcome = processing::test::SendRaw(stub, call);
-    EXPECT_EQ(outcome.code, grpc::StatusCode::INVALID_ARGUMENT) << call.method;
-    EXPECT_NE(outcome.message.find(method->input_type()->full_name()), std::string::npos)
-        << call.method << ": " << outcome.message;
-    ++tried;
-  }
+  const int tried = processing::test::ExpectMalformedRequestsRefused(stub, *service);
   EXPECT_GE(tried, 6);
   v1::ServerInfo info;
   EXPECT_TRUE(Info(channel, &info).ok());

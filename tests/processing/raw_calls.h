@@ -11,6 +11,7 @@
 #include <google/protobuf/message.h>
 #include <grpcpp/generic/generic_stub.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
@@ -119,6 +120,32 @@ inline RawOutcome SendRaw(grpc::GenericStub& stub, const RawCall& call) {
   out.message = status.error_message();
   out.seconds = std::chrono::duration<double>(SystemClock::now() - start).count();
   return out;
+}
+
+// Bytes that no request message parses from.
+inline constexpr char kNotAMessage[] = "\x0a\xff\xff\xff\xff\x0f";
+
+// Sends kNotAMessage to every method of `service` that takes one request
+// and expects each refused with INVALID_ARGUMENT naming the request type
+// (in a request stream a malformed message reads as the stream's end, so
+// those are left out); returns how many methods were tried.
+inline int ExpectMalformedRequestsRefused(grpc::GenericStub& stub,
+                                          const pb::ServiceDescriptor& service) {
+  int tried = 0;
+  for (int i = 0; i < service.method_count(); ++i) {
+    const pb::MethodDescriptor* method = service.method(i);
+    if (method->client_streaming()) continue;
+    RawCall call;
+    call.method = "/" + service.full_name() + "/" + method->name();
+    call.messages = {std::string(kNotAMessage, sizeof kNotAMessage - 1)};
+    call.deadline_ms = 10000;
+    const RawOutcome outcome = SendRaw(stub, call);
+    EXPECT_EQ(outcome.code, grpc::StatusCode::INVALID_ARGUMENT) << call.method;
+    EXPECT_NE(outcome.message.find(method->input_type()->full_name()), std::string::npos)
+        << call.method << ": " << outcome.message;
+    ++tried;
+  }
+  return tried;
 }
 
 // A uniform pick in [0, n).
