@@ -16,8 +16,10 @@
 #include <vector>
 
 #include "bsls/processing/processing_client.h"
+#include "bsls/rpc/frame_message.h"
 #include "bsls/testing/certificates.h"
 #include "bsls/testing/raw_connections.h"
+#include "hostile_frame.h"
 #include "raw_calls.h"
 #include "server.h"
 
@@ -68,6 +70,50 @@ TEST_F(ProcessdServer, ServesTheUnixSocketAndPlainLoopback) {
   }
   server->Drain();
   EXPECT_FALSE(fs::exists(config.listen.unix_socket));
+}
+
+// Issue 26: draining stops work under way inside its stages: two calls
+// decoding frames that keep every stage busy end (UNAVAILABLE) and the
+// drain returns well before their decodes would have ended.
+TEST_F(ProcessdServer, DrainStopsWorkInsideItsStages) {
+  Config config;
+  config.listen.unix_socket = (dir_ / "processd.sock").string();
+  config.workers = 2;
+  auto server = Server::Start(config, "test");
+  processing::ClientOptions options;
+  options.target = "unix:" + config.listen.unix_socket;
+  options.timeout = std::chrono::minutes(5);
+  v1::ProcessFrameRequest request;
+  rpc::ToFrameMessage(processing::test::HostileFrame(), request.mutable_frame());
+  request.set_side(v1::SIDE_LEFT);
+  auto start = std::chrono::steady_clock::now();
+  {
+    processing::ProcessingClient client(processing::OpenProcessingChannel(options), options);
+    (void)client.ProcessFrame(request);
+  }
+  const auto whole = std::chrono::steady_clock::now() - start;
+
+  std::vector<grpc::Status> statuses(2);
+  std::vector<std::thread> callers;
+  for (grpc::Status& status : statuses)
+    callers.emplace_back([&] {
+      processing::ProcessingClient client(processing::OpenProcessingChannel(options), options);
+      status = client.ProcessFrame(request).status;
+    });
+  while (server->service().Stats().busy < 2 &&
+         std::chrono::steady_clock::now() - start < whole * 10)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  ASSERT_EQ(server->service().Stats().busy, 2);
+  start = std::chrono::steady_clock::now();
+  server->Drain();
+  const auto drained = std::chrono::steady_clock::now() - start;
+  for (std::thread& t : callers) t.join();
+  for (const grpc::Status& status : statuses)
+    EXPECT_FALSE(status.ok()) << "a call went on to its end while the service drained";
+  EXPECT_EQ(server->service().Stats().busy, 0);
+  EXPECT_LT(drained, whole / 2) << "decode " << std::chrono::duration<double>(whole).count()
+                                << " s, drain " << std::chrono::duration<double>(drained).count()
+                                << " s";
 }
 
 // Issue 26: the HTTP/2 limits reach the server: a connection without calls

@@ -14,6 +14,7 @@
 #include "bsls/decoder/decoder.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/simulator/calibration_session.h"
+#include "hostile_frame.h"
 #include "service_fixture.h"
 
 namespace bsls::processing::test {
@@ -420,22 +421,10 @@ TEST(ProcessingService, ACallPastItsDeadlineStops) {
   EXPECT_EQ(s.service().Stats().busy, 0);
 }
 
-// A frame that keeps every stage of the decoder busy: 2896 x 2896 (8 Mpx,
-// the default budget), every other row the stripes, the rest noise.
-v1::Frame HostileFrame() {
-  cv::Mat grey(2896, 2896, CV_8UC1);
-  cv::RNG rng(7);
-  rng.fill(grey, cv::RNG::UNIFORM, 0, 256);
-  for (int y = 0; y < grey.rows; y += 2)
-    for (int x = 0; x < grey.cols; ++x)
-      grey.at<uchar>(y, x) = cv::saturate_cast<uchar>(128 + 100 * std::cos(2 * CV_PI * x / 15));
-  return FrameMessage(grey);
-}
-
 TEST(ProcessingService, ADeadlineFreesTheWorkerInsideTheDecode) {
   InProcessService s;
   v1::ProcessFrameRequest request;
-  *request.mutable_frame() = HostileFrame();
+  *request.mutable_frame() = FrameMessage(HostileFrame());
   request.set_side(v1::SIDE_LEFT);
   // How long the whole decode takes here (no deadline).
   auto start = std::chrono::steady_clock::now();
