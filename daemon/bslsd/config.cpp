@@ -116,12 +116,7 @@ void ParseListen(const YAML::Node& node, ListenConfig& out) {
     }
     if (used != text.size() || mode < 0 || mode > 0777)
       Fail("listen.socket_mode", "'" + text + "' is not an octal mode 000..777");
-    if (mode & 0002)
-      Fail("listen.socket_mode",
-           "'" + text +
-               "' lets every local user connect (world-writable); give the callers a group "
-               "(listen.socket_group) and a mode such as 0660");
-    out.socket_mode = mode;
+    out.socket_mode = mode;  // a world-writable one is refused by Validate
   }
   ReadInRange(node, "listen", "max_connections", out.max_connections, 1, 65536);
   ReadInRange(node, "listen", "max_connections_per_user", out.max_connections_per_user, 1, 65536);
@@ -290,8 +285,13 @@ Status Validate(const Config& config) {
   };
   std::string error;
   if (!config.store.IsValid(&error)) return fail("store: " + error);
-  if (config.listen.socket_mode & 0002)
-    return fail("listen.socket_mode: a world-writable mode lets every local user connect");
+  if (config.listen.socket_mode & 0002) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", config.listen.socket_mode);
+    return fail(std::string("listen.socket_mode: '") + mode +
+                "' lets every local user connect (world-writable); give the callers a group "
+                "(listen.socket_group) and a mode such as 0660");
+  }
   if (config.listen.max_connections_per_user > config.listen.max_connections)
     return fail("listen.max_connections_per_user is above listen.max_connections");
   if (config.listen.unix_socket.empty() && config.listen.tcp.empty())
