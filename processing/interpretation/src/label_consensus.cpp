@@ -171,17 +171,18 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
     int to;
     Label d;  // label change towards `to`
     bool smooth;
+    bool abrupt;
   };
   std::vector<std::vector<Arc>> adj(n);
   for (const ConsensusLink& l : links) {
-    adj[l.a].push_back({l.b, {l.dp, l.dv}, l.smooth});
-    adj[l.b].push_back({l.a, {-l.dp, -l.dv}, l.smooth});
+    adj[l.a].push_back({l.b, {l.dp, l.dv}, l.smooth, l.abrupt});
+    adj[l.b].push_back({l.a, {-l.dp, -l.dv}, l.smooth, l.abrupt});
   }
   auto lone = [&](int j) { return !(*labelled)[j] && patch_size[patch_of[j]] == 1; };
   // What the labelled neighbours of lone junction m agree on for m itself.
   auto own_label = [&](int m) -> std::optional<Label> {
     std::optional<Label> agreed;
-    for (const auto& [k, d, smooth] : adj[m]) {
+    for (const auto& [k, d, smooth, abrupt] : adj[m]) {
       if (!(*labelled)[k]) continue;
       const Label here = (*label)[k] - d;
       if (agreed && !(*agreed == here)) return std::nullopt;
@@ -198,14 +199,16 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
       votes.clear();
       int total = 0;
       bool smooth_vote = false;
-      for (const auto& [k, d, smooth] : adj[j]) {
+      for (const auto& [k, d, smooth, abrupt] : adj[j]) {
         std::optional<Label> via;
         if ((*labelled)[k]) via = (*label)[k];
         else if (lone(k)) via = own_label(k);
         if (!via) continue;
-        ++votes[*via - d];
-        ++total;
-        smooth_vote = smooth_vote || (smooth && (*labelled)[k]);
+        // In half votes: a link whose ends' pitch differs abruptly is half a vote.
+        const int weight = abrupt ? 1 : 2;
+        votes[*via - d] += weight;
+        total += weight;
+        smooth_vote = smooth_vote || (smooth && !abrupt && (*labelled)[k]);
       }
       int best = 0;
       Label best_label{};
@@ -214,8 +217,8 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
           best = count;
           best_label = l;
         }
-      if ((best >= params.min_support && total - best <= params.max_dissent * best) ||
-          (best == 1 && total == 1 && smooth_vote))
+      if ((best >= 2 * params.min_support && total - best <= params.max_dissent * best) ||
+          (best == 2 && total == 2 && smooth_vote))
         found.emplace_back(j, best_label);
     }
     for (const auto& [j, l] : found) {
@@ -302,6 +305,7 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
   struct Evidence {
     int x, y;
     Label h;
+    int w;  // half votes
   };
   std::vector<Evidence> evidence;
   for (bool joined = true; joined;) {
@@ -309,6 +313,9 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
     evidence.clear();
     for (size_t k = 0; k < links.size(); ++k) {
       if (trusted[k]) continue;
+      // In half votes: a step across a break in a line (its rows counted
+      // over the gap, where an occluding edge may shift them) is half a vote.
+      const int w = links[k].gap ? 1 : 2;
       const ConsensusLink& l = links[k];
       auto [ca, la] = label_of(l.a);
       auto [cb, lb] = label_of(l.b);
@@ -319,7 +326,7 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
         std::swap(ca, cb);
         h = Label{} - h;
       }
-      evidence.push_back({ca, cb, h});
+      evidence.push_back({ca, cb, h, w});
     }
     std::sort(evidence.begin(), evidence.end(), [](const Evidence& a, const Evidence& b) {
       return std::tie(a.x, a.y, a.h) < std::tie(b.x, b.y, b.h);
@@ -336,10 +343,10 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
       while (end < evidence.size() && evidence[end].x == evidence[i].x &&
              evidence[end].y == evidence[i].y) {
         size_t run = end;
+        int count = 0;
         while (run < evidence.size() && evidence[run].x == evidence[end].x &&
                evidence[run].y == evidence[end].y && evidence[run].h == evidence[end].h)
-          ++run;
-        const int count = static_cast<int>(run - end);
+          count += evidence[run++].w;
         total += count;
         // A shift that changes the parity of p + v is impossible: dissent.
         if (!OddSum(evidence[end].h) && count > best) {
@@ -349,7 +356,7 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
         end = run;
       }
       const int dissent = total - best;
-      if (best >= params.min_support && dissent <= params.max_dissent * best)
+      if (best >= 2 * params.min_support && dissent <= params.max_dissent * best)
         candidates.push_back({best, evidence[i].x, evidence[i].y, best_h});
       i = end;
     }

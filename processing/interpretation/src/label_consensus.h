@@ -36,6 +36,13 @@ struct ConsensusLink {
   // A step along a line whose row spacing the step before or after it on
   // the same unbroken line repeats: alone, enough for a lone junction.
   bool smooth = false;
+  // The line pitch at its two ends differs beyond what a smooth surface
+  // gives, and one end's lines crowd (a grazing surface, an occluding
+  // edge): half a vote for a lone junction.
+  bool abrupt = false;
+  // A step across a break in its line (rows counted over the gap): half a
+  // vote for joining two components.
+  bool gap = false;
 };
 
 struct ConsensusParams {

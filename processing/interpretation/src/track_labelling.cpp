@@ -28,6 +28,8 @@ struct Link {
 
 constexpr double kSmoothSpread = 1.2;   // a smooth step's row spacing against its neighbour's
 constexpr double kPitchSpread = 1.4;    // and the pitch beside its two ends
+constexpr double kAbruptPitchSpread = 1.7;  // pitch at a link's two ends beyond this: abrupt
+constexpr double kCrowded = 0.55;  // lines closer than this times the frame's pitch crowd
 constexpr double kOwnLine = 2.0;        // px: ridge points this close to a junction are its line's
 constexpr double kSpacingSpread = 1.6;  // a line's own row spacing lies within this factor
                                         // of the frame's
@@ -269,15 +271,6 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   }
   std::vector<std::vector<Link>> adj(n);
   std::vector<ConsensusLink> links;
-  auto link = [&](int a, int b, int dp, int dv, bool trusted, bool smooth = false) {
-    adj[a].push_back({b, dp, dv});
-    adj[b].push_back({a, -dp, -dv});
-    links.push_back({a, b, dp, dv, trusted, smooth});
-  };
-  // A step is smooth where the step before or after it on its track has a
-  // row spacing within kSmoothSpread of its own, and the lines beside its
-  // two ends lie as far apart within kPitchSpread (an occluding edge
-  // crossed by the track changes the spacing or the pitch).
   auto pitch_at = [&](int j) {  // px to the nearest other line in j's row, or 0
     const cv::Point2d at = net.junctions[j].position;
     const auto row = net.rows.Row(static_cast<int>(std::lround(at.y)));
@@ -295,6 +288,28 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   std::vector<double> pitch(n);
   for (int j = 0; j < n; ++j) pitch[j] = pitch_at(j);
   auto within = [](double a, double b, double spread) { return a > b / spread && a < b * spread; };
+  // A link is abrupt where the line pitch at its two ends differs beyond
+  // what a smooth surface gives and one end's lines crowd (a grazing
+  // surface, an occluding edge beside it).
+  std::vector<double> measured;
+  for (double v : pitch)
+    if (v > 0) measured.push_back(v);
+  const double frame_pitch = measured.empty() ? 0.0 : Median(measured);
+  auto abrupt = [&](int a, int b) {
+    if (!(pitch[a] > 0 && pitch[b] > 0) || within(pitch[a], pitch[b], kAbruptPitchSpread))
+      return false;
+    return std::min(pitch[a], pitch[b]) < kCrowded * frame_pitch;
+  };
+  auto link = [&](int a, int b, int dp, int dv, bool trusted, bool smooth = false,
+                  bool gap = false) {
+    adj[a].push_back({b, dp, dv});
+    adj[b].push_back({a, -dp, -dv});
+    links.push_back({a, b, dp, dv, trusted, smooth, abrupt(a, b), gap});
+  };
+  // A step is smooth where the step before or after it on its track has a
+  // row spacing within kSmoothSpread of its own, and the lines beside its
+  // two ends lie as far apart within kPitchSpread (an occluding edge
+  // crossed by the track changes the spacing or the pitch).
   std::vector<int> up(n, -1);  // the junction whose step down reaches j
   for (int j = 0; j < n; ++j)
     if (down[j].to >= 0) up[down[j].to] = j;
@@ -317,7 +332,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // first below, a whole number of rows apart at the line's spacing.
   auto gap_step = [&](int a, int b) {
     if (const auto rows = rows_between(a, b, spacing_of(net.junctions[a].line)))
-      link(a, b, 0, *rows, false);
+      link(a, b, 0, *rows, false, false, true);
   };
   for (size_t t = 0; t < net.lines.size(); ++t) {
     const int b = net.line_below[t];

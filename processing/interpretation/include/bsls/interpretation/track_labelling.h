@@ -50,7 +50,7 @@ struct TrackLabellingParams {
   // A step along a line between junctions must fit a whole number of rows
   // (odd when their kinds alternate, even otherwise) to within this fraction
   // of a row, (0, 0.5]; at most max_rows rows, >= 1.
-  double max_row_miss = 0.45;
+  double max_row_miss = 0.35;
   int max_rows = 8;
   // Spacing samples a line track needs to judge its steps by its own row
   // spacing instead of the frame's, >= 1.
