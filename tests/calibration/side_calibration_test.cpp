@@ -356,6 +356,24 @@ TEST(SideCalibrationDropsAView, ACameraViewWithoutTheTarget) {
   for (const CameraViewReport& v : c.camera_views) EXPECT_GT(v.rms_px, 0.0) << v.image;
 }
 
+// The caller is asked before every view and inside each view's decode: the
+// question after the camera views' and the first screen view's own comes
+// from inside that screen view's decode, and stops the calibration there.
+TEST(SideCalibration, StopsInsideAViewsDecodeWhenAsked) {
+  const Manifest manifest = LeftManifest();
+  const int before_decode = static_cast<int>(manifest.camera_views.size()) + 1;
+  int asked = 0;
+  const Cancellation stop([&] { return ++asked > before_decode; });
+  try {
+    CalibrateSide(manifest, {}, {}, stop);
+    ADD_FAILURE() << "the calibration ran to its end";
+  } catch (const Cancelled& e) {
+    EXPECT_EQ(asked, before_decode + 1);
+    // Not a view's name: a stage of the decode.
+    EXPECT_EQ(std::string(e.what()).find("view"), std::string::npos) << e.what();
+  }
+}
+
 TEST(SideCalibrationDropsAView, AScreenViewThatDoesNotDecode) {
   Manifest manifest = LeftManifest();
   const std::filesystem::path noise = NoiseImage(manifest);

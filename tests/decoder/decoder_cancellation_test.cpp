@@ -22,6 +22,11 @@ struct CountingCancellation {
   }
 };
 
+// Questions a stage may still ask once told to stop: one per band of rows
+// of a 512-row frame running in parallel (bands of 64 rows) and the one that
+// throws.
+constexpr int kMaxBandsAfterStop = 512 / 64 + 1;
+
 class DecoderCancellation : public ::testing::TestWithParam<DecodeChain> {
  protected:
   DecodeParams Params() const {
@@ -52,7 +57,11 @@ TEST_P(DecoderCancellation, EveryStageAsksAndStopsWhenTold) {
       (void)Decode(frame.image, Side::kLeft, Params(), stopping.Token());
       ADD_FAILURE() << "question " << stop_at << " of " << questions << " said stop; no stop";
     } catch (const Cancelled& e) {
-      EXPECT_EQ(stopping.asked, stop_at) << "the decode went on asking after it was told";
+      // Told to stop, a stage ends at once: the bands of rows still running
+      // in parallel (one question each) skip their work, and the next
+      // question throws.
+      EXPECT_LE(stopping.asked - stop_at, kMaxBandsAfterStop)
+          << "the decode went on asking after it was told";
       EXPECT_NE(std::string(e.what()).find("cancelled during"), std::string::npos) << e.what();
     }
   }

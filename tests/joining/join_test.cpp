@@ -232,7 +232,7 @@ void ExpectFailure(const geometry::SurfaceMesh& left, const geometry::SurfaceMes
                    const JoinParams& params, JoinError::Reason reason, const std::string& named) {
   for (auto join : {&JoinSharedFrame, &JoinByFeatures}) {
     try {
-      join(left, right, params);
+      join(left, right, params, Cancellation());
       ADD_FAILURE() << "joined; expected an error naming " << named;
     } catch (const JoinError& error) {
       EXPECT_EQ(error.reason(), reason) << error.what();

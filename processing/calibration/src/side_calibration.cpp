@@ -258,13 +258,14 @@ ProjectorPose PoseOfProjector(const PerspectivePlaneFit& perspective,
 
 // Thesis chapter 6 (6.1 camera, 6.2 projector) for one side of the rig.
 SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params,
-                              const CalibrationProgress& progress) {
+                              const CalibrationProgress& progress, const Cancellation& cancel) {
   const auto start = Clock::now();
   const double total_views = static_cast<double>(
       manifest.camera_views.size() + manifest.screen_views.size() + manifest.reference_views.size());
   int views_begun = 0;
   // Every view is announced before it is read; the caller may stop there.
   auto begin_view = [&](const std::string& name) {
+    cancel.ThrowIfRequested(name);
     if (progress && !progress(name, views_begun / total_views))
       Throw(CalibrationErrorReason::kCancelled, "calibration: stopped before " + name);
     ++views_begun;
@@ -370,7 +371,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
     const std::string name = ViewName(view, ViewKind::kScreen, i);
     begin_view(name);
     const cv::Mat grey = LoadView(view, name, &width, &height);
-    decoder::DecodeResult result = decoder::Decode(grey, manifest.side, decode);
+    decoder::DecodeResult result = decoder::Decode(grey, manifest.side, decode, cancel);
     if (!result.ok) {
       drop(view, ViewKind::kScreen, i, "the brick pattern could not be decoded: " + result.error);
       continue;

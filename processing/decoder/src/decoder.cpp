@@ -730,8 +730,9 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   result.region = region;
   cv::Mat working = internal::BinFrame(grey(region), n);
   if (!working.isContinuous()) working = working.clone();
+  cancel.ThrowIfRequested("the pattern's columns");
   const extraction::ExtractionResult features =
-      extraction::ExtractFeatures(working, params.extraction);
+      extraction::ExtractFeatures(working, params.extraction, cancel);
   result.times.extraction_ms = MsSince(t);
   cancel.ThrowIfRequested("the feature extraction");
 
@@ -758,7 +759,7 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
 
   t = Clock::now();
   interpretation::InterpretationResult interp = interpretation::Interpret(
-      features.skeleton, side, params.spec, params.interpretation, features.mask);
+      features.skeleton, side, params.spec, params.interpretation, features.mask, cancel);
   internal::MapToFullFrame(n, region.tl(), grey.size(), &interp);
   stop_ahead = true;
   if (measuring.valid()) measuring.get();

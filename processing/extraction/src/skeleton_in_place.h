@@ -8,17 +8,20 @@
 
 #include <opencv2/core.hpp>
 
+#include "bsls/common/cancellation.h"
 #include "bsls/extraction/pruning.h"
 #include "bsls/extraction/thinning.h"
 #include "neighbourhood.h"
 
 namespace bsls::extraction::internal {
 
-// ZhangSuenThin (thinning.h) on *img.
-void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params);
+// ZhangSuenThin (thinning.h) on *img; asks `cancel` before every iteration.
+void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params,
+                          const Cancellation& cancel = {});
 
-// MakeOnePixelWide (thinning.h) on *img.
-void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions);
+// MakeOnePixelWide (thinning.h) on *img; asks `cancel` before every sweep.
+void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions,
+                             const Cancellation& cancel = {});
 
 // The grey image (CV_8UC1) smoothed as RecentreOnRidge reads it, CV_32FC1 in a
 // buffer laid out like a PaddedBinary of its size, its frame -infinity: band by

@@ -302,7 +302,8 @@ void SeedRows(const cv::Mat& strength, const cv::Mat& level, const cv::Mat& shap
   }
 }
 
-cv::Mat DetectByHessian(const cv::Mat& grey, const StripeDetectParams& p) {
+cv::Mat DetectByHessian(const cv::Mat& grey, const StripeDetectParams& p,
+                        const Cancellation& cancel) {
   // Band by band in parallel: the ridge strength, the image smoothed for the
   // shape test and the noise samples.
   const std::vector<double> scales = Scales(p);
@@ -315,7 +316,10 @@ cv::Mat DetectByHessian(const cv::Mat& grey, const StripeDetectParams& p) {
   const bool estimate_noise = !(p.noise_sigma > 0.0);
   std::vector<std::vector<float>> noise((grey.rows + internal::kBandRows - 1) /
                                         internal::kBandRows);
+  // Once the caller asks to stop, the bands left skip their work (an
+  // exception must not leave OpenCV's workers) and the stage stops after.
   internal::ForEachBand(grey.rows, [&](int y0, int y1) {
+    if (cancel.Requested()) return;
     RidgeStrengthRows(grey, scales, y0, y1, &strength);
     if (p.level_sigma > 0.0) {
       cv::Mat rows = level_f.rowRange(y0, y1);
@@ -323,6 +327,7 @@ cv::Mat DetectByHessian(const cv::Mat& grey, const StripeDetectParams& p) {
     }
     if (estimate_noise) NoiseSamples(grey, y0, y1, &noise[y0 / internal::kBandRows]);
   });
+  cancel.ThrowIfRequested("the ridge strength");
   double noise_sigma = p.noise_sigma;
   if (estimate_noise) {
     std::vector<float> all;
@@ -354,6 +359,7 @@ cv::Mat DetectByHessian(const cv::Mat& grey, const StripeDetectParams& p) {
   }
   cv::Mat shaped(grey.size(), CV_8UC1), seeds(grey.size(), CV_8UC1);
   internal::ForEachBand(grey.rows, [&](int y0, int y1) {
+    if (cancel.Requested()) return;
     const cv::Mat strength_rows = strength.rowRange(y0, y1);
     cv::Mat level;
     cv::dilate(strength_rows, level, window, cv::Point(-1, -1), 1, cv::BORDER_REPLICATE);
@@ -364,6 +370,7 @@ cv::Mat DetectByHessian(const cv::Mat& grey, const StripeDetectParams& p) {
     cv::Mat seeds_rows = seeds.rowRange(y0, y1);
     SeedRows(strength_rows, level, shaped_rows, p, &seeds_rows);
   });
+  cancel.ThrowIfRequested("the stripe shape test");
   // Stripes grow from the seeds through the shaped pixels.
   return internal::KeepComponentsTouching(shaped, seeds);
 }
@@ -429,12 +436,13 @@ cv::Mat RidgeStrength(const cv::Mat& grey, const StripeDetectParams& params) {
   return ComputeRidgeStrength(grey, params);
 }
 
-cv::Mat DetectStripes(const cv::Mat& grey, const StripeDetectParams& params) {
+cv::Mat DetectStripes(const cv::Mat& grey, const StripeDetectParams& params,
+                      const Cancellation& cancel) {
   RequireGrey8(grey, "DetectStripes");
   RequireValid(params, "DetectStripes");
   if (params.method == StripeDetector::kAdaptiveThreshold)
     return DetectByAdaptiveThreshold(grey, params);
-  return DetectByHessian(grey, params);
+  return DetectByHessian(grey, params, cancel);
 }
 
 }  // namespace bsls::extraction

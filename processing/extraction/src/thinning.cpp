@@ -459,11 +459,13 @@ namespace internal {
 
 // Thesis 4.3.2: the two sub-iterations of eq. 4.18 - 4.20 over the live pixels,
 // their conditions looked up by neighbourhood code.
-void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params) {
+void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params,
+                          const Cancellation& cancel) {
   std::vector<size_t> live = img->SetIndices();
   std::vector<size_t> flagged;
   const CodeTable& simple = SimpleTable();
   for (int iteration = 0; iteration < params.max_iterations; ++iteration) {
+    cancel.ThrowIfRequested("the thinning");
     bool changed = false;
     for (int step = 0; step < 2; ++step) {
       const CodeTable& deletable = ZhangSuenTable(step);
@@ -483,10 +485,12 @@ void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params) {
 }
 
 // Sweeps in raster order, deleting thinnable pixels, until a sweep deletes none.
-void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions) {
+void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions,
+                             const Cancellation& cancel) {
   const CodeTable& thinnable = ThinnableTable(t_junctions);
   std::vector<size_t> live = img->SetIndices();
   for (bool changed = true; changed;) {
+    cancel.ThrowIfRequested("the one-pixel-wide skeleton");
     changed = false;
     for (size_t i : live) {
       if (!img->data[i] || !thinnable[img->CodeOf(i)]) continue;

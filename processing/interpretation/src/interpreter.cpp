@@ -84,7 +84,7 @@ bool InterpretationParams::IsValid(std::string* error) const {
 
 InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
                                const pattern::PatternSpec& spec, const InterpretationParams& params,
-                               const cv::Mat& stripe_mask) {
+                               const cv::Mat& stripe_mask, const Cancellation& cancel) {
   if (skeleton.empty() || skeleton.type() != CV_8UC1)
     throw std::invalid_argument("Interpret: skeleton must be a non-empty CV_8UC1 image");
   std::string why;
@@ -114,7 +114,9 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   // Thesis 4.4: skeleton pieces too small to be part of the pattern.
   if (params.min_component_pixels > 0)
     sk = extraction::RemoveSmallComponents(sk, params.min_component_pixels);
+  cancel.ThrowIfRequested("the small components");
   PruneFalseJunctions(sk, side, params);
+  cancel.ThrowIfRequested("the false junctions");
 
   // Thesis 5.2.1: the reference line first, sealed end to end.
   if (!TraceReferenceLine(sk, side, params.reference, &result.reference, &why)) {
@@ -124,6 +126,7 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   }
 
   // Thesis 5.2.3.3: corners become junctions with a one-stroke stub.
+  cancel.ThrowIfRequested("the reference line");
   result.corners =
       ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, mask, image);
 
@@ -136,9 +139,12 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   for (int round = 0;; ++round) {
     network.reset();  // it refers to the graph
     graph.reset();    // first, so that the new graph can take over its memory
+    cancel.ThrowIfRequested("the repair rounds");
     graph = std::make_unique<SkeletonGraph>(SkeletonGraph::Build(sk, params.graph));
+    cancel.ThrowIfRequested("the skeleton graph");
     network = std::make_unique<JunctionNetwork>(*graph, side, params.junction);
     loops = TraceLoops(*network);
+    cancel.ThrowIfRequested("the loop tracing");
     if (!params.enable_repair || round == params.max_repair_rounds) break;
     if (round == 0)
       for (const LoopRecord& l : loops) ++result.loop_classes[l.cls];

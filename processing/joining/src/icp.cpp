@@ -70,13 +70,15 @@ std::optional<Eigen::Isometry3d> RigidFromPairs(const std::vector<Eigen::Vector3
 }
 
 IcpResult AlignToCurve(const StripeCurve& fixed, const std::vector<Eigen::Vector3d>& moving,
-                       const Eigen::Isometry3d& initial, const IcpParams& params) {
+                       const Eigen::Isometry3d& initial, const IcpParams& params,
+                       const Cancellation& cancel) {
   IcpResult result;
   result.transform = initial;
   const double converged_rotation_rad = params.converged_rotation_deg * std::numbers::pi / 180.0;
   std::vector<Pair> pairs;
   pairs.reserve(moving.size());
   while (result.iterations < params.max_iterations) {
+    cancel.ThrowIfRequested("the ICP alignment");
     pairs.clear();
     for (const Eigen::Vector3d& m : moving) {
       const Eigen::Vector3d moved = result.transform * m;

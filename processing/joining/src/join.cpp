@@ -71,10 +71,11 @@ bool JoinParams::IsValid(std::string* error) const {
 }
 
 JoinResult JoinSharedFrame(const geometry::SurfaceMesh& left, const geometry::SurfaceMesh& right,
-                           const JoinParams& params) {
+                           const JoinParams& params, const Cancellation& cancel) {
   CheckParams(params);
   const StripeCurve left_line = ReferenceLine(left, "left", params);
   const StripeCurve right_line = ReferenceLine(right, "right", params);
+  cancel.ThrowIfRequested("the reference lines");
   JoinResult result;
   Stitch(left, right, params, &result);
   result.seam = MeasureSeam(left_line, right_line, params.stitch);
@@ -82,10 +83,11 @@ JoinResult JoinSharedFrame(const geometry::SurfaceMesh& left, const geometry::Su
 }
 
 JoinResult JoinByFeatures(const geometry::SurfaceMesh& left, const geometry::SurfaceMesh& right,
-                          const JoinParams& params) {
+                          const JoinParams& params, const Cancellation& cancel) {
   CheckParams(params);
   const StripeCurve left_line = ReferenceLine(left, "left", params);
   const StripeCurve right_line = ReferenceLine(right, "right", params);
+  cancel.ThrowIfRequested("the reference lines");
   JoinResult result;
   // Thesis 5.2.2: nose and mouth on each side's common line.
   result.left_features = FindLineFeatures(left_line, params.features, "left");
@@ -106,7 +108,7 @@ JoinResult JoinByFeatures(const geometry::SurfaceMesh& left, const geometry::Sur
   result.initial_rotation = initial->linear();
   result.initial_translation = initial->translation();
   // Refinement on the whole common line.
-  const IcpResult icp = AlignToCurve(left_line, right_line.points(), *initial, params.icp);
+  const IcpResult icp = AlignToCurve(left_line, right_line.points(), *initial, params.icp, cancel);
   if (!icp.converged) {
     throw JoinError(
         JoinError::Reason::kNotConverged,
@@ -116,6 +118,7 @@ JoinResult JoinByFeatures(const geometry::SurfaceMesh& left, const geometry::Sur
   result.translation = icp.transform.translation();
   result.iterations = icp.iterations;
   result.icp_rms_mm = icp.rms_mm;
+  cancel.ThrowIfRequested("the ICP alignment");
   Stitch(left, Moved(right, icp.transform), params, &result);
   result.seam = MeasureSeam(left_line, right_line.Transformed(icp.transform), params.stitch);
   return result;

@@ -692,7 +692,7 @@ Status ProcessingService::Calibrate(
             if (w.observer.cancelled && w.observer.cancelled()) return false;
             w.observer.Report("calibrate " + view, 0.05 + 0.9 * fraction);
             return true;
-          });
+          }, w.observer.cancellation());
     } catch (const calibration::CalibrationError& e) {
       if (e.reason() == calibration::CalibrationErrorReason::kCancelled) throw;
       throw calibration::CalibrationError(e.reason(), strip(e.what()));

@@ -111,8 +111,10 @@ SessionOutcome ReconstructSession(const cv::Mat& left, const calibration::SideCa
   try {
     out.joined =
         out.by_features
-            ? joining::JoinByFeatures(*out.left.surface, *out.right.surface, params.join_params)
-            : joining::JoinSharedFrame(*out.left.surface, *out.right.surface, params.join_params);
+            ? joining::JoinByFeatures(*out.left.surface, *out.right.surface, params.join_params,
+                                      cancel)
+            : joining::JoinSharedFrame(*out.left.surface, *out.right.surface, params.join_params,
+                                       cancel);
   } catch (const joining::JoinError& e) {
     throw SessionError(SessionErrorReason::kNotProcessed, SessionPart::kJoin,
                        std::string("join: ") + e.what());

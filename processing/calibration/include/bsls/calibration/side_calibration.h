@@ -59,6 +59,7 @@
 #include <vector>
 
 #include "bsls/calibration/calibration_error.h"
+#include "bsls/common/cancellation.h"
 #include "bsls/calibration/camera_calibration.h"
 #include "bsls/calibration/manifest.h"
 #include "bsls/calibration/projector_calibration.h"
@@ -262,9 +263,11 @@ bool SharesWorldFrame(const SideCalibration& left, const SideCalibration& right,
 using CalibrationProgress = std::function<bool(const std::string& view, double fraction)>;
 
 // Thesis chapter 6 for one side: every step above. Throws CalibrationError
-// naming the manifest or the view and the reason.
+// naming the manifest or the view and the reason; Cancelled when `cancel`
+// asks to stop (before each view and inside each view's decode).
 SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params = {},
-                              const CalibrationProgress& progress = {});
+                              const CalibrationProgress& progress = {},
+                              const Cancellation& cancel = {});
 
 // The projector pose of thesis Table 6.2 from the fitted models (step 5
 // optional). Pure; used by CalibrateSide and after loading a file.

@@ -38,6 +38,7 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "bsls/common/cancellation.h"
 #include "bsls/extraction/edge_detect.h"
 #include "bsls/extraction/enhance.h"
 #include "bsls/extraction/pruning.h"
@@ -77,8 +78,10 @@ struct ExtractionResult {
   cv::Mat skeleton;  // CV_8UC1 0/255, one pixel wide, 8-connected
 };
 
-// Runs the chosen chain on a grey frame.
-ExtractionResult ExtractFeatures(const cv::Mat& grey, const ExtractionParams& params = {});
+// Runs the chosen chain on a grey frame, asking `cancel` between its stages
+// and before every thinning iteration (Cancelled when asked to stop).
+ExtractionResult ExtractFeatures(const cv::Mat& grey, const ExtractionParams& params = {},
+                                 const Cancellation& cancel = {});
 
 }  // namespace bsls::extraction
 

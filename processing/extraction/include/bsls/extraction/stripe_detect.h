@@ -53,6 +53,8 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "bsls/common/cancellation.h"
+
 namespace bsls::extraction {
 
 enum class StripeDetector { kHessianRidge, kAdaptiveThreshold };
@@ -86,8 +88,10 @@ struct StripeDetectParams {
 // Multi-scale Hessian ridge strength (see above), CV_32FC1, grey levels, >= 0.
 cv::Mat RidgeStrength(const cv::Mat& grey, const StripeDetectParams& params);
 
-// Binary mask (0/255) of bright stripe pixels by params.method.
-cv::Mat DetectStripes(const cv::Mat& grey, const StripeDetectParams& params);
+// Binary mask (0/255) of bright stripe pixels by params.method. `cancel` is
+// asked by every band of rows (Cancelled when asked to stop).
+cv::Mat DetectStripes(const cv::Mat& grey, const StripeDetectParams& params,
+                      const Cancellation& cancel = {});
 
 }  // namespace bsls::extraction
 

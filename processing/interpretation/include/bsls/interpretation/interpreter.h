@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/cancellation.h"
 #include "bsls/interpretation/corner_extension.h"
 #include "bsls/interpretation/labelling.h"
 #include "bsls/interpretation/loop_trace.h"
@@ -55,10 +56,13 @@ struct InterpretationResult {
 // mask the skeleton was thinned from; it lets corner extension (5.2.3.3) tell
 // a stroke lost in thinning from a line that really turns. Throws
 // std::invalid_argument for an empty or non-CV_8UC1 skeleton or invalid params.
+// `cancel` is asked between the stages and every round of repair (Cancelled
+// when asked to stop).
 InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
                                const pattern::PatternSpec& spec,
                                const InterpretationParams& params = {},
-                               const cv::Mat& stripe_mask = cv::Mat());
+                               const cv::Mat& stripe_mask = cv::Mat(),
+                               const Cancellation& cancel = {});
 
 }  // namespace bsls::interpretation
 

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/cancellation.h"
 #include "bsls/joining/stripe_curve.h"
 
 namespace bsls::joining {
@@ -50,8 +51,10 @@ struct IcpResult {
 // component along the curve, n its surface normal). Does not throw: a
 // failure (too few pairs, a degenerate system, the cap reached) comes back
 // with converged = false and `failure` saying why. `params` must be valid.
+// `cancel` is asked before every step (Cancelled when asked to stop).
 IcpResult AlignToCurve(const StripeCurve& fixed, const std::vector<Eigen::Vector3d>& moving,
-                       const Eigen::Isometry3d& initial, const IcpParams& params);
+                       const Eigen::Isometry3d& initial, const IcpParams& params,
+                       const Cancellation& cancel = {});
 
 // Least-squares rigid transform (Kabsch) taking `source[i]` onto
 // `target[i]`; at least 3 non-collinear pairs, else nullopt.

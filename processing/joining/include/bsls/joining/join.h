@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "bsls/common/cancellation.h"
 #include "bsls/geometry/surface_mesh.h"
 #include "bsls/joining/features.h"
 #include "bsls/joining/icp.h"
@@ -69,15 +70,17 @@ struct JoinResult {
 // Both sides in one world frame: the merged, stitched mesh and the seam
 // error. Throws JoinError for invalid params or meshes, an empty mesh, or a
 // side without vertices on the reference line.
+// `cancel` is asked between the steps (Cancelled when asked to stop).
 JoinResult JoinSharedFrame(const geometry::SurfaceMesh& left, const geometry::SurfaceMesh& right,
-                           const JoinParams& params);
+                           const JoinParams& params, const Cancellation& cancel = {});
 
 // Thesis 5.2.2: the right side matched onto the left by the nose and mouth
 // of the common line, refined by ICP, then merged and stitched. Throws
 // JoinError as JoinSharedFrame, and when a side's nose or mouth is not found
 // (kFeaturesNotFound) or ICP does not converge (kNotConverged).
+// `cancel` is asked between the steps and every ICP step.
 JoinResult JoinByFeatures(const geometry::SurfaceMesh& left, const geometry::SurfaceMesh& right,
-                          const JoinParams& params);
+                          const JoinParams& params, const Cancellation& cancel = {});
 
 }  // namespace bsls::joining
 
