@@ -39,8 +39,10 @@ grep -q '[[:space:]]\.gnu_debuglink[[:space:]]' <<<"$sections" || fail "$install
 
 # The debug file: the DWARF, of this very build.
 [ -f "$debug" ] || fail "no debug file $debug"
-readelf --wide --section-headers "$debug" | grep -q '[[:space:]]\.debug_info[[:space:]]' ||
-  fail "$debug has no .debug_info"
+# (Output taken whole before grep: with pipefail, grep -q closing a pipe
+# early would fail the writer with SIGPIPE.)
+debug_sections=$(readelf --wide --section-headers "$debug" 2>/dev/null)
+grep -q '[[:space:]]\.debug_info[[:space:]]' <<<"$debug_sections" || fail "$debug has no .debug_info"
 id_of() { readelf --notes "$1" 2>/dev/null | sed -n 's/.*Build ID: \([0-9a-f]*\).*/\1/p'; }
 build_id=$(id_of "$installed")
 [ -n "$build_id" ] || fail "$installed has no build id"
