@@ -79,13 +79,14 @@ function(bsls_split_debug_info)
   if(failed)
     message(FATAL_ERROR "Splitting debug information: objcopy --strip-debug ${staged}: ${error}")
   endif()
-  set(installed "${staged_debug}")
+  set(installed "${debug_file}")
 
   # 3. The build-id link; links left by earlier installs of this program
   #    (other build ids) would point at a file that no longer matches them.
   if(build_id MATCHES "^(..)(.+)$")
-    set(link_dir "$ENV{DESTDIR}${debug_root}/.build-id/${CMAKE_MATCH_1}")
-    set(link "${link_dir}/${CMAKE_MATCH_2}.debug")
+    set(link_name "${debug_root}/.build-id/${CMAKE_MATCH_1}/${CMAKE_MATCH_2}.debug")
+    set(link "$ENV{DESTDIR}${link_name}")
+    cmake_path(GET link PARENT_PATH link_dir)
     file(GLOB old_links LIST_DIRECTORIES false "$ENV{DESTDIR}${debug_root}/.build-id/*/*.debug")
     foreach(old IN LISTS old_links)
       if(IS_SYMLINK "${old}")
@@ -99,10 +100,11 @@ function(bsls_split_debug_info)
     file(MAKE_DIRECTORY "${link_dir}")
     file(RELATIVE_PATH relative "${link_dir}" "${staged_debug}")
     file(CREATE_LINK "${relative}" "${link}" SYMBOLIC)
-    list(APPEND installed "${link}")
+    list(APPEND installed "${link_name}")
   endif()
 
-  # install_manifest*.txt lists them with the program's other files.
+  # install_manifest*.txt lists them with the other files (as CMake does,
+  # without DESTDIR).
   set(CMAKE_INSTALL_MANIFEST_FILES ${CMAKE_INSTALL_MANIFEST_FILES} ${installed} PARENT_SCOPE)
   set(hint "")
   if(NOT debug_root STREQUAL "/usr/lib/debug")
