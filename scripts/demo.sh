@@ -15,7 +15,7 @@
 #   face.ply, face.stl               both sides joined (open in MeshLab, ParaView, a slicer...)
 #   face_report.json                 per-side figures and the seam error of the join
 #   face_measurements.json           heights and a distance on the face, with uncertainties
-# Then the same through the services, as a clinic runs it (issue 5): the
+# Then the same through the services, as a clinic runs it: the
 # capture daemon bslsd on its simulated framestore and one processing service
 # bsls-processd on this machine, driven by the Python automation example
 # (clients/python/examples/scripted_session.py), which grabs both sides,

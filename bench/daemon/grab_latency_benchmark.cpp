@@ -1,4 +1,4 @@
-// Latency of a grab of both sides through bslsd (issue 4): the daemon's own
+// Latency of a grab of both sides through bslsd: the daemon's own
 // assembly in-process (bslsd::Daemon), a client on its Unix socket, each grab
 // acknowledged only once stored durably. Per backend (the simulated head and
 // the emulated ISA card): median and 99th percentile (counters p50_ms,

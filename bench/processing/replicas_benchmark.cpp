@@ -1,4 +1,4 @@
-// Sessions per second of bsls-processd replicas (issue 5): ReconstructSession
+// Sessions per second of bsls-processd replicas: ReconstructSession
 // of both simulated 512 x 512 faces with both calibrations inline (the
 // request of tests/processing/service_fixture.h), through ONE channel with
 // round_robin over 1, 2 and 3 replicas. Each replica is the real executable

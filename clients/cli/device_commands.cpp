@@ -1,5 +1,5 @@
-// The capture daemon's commands of `bsls` (issue 4, for the bedside
-// workstation and automation scripts): status, camera, gain, slide, grab,
+// The capture daemon's commands of `bsls` (for the bedside workstation and
+// automation scripts): status, camera, gain, slide, grab,
 // captures and preview, over the daemon's gRPC API (proto/bsls/v1).
 // Every call has a deadline; --json prints the reply for scripts (frames
 // without their pixels); frames are written as lossless PNG files.

@@ -67,7 +67,7 @@ struct SlidesConfig {
   slides::SlideControllerConfig controller;  // lines and timing (gpio and simulated)
 };
 
-// The processing service every acknowledged grab is handed to (issue 5).
+// The processing service every acknowledged grab is handed to.
 struct ProcessingConfig {
   // "unix:PATH", "host:port", "ipv4:h:p,h:p" or "dns:///name:port" (round
   // robin over replicas); "" : no processing.

@@ -1,4 +1,4 @@
-// bslsd: the BSLS capture daemon (issue 4). Owns the framestore and the slide
+// bslsd: the BSLS capture daemon. Owns the framestore and the slide
 // controller, keeps every grab durably, and serves proto/bsls/v1/capture.proto
 // on a Unix socket (roles from SO_PEERCRED) and, when configured, on TCP with
 // mutual TLS.

@@ -1,4 +1,4 @@
-// Least privilege for bslsd (issues 4 and 26): the daemon may start with
+// Least privilege for bslsd: the daemon may start with
 // CAP_SYS_RAWIO (for /dev/port or ioperm) and nothing else, or as root; it
 // opens the devices that need a privilege and its socket while it is still
 // single-threaded, then (started as root) becomes the configured user and

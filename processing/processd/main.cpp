@@ -1,4 +1,4 @@
-// bsls-processd: the BSLS processing service (issue 5). Runs unprivileged;
+// bsls-processd: the BSLS processing service. Runs unprivileged;
 // configuration errors exit 78 (EX_CONFIG) so systemd does not restart into
 // the same mistake.
 #include <signal.h>

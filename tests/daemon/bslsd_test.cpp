@@ -1,5 +1,5 @@
 // bslsd as its users meet it: the real executable started on a temporary
-// socket and store, driven over gRPC (issue 4, "Done means").
+// socket and store, driven over gRPC.
 #include <grp.h>
 #include <gtest/gtest.h>
 #include <openssl/sha.h>
@@ -499,7 +499,7 @@ TEST_F(Bslsd, TcpServesOnlyMutualTlsCallersWithTheirCertificatesRole) {
   EXPECT_EQ(status.captures_stored(), 1u);
 }
 
-// The roles of issue 4 tried on every call: uids 60001-60004 are viewer,
+// Every role tried on every call (roles.h): uids 60001-60004 are viewer,
 // operator, admin and nobody-in-particular.
 TEST_F(Bslsd, EveryRoleOnEveryCallHasNoUnauthorizedSuccess) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root to run the probe as other uids";
@@ -568,8 +568,8 @@ std::map<std::string, std::vector<std::string>> StatusFields(const fs::path& sta
   return fields;
 }
 
-// Issue 26: started as root, bslsd sets up its socket (with a group root is
-// needed for) and becomes the configured user: uid, gid and groups, no
+// Started as root, bslsd sets up its socket (with a group root is needed
+// for) and becomes the configured user: uid, gid and groups, no
 // capabilities, no_new_privs, in every thread; it still grabs and stores.
 TEST_F(Bslsd, StartedAsRootItBecomesTheConfiguredUserWithoutPrivileges) {
   if (::geteuid() != 0)
@@ -615,9 +615,9 @@ TEST_F(Bslsd, StartedAsRootItBecomesTheConfiguredUserWithoutPrivileges) {
   EXPECT_EQ(store.st_uid, kUid);
 }
 
-// Issue 26: bytes that are not the request message get INVALID_ARGUMENT
-// naming the message type, on every method of bslsd (they got INTERNAL with
-// an empty message), before any role is checked; the daemon still answers.
+// Bytes that are not the request message get INVALID_ARGUMENT naming the
+// message type, on every method of bslsd (gRPC alone gives INTERNAL with an
+// empty message), before any role is checked; the daemon still answers.
 TEST_F(Bslsd, AMalformedRequestIsInvalidArgumentWithAMessage) {
   Start("malformed");
   grpc::GenericStub stub(daemon_->Channel());
@@ -632,7 +632,7 @@ TEST_F(Bslsd, AMalformedRequestIsInvalidArgumentWithAMessage) {
   EXPECT_TRUE(daemon_->Stub()->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok());
 }
 
-// Issue 26: the configured connection limits reach bslsd's socket: one
+// The configured connection limits reach bslsd's socket: one
 // user's connections beyond listen.max_connections_per_user are closed at
 // once, and once they are gone the daemon answers that user again.
 TEST_F(Bslsd, AUsersConnectionsBeyondItsShareAreClosedAtOnce) {
@@ -665,7 +665,7 @@ TEST_F(Bslsd, AUsersConnectionsBeyondItsShareAreClosedAtOnce) {
   EXPECT_TRUE(answered.ok()) << answered.error_message();
 }
 
-// Issue 26: HTTP/2 limits are set on the server: a connection without calls
+// HTTP/2 limits are set on the server: a connection without calls
 // is closed after listen.max_connection_idle_ms, and the client reconnects.
 TEST_F(Bslsd, AConnectionWithoutCallsIsClosedAfterTheIdleLimit) {
   Start("idle", kSimulatedSlides, {"--set", "listen.max_connection_idle_ms=500"});
@@ -718,7 +718,7 @@ std::pair<int, std::string> RunCommand(const std::string& command) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
-// Issue 26: a world-writable socket would let every local user call the
+// A world-writable socket would let every local user call the
 // daemon; such a mode is refused, naming the key and the reason.
 TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
   const fs::path dir = MakeDaemonDir("mode");
@@ -736,7 +736,7 @@ TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
   EXPECT_EQ(code, 0) << output;
 }
 
-// Issue 26: started as root with a `user` that does not exist, bslsd
+// Started as root with a `user` that does not exist, bslsd
 // refuses to start (it never serves as root by accident) and names it.
 TEST(BslsdConfig, StartedAsRootWithAnUnknownUserItRefusesToStart) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root: the user matters only when started as root";

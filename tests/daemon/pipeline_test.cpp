@@ -1,4 +1,4 @@
-// The capture-to-mesh pipeline (issue 5): the real bslsd on its simulated
+// The capture-to-mesh pipeline: the real bslsd on its simulated
 // framestore hands every acknowledged grab to a real bsls-processd and keeps
 // what comes back beside the capture as a sealed record; the queue survives
 // an absent service and a restart of the daemon.

@@ -1,6 +1,6 @@
-// Preview to four clients at once, one of them reading slowly (issue 4, "Done
-// means"): the others keep the camera's 25 frames/s; a reader that reads
-// nothing gives its slot back (issue 26). Timing depends on the
+// Preview to four clients at once, one of them reading slowly: the others
+// keep the camera's 25 frames/s; a reader that reads nothing gives its slot
+// back. Timing depends on the
 // machine, so this test is labelled `timing` (not run under the sanitizers).
 #include <gtest/gtest.h>
 
@@ -94,9 +94,9 @@ TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
   EXPECT_EQ(daemon.Terminate(), 0) << daemon.Log();
 }
 
-// Issue 26: a reader that reads nothing and set no deadline held one of the
-// preview slots for ever. Now a write it does not take within
-// limits.stream_write_timeout_ms ends its stream with RESOURCE_EXHAUSTED
+// A reader that reads nothing and set no deadline would hold one of the
+// preview slots for ever: a write it does not take within
+// limits.stream_write_timeout_ms ends its stream with RESOURCE_EXHAUSTED,
 // and the next reader gets the slot and its frames.
 TEST(BslsdPreview, AReaderThatReadsNothingGivesItsSlotBack) {
   const fs::path dir = MakeDaemonDir("preview_stalled");

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# The hardened unit's exposure as systemd rates it (issue 4: at most 2.5), the
-# resource limits and sandbox settings issue 26 requires, and the unit,
-# sysusers and tmpfiles files as systemd parses them.
+# The hardened unit's exposure as systemd rates it (at most the limit given
+# as the second argument), the resource limits and sandbox settings every
+# service unit must have, and the unit, sysusers and tmpfiles files as
+# systemd parses them.
 set -euo pipefail
 unit=$1
 limit=$2
@@ -22,8 +23,8 @@ if ! awk -v e="$exposure" -v l="$limit" 'BEGIN { exit !(e <= l) }'; then
   echo "FAIL: exposure $exposure of $name is above $limit"
   exit 1
 fi
-# The resource limits and the sandbox every BSLS service unit must set
-# (issue 26): what a flood or a bug can take, and the system calls it may make.
+# The resource limits and the sandbox every BSLS service unit must set:
+# what a flood or a bug can take, and the system calls it may make.
 for setting in '^LimitNOFILE=[0-9]+$' '^MemoryMax=[0-9]+[KMGT]?$' '^TasksMax=[0-9]+$' \
                '^NoNewPrivileges=yes$' '^SystemCallArchitectures=native$' \
                '^SystemCallFilter=@system-service( |$)' '^CapabilityBoundingSet=' \

@@ -1,4 +1,4 @@
-// 10,000 malformed requests to each service (issue 5, "Done means"):
+// 10,000 malformed requests to each service:
 // bsls-processd and bslsd run as real processes and get raw bytes through
 // grpc::GenericStub on every method of their service (found in the
 // descriptor, so a method added later is covered too): random bytes,

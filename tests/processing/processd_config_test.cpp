@@ -45,7 +45,7 @@ TEST(ProcessdConfig, ErrorsNameTheKey) {
   EXPECT_NE(ErrorOf({"scratch_dir=/nonexistent/x"}).find("scratch_dir"), std::string::npos);
 }
 
-// Issue 26: the HTTP/2 and connection limits have defaults, are read under
+// The HTTP/2 and connection limits have defaults, are read under
 // listen: and are bounded (a key out of range is named).
 TEST(ProcessdConfig, Http2LimitsHaveBoundedDefaults) {
   const Config defaults = LoadConfig(std::nullopt, {});

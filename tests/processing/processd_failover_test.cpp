@@ -1,4 +1,4 @@
-// Failover across bsls-processd replicas (issue 5, "Done means"): three
+// Failover across bsls-processd replicas: three
 // replicas as real processes on loopback TCP, one channel with round_robin,
 // 100 ReconstructSession calls through ProcessingClient with its retries;
 // once about 20 have completed, one replica that has a call running and

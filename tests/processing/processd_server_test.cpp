@@ -72,7 +72,7 @@ TEST_F(ProcessdServer, ServesTheUnixSocketAndPlainLoopback) {
   EXPECT_FALSE(fs::exists(config.listen.unix_socket));
 }
 
-// Issue 26: draining stops work under way inside its stages: two calls
+// Draining stops work under way inside its stages: two calls
 // decoding frames that keep every stage busy end (UNAVAILABLE) and the
 // drain returns well before their decodes would have ended.
 TEST_F(ProcessdServer, DrainStopsWorkInsideItsStages) {
@@ -116,7 +116,7 @@ TEST_F(ProcessdServer, DrainStopsWorkInsideItsStages) {
                                 << " s";
 }
 
-// Issue 26: the HTTP/2 limits reach the server: a connection without calls
+// The HTTP/2 limits reach the server: a connection without calls
 // is closed after listen.max_connection_idle_ms and the client reconnects.
 TEST_F(ProcessdServer, AConnectionWithoutCallsIsClosedAfterTheIdleLimit) {
   Config config;
@@ -137,9 +137,9 @@ TEST_F(ProcessdServer, AConnectionWithoutCallsIsClosedAfterTheIdleLimit) {
   server->Drain();
 }
 
-// Issue 26: bytes that are not the request message get INVALID_ARGUMENT
-// naming the message type, on every method that takes one request (they
-// got INTERNAL with an empty message); the service still answers after.
+// Bytes that are not the request message get INVALID_ARGUMENT naming the
+// message type, on every method that takes one request (gRPC alone gives
+// INTERNAL with an empty message); the service still answers after.
 // (In a request stream a malformed message reads as the stream's end.)
 TEST_F(ProcessdServer, AMalformedRequestIsInvalidArgumentWithAMessage) {
   Config config;
@@ -160,7 +160,7 @@ TEST_F(ProcessdServer, AMalformedRequestIsInvalidArgumentWithAMessage) {
   server->Drain();
 }
 
-// Issue 26: the Unix socket's connections are limited per user and in all
+// The Unix socket's connections are limited per user and in all
 // (listen.max_connections*); connections beyond are closed at once while
 // other users are still let in, and the service answers after.
 TEST_F(ProcessdServer, UnixConnectionsBeyondTheLimitsAreClosedAtOnce) {

@@ -1,4 +1,4 @@
-// UnixListener under hostile callers (issue 26). Out of descriptors, the
+// UnixListener under hostile callers. Out of descriptors, the
 // accept loop sheds the waiting callers at once and does not spin (the
 // listener runs in a child process whose descriptor limit is set just above
 // what it holds, so that each further connection meets EMFILE). Beyond the
@@ -144,7 +144,7 @@ TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
   std::filesystem::remove(path);
 }
 
-// The limits on connections open at once (issue 26): one user beyond its
+// The limits on connections open at once: one user beyond its
 // share and everybody beyond the total are closed at once, while others are
 // still served. The listener runs in a child process (gRPC is not used in
 // this one before it forks the caller of another uid).

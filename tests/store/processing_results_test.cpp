@@ -1,4 +1,4 @@
-// The processing queue in the capture store (issue 5): which captures wait,
+// The processing queue in the capture store: which captures wait,
 // attempts and failures, results stored durably and verified on reading,
 // leftovers of interrupted stores removed on open, results deleted with
 // their capture, and a store of the first schema migrated.

@@ -4,7 +4,7 @@
 // reopens the store and checks that every acknowledged capture is present
 // and its hashes verify, that leftovers of the interrupted put are gone and
 // that the index passes its integrity check. Repeated until 200 grabs have
-// been acknowledged (issue 4, "Done means").
+// been acknowledged.
 //
 // SIGKILL ends the process, not the machine: the page cache survives. Power
 // loss is covered by the fsync sequence (docs/capture-store.md) and by the

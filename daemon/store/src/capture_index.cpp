@@ -47,7 +47,7 @@ CREATE TABLE frames (
   PRIMARY KEY (capture_id, camera)
 ) WITHOUT ROWID;
 )sql",
-    // 1 -> 2: the processing queue (issue 5). A capture without a row has not
+    // 1 -> 2: the processing queue. A capture without a row has not
     // been tried; `files` lists "name sha256" lines of the stored results.
     R"sql(
 CREATE TABLE processing (

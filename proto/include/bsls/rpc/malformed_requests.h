@@ -1,5 +1,4 @@
-// Malformed requests get INVALID_ARGUMENT with a message (issue 26), on
-// both services.
+// Malformed requests get INVALID_ARGUMENT with a message, on both services.
 //
 // gRPC C++ parses a request before any handler runs and sends the parser's
 // status as the call's: for protobuf, INTERNAL with

@@ -1,5 +1,5 @@
 // What both services (bslsd, bsls-processd) do the same way to stay within
-// bounds whatever their callers send (issue 26): HTTP/2 keep-alive, ping and
+// bounds whatever their callers send: HTTP/2 keep-alive, ping and
 // stream limits set on the gRPC server through channel arguments, read from
 // the same configuration keys under `listen:`, and the allocator discipline
 // that gives memory back after a burst of requests or a flood.

@@ -2,7 +2,7 @@
 // service accepts its local connections itself and hands each to its gRPC
 // server (grpc::AddInsecureChannelFromFd), so that what gRPC does not do is
 // done before: the peer's credentials (SO_PEERCRED) for bslsd's roles, and
-// limits no caller can get around (issue 26):
+// limits no caller can get around:
 //  - connections open at once, in all and per peer uid; one beyond either
 //    is closed as soon as it is accepted (gRPC 1.51 has no such limit);
 //  - out of descriptors (EMFILE, ENFILE), the waiting caller is shed

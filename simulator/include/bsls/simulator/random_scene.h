@@ -94,7 +94,8 @@ struct Interval {
   bool Contains(double value) const { return value >= min && value <= max; }
 };
 
-// The ranges scenes are drawn from. Defaults: issue 25's ranges. Lengths in
+// The ranges scenes are drawn from (defaults tabulated in docs/heldout.md,
+// "What a seed draws"). Lengths in
 // mm, angles in degrees, image quantities in pixels. A "+-x" field is the
 // half-width of a symmetric range around the nominal value.
 struct RandomSceneRanges {

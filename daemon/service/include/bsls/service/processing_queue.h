@@ -1,4 +1,4 @@
-// bslsd's processing queue (issue 5, "Pipeline"): every acknowledged grab is
+// bslsd's processing queue: every acknowledged grab is
 // handed to the processing service named in the configuration, and what it
 // returns is stored beside the capture as a sealed record
 // (CaptureStore::PutProcessingResult).

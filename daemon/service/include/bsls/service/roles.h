@@ -1,4 +1,4 @@
-// Who may do what on bslsd (issue 4, "Privilege and deployment"): a caller
+// Who may do what on bslsd: a caller
 // is identified by the transport (the peer's uid from SO_PEERCRED on the Unix
 // socket, the client certificate's common name on mutual-TLS TCP) and mapped
 // to one role. Roles are ordered: each may do everything of the one before.

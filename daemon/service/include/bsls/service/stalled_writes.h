@@ -1,4 +1,4 @@
-// Server streams whose reader stopped reading (issue 26): with the sync API
+// Server streams whose reader stopped reading: with the sync API
 // a stream message is written by a blocking Write, which a client that never
 // reads (and set no deadline) holds for ever, and with it the stream's slot
 // (one of limits.max_preview_streams) and a handler thread. StalledWrites

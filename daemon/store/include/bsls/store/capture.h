@@ -93,7 +93,7 @@ struct CaptureInfo {
   std::vector<StoredFrameInfo> frames;                // in camera order
 };
 
-// Where a capture is in bslsd's processing queue (issue 5). Values are
+// Where a capture is in bslsd's processing queue. Values are
 // stored. A capture without a record has not been tried yet.
 enum class ProcessingState : int {
   kPending = 1,  // tried, will be tried again (attempts, last_error)

@@ -1,11 +1,11 @@
-// The durable capture store of bslsd (issue 4, "Keeping frames safe"): every
+// The durable capture store of bslsd: every
 // grab is kept as frame files (frame_file.h) plus rows in a SQLite index
 // (capture_index.h) under one root directory:
 //
 //   <root>/LOCK            flock(2)ed by the one process that has the store open
 //   <root>/index.sqlite    the index (+ -wal, -shm while open)
 //   <root>/frames/<id>-<camera>.pgm
-//   <root>/results/<id>-<name>   processing results (issue 5)
+//   <root>/results/<id>-<name>   processing results
 //
 // Put returns only when the capture is durable -- that return is the
 // acknowledgement: each frame file is written to a temporary name, fsynced,
@@ -158,7 +158,7 @@ class CaptureStore {
   // The store's root directory.
   const std::string& root() const { return options_.root; }
 
-  // Processing (issue 5): every capture is processed once by the processing
+  // Processing: every capture is processed once by the processing
   // service; its results are stored beside it as <root>/results/<id>-<name>,
   // each written durably, then the record (state done, each file's SHA-256)
   // is committed. Captures not yet done or failed, oldest first.

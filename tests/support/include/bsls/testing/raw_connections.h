@@ -1,5 +1,5 @@
-// Raw connections to a service's Unix socket for the connection-limit tests
-// (issue 26): made as another effective uid (SO_PEERCRED gives the server
+// Raw connections to a service's Unix socket for the connection-limit tests:
+// made as another effective uid (SO_PEERCRED gives the server
 // the euid of the connecting process), and whether the server closes one
 // at once (header only).
 #ifndef BSLS_TESTING_RAW_CONNECTIONS_H_
