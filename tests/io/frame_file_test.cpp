@@ -56,5 +56,31 @@ TEST(FrameFile, LimitsAreTheCallersOwn) {
   EXPECT_EQ(DecodeGreyFrame(bytes, "big.png", nullptr, limits).cols, 600);
 }
 
+// Issue 26: sides within max_side (16384) still allowed 268 Mpx, 2 GiB
+// allocated for a 16-bit RGBA header; bsls-processd read calibration images
+// up to that size whatever its frame budget. The pixel count is a limit of
+// its own, checked on the header too.
+TEST(FrameFile, APngAboveThePixelBudgetIsRefusedFromItsHeader) {
+  std::vector<unsigned char> bytes = Png(cv::Mat(32, 32, CV_8UC1, cv::Scalar(0)));
+  PutBe32(&bytes, 16, 16384);
+  PutBe32(&bytes, 20, 16384);
+  try {
+    (void)DecodeGreyFrame(bytes, "wide.png");
+    FAIL() << "a PNG claiming 16384 x 16384 was decoded";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("wide.png: size 16384x16384 = 268435456 pixels is above the budget of "
+                        "16777216"),
+              std::string::npos)
+        << what;
+  }
+  const std::vector<unsigned char> real = Png(cv::Mat(300, 300, CV_8UC1, cv::Scalar(1)));
+  FrameLimits limits;
+  limits.max_pixels = 300 * 300 - 1;
+  EXPECT_THROW((void)DecodeGreyFrame(real, "real.png", nullptr, limits), InputError);
+  limits.max_pixels = 300 * 300;
+  EXPECT_EQ(DecodeGreyFrame(real, "real.png", nullptr, limits).total(), 300u * 300u);
+}
+
 }  // namespace
 }  // namespace bsls::io

@@ -52,9 +52,14 @@ cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::stri
       throw InputError(path + ": size " + std::to_string(width) + "x" + std::to_string(height) +
                        " is outside " + std::to_string(limits.min_side) + ".." +
                        std::to_string(limits.max_side) + " pixels a side");
+    if (width * height > static_cast<std::uint64_t>(limits.max_pixels))
+      throw InputError(path + ": size " + std::to_string(width) + "x" + std::to_string(height) +
+                       " = " + std::to_string(width * height) + " pixels is above the budget of " +
+                       std::to_string(limits.max_pixels));
   };
   // A PNG says its size in its first chunk (IHDR): a size outside the
-  // limits is refused before anything is decoded or allocated for it.
+  // limits is refused before anything is decoded or allocated for it. Other
+  // formats are checked once decoded.
   static constexpr unsigned char kPngStart[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
                                                 0,    0,   0,   13,  'I',  'H',  'D',  'R'};
   if (bytes.size() >= 24 && std::equal(std::begin(kPngStart), std::end(kPngStart), bytes.begin())) {
