@@ -27,10 +27,13 @@ namespace fs = std::filesystem;
 // (minutes for the alias bomb, for ever for the PLY count).
 constexpr double kMaxSeconds = 5.0;
 
-class SeedReplay : public ::testing::TestWithParam<ParserTarget> {};
+// Parameterised by the target's name (its seed folder).
+class SeedReplay : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(SeedReplay, EverySeedKeepsTheContract) {
-  const ParserTarget& target = GetParam();
+  const ParserTarget* found = FindParserTarget(GetParam());
+  ASSERT_NE(found, nullptr) << GetParam();
+  const ParserTarget& target = *found;
   const fs::path folder = fs::path(SeedsDir()) / target.name;
   std::vector<fs::path> files;
   for (const auto& entry : fs::directory_iterator(folder))
@@ -61,9 +64,15 @@ TEST_P(SeedReplay, EverySeedKeepsTheContract) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Parsers, SeedReplay, ::testing::ValuesIn(ParserTargets()),
-                         [](const ::testing::TestParamInfo<ParserTarget>& param) {
-                           return std::string(param.param.name);
+std::vector<std::string> TargetNames() {
+  std::vector<std::string> names;
+  for (const ParserTarget& t : ParserTargets()) names.emplace_back(t.name);
+  return names;
+}
+
+INSTANTIATE_TEST_SUITE_P(Parsers, SeedReplay, ::testing::ValuesIn(TargetNames()),
+                         [](const ::testing::TestParamInfo<std::string>& param) {
+                           return param.param;
                          });
 
 }  // namespace
