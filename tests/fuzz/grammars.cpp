@@ -22,24 +22,76 @@ namespace {
 // its own kind naming an anchor).
 struct Tree {
   enum Kind { kScalar, kSequence, kMap, kAlias } kind = kScalar;
-  std::string text;                      // scalar text, or the alias's anchor
-  std::vector<Tree> items;               // sequence items; map keys and values alternate
-  std::string anchor;                    // "&name" set on this node, or ""
+  std::string text;         // scalar text, or the alias's anchor
+  std::vector<Tree> items;  // sequence items; map keys and values alternate
+  std::string anchor;       // "&name" set on this node, or ""
   bool flow = false;
 };
 
 // Scalars a reader must cope with: special floats, numbers at and beyond
 // every integer type's ends, empty and null, tags, long and odd text.
 const std::vector<std::string>& HostileScalars() {
-  static const std::vector<std::string> values = {
-      "0", "-1", "1", "2", "8", "255", "256", "65536", "2147483647", "2147483648", "-2147483649",
-      "4294967296", "9223372036854775807", "18446744073709551615", "18446744073709551616",
-      "1e308", "1e309", "-1e309", "5e-324", ".nan", ".NaN", ".inf", "-.inf", "0x7fffffff", "0o777",
-      "~", "null", "''", "\"\"", "true", "no", "left", "right", "both", "!!binary aGVsbG8=",
-      "!!int 12", "!!str 3", "!!float .nan", "\"\\u0000\"", "\"\\xff\\xfe\"", "0660", "0666",
-      "\"0666\"", "/etc/passwd", "../../../etc/passwd", "t0.png", "s0.png", "r0.png",
-      "bsls-calibration", "sha256:" + std::string(64, 'a'), std::string(300, 'x'),
-      "1.5", "-0.0", "6.5", "4", "20", "24", "100", "\"1, 2\"", "[1, 2, 3]", "{a: 1}"};
+  static const std::vector<std::string> values = {"0",
+                                                  "-1",
+                                                  "1",
+                                                  "2",
+                                                  "8",
+                                                  "255",
+                                                  "256",
+                                                  "65536",
+                                                  "2147483647",
+                                                  "2147483648",
+                                                  "-2147483649",
+                                                  "4294967296",
+                                                  "9223372036854775807",
+                                                  "18446744073709551615",
+                                                  "18446744073709551616",
+                                                  "1e308",
+                                                  "1e309",
+                                                  "-1e309",
+                                                  "5e-324",
+                                                  ".nan",
+                                                  ".NaN",
+                                                  ".inf",
+                                                  "-.inf",
+                                                  "0x7fffffff",
+                                                  "0o777",
+                                                  "~",
+                                                  "null",
+                                                  "''",
+                                                  "\"\"",
+                                                  "true",
+                                                  "no",
+                                                  "left",
+                                                  "right",
+                                                  "both",
+                                                  "!!binary aGVsbG8=",
+                                                  "!!int 12",
+                                                  "!!str 3",
+                                                  "!!float .nan",
+                                                  "\"\\u0000\"",
+                                                  "\"\\xff\\xfe\"",
+                                                  "0660",
+                                                  "0666",
+                                                  "\"0666\"",
+                                                  "/etc/passwd",
+                                                  "../../../etc/passwd",
+                                                  "t0.png",
+                                                  "s0.png",
+                                                  "r0.png",
+                                                  "bsls-calibration",
+                                                  "sha256:" + std::string(64, 'a'),
+                                                  std::string(300, 'x'),
+                                                  "1.5",
+                                                  "-0.0",
+                                                  "6.5",
+                                                  "4",
+                                                  "20",
+                                                  "24",
+                                                  "100",
+                                                  "\"1, 2\"",
+                                                  "[1, 2, 3]",
+                                                  "{a: 1}"};
   return values;
 }
 
@@ -189,8 +241,7 @@ void Mutate(Walk& w, Tree& t, int depth) {
     case 8:  // a small child repeated (a duplicate key in a map)
       if (!t.items.empty() && NodeCount(t, 64) < 64) {
         const std::size_t step = t.kind == Tree::kMap ? 2 : 1;
-        const std::size_t at =
-            step * w.in.Below(static_cast<std::uint32_t>(t.items.size() / step));
+        const std::size_t at = step * w.in.Below(static_cast<std::uint32_t>(t.items.size() / step));
         std::vector<Tree> copy(t.items.begin() + static_cast<std::ptrdiff_t>(at),
                                t.items.begin() + static_cast<std::ptrdiff_t>(at + step));
         const std::uint32_t times = 1 + w.in.Below(8);
@@ -220,8 +271,7 @@ void Mutate(Walk& w, Tree& t, int depth) {
 std::string ScalarText(const std::string& text) {
   if (text.empty()) return "\"\"";
   const char first = text.front();
-  if (first == '!' || first == '"' || first == '\'' || first == '[' || first == '{' ||
-      first == '~')
+  if (first == '!' || first == '"' || first == '\'' || first == '[' || first == '{' || first == '~')
     return text;
   bool plain = true;
   for (const char c : text) {
@@ -288,8 +338,8 @@ bool IsEmptyCollection(const Tree& t) {
 // Appends `t` as a block node whose lines are indented by `indent` spaces;
 // the caller wrote what comes before it on the current line ("key:" or "-").
 void EmitBlock(const Tree& t, int indent, std::string* out) {
-  const bool block = !t.flow && !IsEmptyCollection(t) &&
-                     (t.kind == Tree::kSequence || t.kind == Tree::kMap);
+  const bool block =
+      !t.flow && !IsEmptyCollection(t) && (t.kind == Tree::kSequence || t.kind == Tree::kMap);
   if (!block) {
     *out += " ";
     EmitFlow(t, out);
@@ -363,9 +413,9 @@ std::int64_t Clamped(double value) {
 std::string HostileNumber(FuzzInput& in) {
   switch (in.Below(6)) {
     case 0:
-      return std::string(in.Pick({"nan", "inf", "-inf", "1e309", "-1e309", "1e-320", "-0",
-                                  "0x10", "1e", "--1", "+5", "4294967296", "-2147483649",
-                                  "99999999999999999999", ".", ""}));
+      return std::string(
+          in.Pick({"nan", "inf", "-inf", "1e309", "-1e309", "1e-320", "-0", "0x10", "1e", "--1",
+                   "+5", "4294967296", "-2147483649", "99999999999999999999", ".", ""}));
     case 1:
       return std::to_string(static_cast<std::int64_t>(in.Bits(8)));
     case 2:
@@ -424,22 +474,20 @@ std::string PlyFrom(FuzzInput& in) {
     std::uint64_t count = 0;
     std::vector<Prop> props;
   };
-  static const std::vector<std::string> types = {"float", "double", "uchar", "char", "short",
-                                                 "ushort", "int", "uint", "int8", "uint8",
-                                                 "int16", "uint16", "int32", "uint32",
-                                                 "float32", "float64"};
-  static const std::vector<std::string> vertex_names = {"x", "y", "z", "nx", "ny", "nz",
-                                                        "uncertainty_mm", "line", "flags",
-                                                        "red", "s"};
-  static const std::vector<std::string> element_names = {"vertex", "face", "junk", "edge",
+  static const std::vector<std::string> types = {
+      "float", "double", "uchar", "char",   "short", "ushort", "int",     "uint",
+      "int8",  "uint8",  "int16", "uint16", "int32", "uint32", "float32", "float64"};
+  static const std::vector<std::string> vertex_names = {
+      "x", "y", "z", "nx", "ny", "nz", "uncertainty_mm", "line", "flags", "red", "s"};
+  static const std::vector<std::string> element_names = {"vertex",   "face",   "junk", "edge",
                                                          "material", "vertex", "face"};
   const int format = static_cast<int>(in.Below(4));  // 3: something else
   std::string out = "ply\n";
   out += format == 0   ? "format binary_little_endian 1.0\n"
          : format == 1 ? "format ascii 1.0\n"
          : format == 2 ? "format binary_big_endian 1.0\n"
-                       : std::string(in.Pick({"format ascii 2.0\n", "format binary 1.0\n",
-                                              "format ascii\n", ""}));
+                       : std::string(in.Pick(
+                             {"format ascii 2.0\n", "format binary 1.0\n", "format ascii\n", ""}));
   if (in.Below(4) == 1) out += "comment made by the fuzzer\nobj_info x\n";
   std::vector<Elem> elements;
   const std::uint32_t n_elements = 1 + in.Below(4);
@@ -468,8 +516,7 @@ std::string PlyFrom(FuzzInput& in) {
       Prop prop;
       if (el.name == "face" && p == 0) {
         prop = {in.Pick({"vertex_indices", "vertex_index", "indices"}).data(), in.Pick(types),
-                in.Pick(std::vector<std::string>{"uchar", "uint", "int", "ushort", "float"}),
-                true};
+                in.Pick(std::vector<std::string>{"uchar", "uint", "int", "ushort", "float"}), true};
       } else if (is_vertex && p < 3) {
         prop = {std::string(1, static_cast<char>('x' + p)),
                 in.Below(4) == 0 ? in.Pick(types) : "float", "", false};
@@ -487,17 +534,17 @@ std::string PlyFrom(FuzzInput& in) {
       out += p.list ? "property list " + p.count_type + " " + p.type + " " + p.name + "\n"
                     : "property " + p.type + " " + p.name + "\n";
   }
-  if (in.Below(16) == 1) out += std::string(in.Pick({"property float lost\n", "element\n",
-                                                     "bogus line\n", "element a -1\n"}));
+  if (in.Below(16) == 1)
+    out += std::string(
+        in.Pick({"property float lost\n", "element\n", "bogus line\n", "element a -1\n"}));
   out += "end_header\n";
   // The body: values of the declared types, at most 48 items an element.
   const bool ascii = format == 1;
   const bool big = format == 2;
   auto put = [&](const std::string& type, double value) {
     if (ascii) {
-      out += (value == static_cast<double>(Clamped(value))
-                  ? std::to_string(Clamped(value))
-                  : std::to_string(value)) +
+      out += (value == static_cast<double>(Clamped(value)) ? std::to_string(Clamped(value))
+                                                           : std::to_string(value)) +
              " ";
       return;
     }
@@ -601,16 +648,15 @@ std::string ObjFrom(FuzzInput& in) {
             default:
               ref = std::to_string(1 + in.Below(static_cast<std::uint32_t>(vertices + 2)));
           }
-          out += " " + ref +
-                 std::string(in.Pick({"", "", "/1", "//1", "/1/1", "/", "//", "/x"}));
+          out += " " + ref + std::string(in.Pick({"", "", "/1", "//1", "/1/1", "/", "//", "/x"}));
         }
         out += "\n";
         break;
       }
       case 7:
-        out += std::string(in.Pick({"vn 0 0 1\n", "vt 0.5 0.5\n", "# comment\n", "\n",
-                                    "o face\n", "g group\n", "s off\n", "usemtl m\n",
-                                    "mtllib x.mtl\n", "   \t\n", "f\n", "v\n"}));
+        out += std::string(
+            in.Pick({"vn 0 0 1\n", "vt 0.5 0.5\n", "# comment\n", "\n", "o face\n", "g group\n",
+                     "s off\n", "usemtl m\n", "mtllib x.mtl\n", "   \t\n", "f\n", "v\n"}));
         break;
       case 8:
         out += in.Bytes(24) + "\n";
@@ -628,8 +674,7 @@ std::string PngFrom(FuzzInput& in) {
     switch (in.Below(8)) {
       case 0:  // at and around every limit, and far beyond
         return in.Pick(std::vector<std::uint32_t>{0, 1, 15, 16, 17, 4096, 4097, 16384, 16385,
-                                                  100000, 0x7fffffffu, 0x80000000u,
-                                                  0xffffffffu});
+                                                  100000, 0x7fffffffu, 0x80000000u, 0xffffffffu});
       case 1:
         return static_cast<std::uint32_t>(in.Bits(4));
       default:
@@ -641,10 +686,9 @@ std::string PngFrom(FuzzInput& in) {
   struct Mode {
     std::uint8_t colour, depth, channels;
   };
-  static const std::vector<Mode> modes = {{0, 8, 1}, {0, 16, 1}, {0, 1, 1}, {0, 2, 1},
-                                          {0, 4, 1}, {2, 8, 3},  {2, 16, 3}, {3, 8, 1},
-                                          {3, 4, 1}, {4, 8, 2},  {4, 16, 2}, {6, 8, 4},
-                                          {6, 16, 4}, {5, 8, 1}, {2, 3, 3}};
+  static const std::vector<Mode> modes = {{0, 8, 1},  {0, 16, 1}, {0, 1, 1},  {0, 2, 1}, {0, 4, 1},
+                                          {2, 8, 3},  {2, 16, 3}, {3, 8, 1},  {3, 4, 1}, {4, 8, 2},
+                                          {4, 16, 2}, {6, 8, 4},  {6, 16, 4}, {5, 8, 1}, {2, 3, 3}};
   const Mode mode = in.Pick(modes);
   const bool interlaced = in.Below(8) == 1;
   std::string out("\x89PNG\r\n\x1a\n", 8);
@@ -693,8 +737,8 @@ std::string PngFrom(FuzzInput& in) {
 }
 
 std::string JsonFrom(FuzzInput& in) {
-  static const std::vector<std::string> keys = {"junctions", "lines", "p", "q", "v", "x", "y",
-                                                "points", "samples", "value", "uncertainty"};
+  static const std::vector<std::string> keys = {
+      "junctions", "lines", "p", "q", "v", "x", "y", "points", "samples", "value", "uncertainty"};
   std::string out;
   std::vector<char> open;  // ']' or '}' to close, innermost last
   std::vector<bool> first;
@@ -729,8 +773,8 @@ std::string JsonFrom(FuzzInput& in) {
           out += HostileNumber(in);
           break;
         case 1:
-          out += std::string(in.Pick({"true", "false", "null", "\"\\ud800\"", "\"\\u0000\"",
-                                      "1e400", "-0", "\"x\""}));
+          out += std::string(in.Pick(
+              {"true", "false", "null", "\"\\ud800\"", "\"\\u0000\"", "1e400", "-0", "\"x\""}));
           break;
         default:
           out += std::to_string(in.Below(1000));

@@ -7,8 +7,7 @@
 #include "parser_targets.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  static const bsls::fuzz::ParserTarget* target =
-      bsls::fuzz::FindParserTarget(BSLS_PARSER_TARGET);
+  static const bsls::fuzz::ParserTarget* target = bsls::fuzz::FindParserTarget(BSLS_PARSER_TARGET);
   if (target == nullptr) {
     std::fprintf(stderr, "no parser target called %s\n", BSLS_PARSER_TARGET);
     std::abort();

@@ -59,13 +59,49 @@ std::vector<std::string> YamlTemplates(const std::string& target) {
 
 // Keys of every YAML file this project reads, for documents made from nothing.
 const std::vector<std::string>& YamlKeys() {
-  static const std::vector<std::string> keys = {
-      "side", "target", "rows", "cols", "pitch_mm", "square_mm", "camera_views", "screen_views",
-      "reference_views", "image", "z_mm", "pattern", "lines", "format", "format_version",
-      "software_version", "width", "height", "camera", "intrinsics", "pose", "projector",
-      "reference", "uncertainty", "listen", "unix_socket", "tcp", "socket_mode", "store", "root",
-      "workers", "queue", "limits", "roles", "admin", "user", "log_level", "framestore",
-      "backend", "slides", "max_frame_pixels", "drain_timeout_ms", "scratch_dir"};
+  static const std::vector<std::string> keys = {"side",
+                                                "target",
+                                                "rows",
+                                                "cols",
+                                                "pitch_mm",
+                                                "square_mm",
+                                                "camera_views",
+                                                "screen_views",
+                                                "reference_views",
+                                                "image",
+                                                "z_mm",
+                                                "pattern",
+                                                "lines",
+                                                "format",
+                                                "format_version",
+                                                "software_version",
+                                                "width",
+                                                "height",
+                                                "camera",
+                                                "intrinsics",
+                                                "pose",
+                                                "projector",
+                                                "reference",
+                                                "uncertainty",
+                                                "listen",
+                                                "unix_socket",
+                                                "tcp",
+                                                "socket_mode",
+                                                "store",
+                                                "root",
+                                                "workers",
+                                                "queue",
+                                                "limits",
+                                                "roles",
+                                                "admin",
+                                                "user",
+                                                "log_level",
+                                                "framestore",
+                                                "backend",
+                                                "slides",
+                                                "max_frame_pixels",
+                                                "drain_timeout_ms",
+                                                "scratch_dir"};
   return keys;
 }
 
@@ -74,8 +110,7 @@ const std::vector<std::string>& YamlKeys() {
 const fs::path& Scratch() {
   static const fs::path dir = [] {
     const char* base = std::getenv("TMPDIR");
-    std::string pattern =
-        std::string(base && *base ? base : "/tmp") + "/bsls_parser_fuzz_XXXXXX";
+    std::string pattern = std::string(base && *base ? base : "/tmp") + "/bsls_parser_fuzz_XXXXXX";
     if (::mkdtemp(pattern.data()) == nullptr) std::abort();
     std::atexit([] {
       std::error_code ec;
@@ -147,8 +182,8 @@ const fs::path& ManifestFolder() {
   static const fs::path dir = [] {
     const fs::path d = Scratch() / "manifest";
     fs::create_directories(d / "sub");
-    for (const char* name : {"t0.png", "t1.png", "t2.png", "s0.png", "s1.png", "s2.png",
-                             "r0.png", "r1.png", "sub/t3.png"})
+    for (const char* name : {"t0.png", "t1.png", "t2.png", "s0.png", "s1.png", "s2.png", "r0.png",
+                             "r1.png", "sub/t3.png"})
       WriteFile(d / name, "");
     return d;
   }();
@@ -168,8 +203,7 @@ bool OneManifest(const std::string& text) {
   }
   std::string why;
   if (!m.target.IsValid(&why)) Violation("LoadManifest", "accepted an invalid target: " + why);
-  if (m.camera_views.size() < 2)
-    Violation("LoadManifest", "accepted fewer than two camera views");
+  if (m.camera_views.size() < 2) Violation("LoadManifest", "accepted fewer than two camera views");
   std::set<double> z;
   for (const auto& v : m.camera_views) z.insert(v.z_mm);
   if (z.size() < 2) Violation("LoadManifest", "accepted camera views all at one z");
@@ -243,9 +277,10 @@ std::vector<std::string> Overrides(FuzzInput& in) {
   for (std::uint32_t i = 0; i < n; ++i) {
     std::string key = in.Pick(YamlKeys());
     if (in.Flip()) key = in.Pick(YamlKeys()) + "." + key;
-    const std::string value = in.Flip() ? std::string(in.Pick({"1", "\"0666\"", "[a, b]", "{x: 1}",
-                                                              "&a [*a]", "", "~", "-1"}))
-                                        : in.Bytes(16);
+    const std::string value =
+        in.Flip()
+            ? std::string(in.Pick({"1", "\"0666\"", "[a, b]", "{x: 1}", "&a [*a]", "", "~", "-1"}))
+            : in.Bytes(16);
     overrides.push_back(key + "=" + value);
   }
   return overrides;
@@ -314,7 +349,8 @@ bool OneProcessdConfig(const std::string& text, const std::vector<std::string>& 
 }
 
 bool RunProcessdConfig(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OneProcessdConfig(std::string(reinterpret_cast<const char*>(data), size), {});
+  const bool accepted =
+      OneProcessdConfig(std::string(reinterpret_cast<const char*>(data), size), {});
   static const std::vector<std::string> templates = YamlTemplates("processd_config");
   FuzzInput in(data, size);
   const std::vector<std::string> overrides = Overrides(in);
@@ -392,9 +428,8 @@ bool OnePng(const std::string& bytes) {
   }
   if (grey.type() != CV_8UC1 || !grey.isContinuous())
     Violation("DecodeGreyFrame", "returned another than a continuous 8-bit grey image");
-  if (grey.cols < limits.min_side || grey.rows < limits.min_side ||
-      grey.cols > limits.max_side || grey.rows > limits.max_side ||
-      static_cast<std::int64_t>(grey.total()) > limits.max_pixels)
+  if (grey.cols < limits.min_side || grey.rows < limits.min_side || grey.cols > limits.max_side ||
+      grey.rows > limits.max_side || static_cast<std::int64_t>(grey.total()) > limits.max_pixels)
     Violation("DecodeGreyFrame", "returned a frame outside its limits");
   return true;
 }

@@ -63,12 +63,12 @@ using grpc::StatusCode;
 using std::chrono::milliseconds;
 using std::chrono::seconds;
 
-constexpr double kAnswerSlackS = 1.0;       // answered within deadline + this
+constexpr double kAnswerSlackS = 1.0;         // answered within deadline + this
 constexpr auto kBusyCheckAfter = seconds(3);  // then no worker busy
-constexpr int kFdSlack = 4;                 // gRPC's own timers and wakeup fds
-constexpr double kRssGrowth = 1.20;         // after a flood, within 20 % of before
-constexpr auto kSettle = seconds(10);       // descriptors and memory may take this long
-constexpr auto kShutdown = seconds(10);     // SIGTERM to exit
+constexpr int kFdSlack = 4;                   // gRPC's own timers and wakeup fds
+constexpr double kRssGrowth = 1.20;           // after a flood, within 20 % of before
+constexpr auto kSettle = seconds(10);         // descriptors and memory may take this long
+constexpr auto kShutdown = seconds(10);       // SIGTERM to exit
 constexpr int kFloodConnections = 200;
 constexpr std::size_t kMaxMessageBytes = 1024;  // an error message echoes a short prefix only
 
@@ -111,14 +111,14 @@ void Send(const std::string& target, const std::vector<Attack>& group) {
   for (const Attack& attack : group)
     for (int i = 0; i < attack.copies; ++i)
       calls.emplace_back(&attack, std::async(std::launch::async, [&target, &attack] {
-                           grpc::GenericStub stub(OwnChannel(target));
-                           return SendRaw(stub, attack.call);
-                         }));
+        grpc::GenericStub stub(OwnChannel(target));
+        return SendRaw(stub, attack.call);
+      }));
   for (auto& [attack, call] : calls) {
     const RawOutcome out = call.get();
     const double limit = attack->call.deadline_ms / 1000.0 + kAnswerSlackS;
-    std::printf("  %-44s status %2d after %6.3f s (limit %4.1f s): %.100s\n",
-                attack->name.c_str(), out.code, out.seconds, limit, out.message.c_str());
+    std::printf("  %-44s status %2d after %6.3f s (limit %4.1f s): %.100s\n", attack->name.c_str(),
+                out.code, out.seconds, limit, out.message.c_str());
     EXPECT_FALSE(out.hung) << attack->name;
     EXPECT_LE(out.seconds, limit) << attack->name << ": answered after " << out.seconds << " s";
     if (!attack->expected.empty()) {
@@ -183,6 +183,7 @@ std::vector<int> TcpFlood(int port, int n) {
   return fds;
 }
 
+// Closes every connection of `fds` and empties it.
 void CloseAll(std::vector<int>* fds) {
   for (const int fd : *fds) ::close(fd);
   fds->clear();
@@ -206,9 +207,8 @@ std::string BlackPng(int side) {
     be32(out, static_cast<std::uint32_t>(data.size()));
     const std::string body = type + data;
     *out += body;
-    be32(out, static_cast<std::uint32_t>(
-                  crc32(0, reinterpret_cast<const Bytef*>(body.data()),
-                        static_cast<uInt>(body.size()))));
+    be32(out, static_cast<std::uint32_t>(crc32(0, reinterpret_cast<const Bytef*>(body.data()),
+                                               static_cast<uInt>(body.size()))));
   };
   std::string png("\x89PNG\r\n\x1a\n", 8);
   std::string ihdr;
@@ -241,6 +241,7 @@ RawCall CalibrateCall(const std::string& manifest,
   return call;
 }
 
+// One request message of `bytes` to `method` ("/bsls.v1.Service/Method").
 RawCall UnaryCall(const std::string& method, const std::string& bytes, int deadline_ms) {
   RawCall call;
   call.method = method;
@@ -286,6 +287,7 @@ std::string PlyTriangle(const std::string& header_extra) {
   return ply;
 }
 
+// A ProcessFrame request of `grey` (8-bit) as a left frame, nothing else asked.
 v1::ProcessFrameRequest FrameRequest(const cv::Mat& grey) {
   v1::ProcessFrameRequest request;
   rpc::ToFrameMessage(grey, request.mutable_frame());
@@ -293,6 +295,8 @@ v1::ProcessFrameRequest FrameRequest(const cv::Mat& grey) {
   return request;
 }
 
+// Protobuf's log handler here: fatal messages only (the malformed bytes make
+// it complain on the client side too).
 void QuietProtobuf(pb::LogLevel level, const char*, int, const std::string& text) {
   if (level >= pb::LOGLEVEL_FATAL) std::fprintf(stderr, "%s\n", text.c_str());
 }
@@ -303,8 +307,8 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
   pb::SetLogHandler(&QuietProtobuf);
   const fs::path folder = MakeTempFolder("bsls_attack_processd_");
   const fs::path socket = folder / "processd.sock";
-  ProcessdProcess processd(BSLS_PROCESSD_PATH, folder, "attack", 2, {}, seconds(120),
-                           "127.0.0.1:0", socket.string());
+  ProcessdProcess processd(BSLS_PROCESSD_PATH, folder, "attack", 2, {}, seconds(120), "127.0.0.1:0",
+                           socket.string());
   ASSERT_TRUE(processd.ready()) << processd.Log();
   const std::string target = processd.address();
   auto info_stub = v1::Processing::NewStub(OwnChannel(target));
@@ -321,9 +325,10 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
   // the allocator's arenas have their working size before the baseline.
   cv::Mat noise(64, 64, CV_8UC1);
   cv::randu(noise, 0, 256);
-  Send(target, {{"warm-up: a small frame", UnaryCall("/bsls.v1.Processing/ProcessFrame",
-                                                     Bytes(FrameRequest(noise)), 20000),
-                 2, {StatusCode::OK, StatusCode::FAILED_PRECONDITION}}});
+  Send(target, {{"warm-up: a small frame",
+                 UnaryCall("/bsls.v1.Processing/ProcessFrame", Bytes(FrameRequest(noise)), 20000),
+                 2,
+                 {StatusCode::OK, StatusCode::FAILED_PRECONDITION}}});
   std::this_thread::sleep_for(seconds(1));
   const int base_fds = OpenDescriptors(processd.pid());
   const long base_rss = ResidentKib(processd.pid());
@@ -340,8 +345,8 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
     EXPECT_EQ(now.busy(), 0u) << name << ": a worker is still busy 3 s after the last answer";
     EXPECT_EQ(now.waiting(), 0u) << name << ": work is still queued 3 s after the last answer";
     const int fds = SettledFds(processd.pid(), base_fds);
-    EXPECT_LE(fds, base_fds + kFdSlack) << name << ": descriptors " << fds << ", baseline "
-                                        << base_fds;
+    EXPECT_LE(fds, base_fds + kFdSlack)
+        << name << ": descriptors " << fds << ", baseline " << base_fds;
     ASSERT_FALSE(processd.exited()) << name << " ended the service\n" << processd.Log();
   };
   // Each group is sent at once: at most six work calls, what the two
@@ -373,15 +378,15 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
     h->set_x(1);
     h->set_y(1);
     v1::MeasureRequest one_byte = no_properties;
-    one_byte.set_surface_ply(
-        PlyTriangle("element junk 18446744073709551615\nproperty uchar a\n"));
+    one_byte.set_surface_ply(PlyTriangle("element junk 18446744073709551615\nproperty uchar a\n"));
     run("YAML calibration files, PLY counts",
         {{"calibration file &a {k: *a}",
           UnaryCall("/bsls.v1.Processing/PutCalibration", Bytes(map_alias), 5000), 2, refused},
          {"calibration file alias bomb",
           UnaryCall("/bsls.v1.Processing/PutCalibration", Bytes(bomb), 5000), 2, refused},
          {"PLY element junk 18446744073709551615",
-          UnaryCall("/bsls.v1.Processing/Measure", Bytes(no_properties), 5000), 2,
+          UnaryCall("/bsls.v1.Processing/Measure", Bytes(no_properties), 5000),
+          2,
           {StatusCode::OK}},
          {"PLY 2^64 - 1 items of one byte",
           UnaryCall("/bsls.v1.Processing/Measure", Bytes(one_byte), 5000), 2, refused}});
@@ -400,12 +405,14 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
     cv::randu(at, 0, 256);
     run("frame at the budget",
         {{"noise frame 2896 x 2896 (at the budget), 1 s",
-          UnaryCall("/bsls.v1.Processing/ProcessFrame", Bytes(FrameRequest(at)), 1000), 2, {}}});
+          UnaryCall("/bsls.v1.Processing/ProcessFrame", Bytes(FrameRequest(at)), 1000),
+          2,
+          {}}});
     run("slow frame",
         {{"hostile frame, deadline 300 ms",
-          UnaryCall("/bsls.v1.Processing/ProcessFrame", Bytes(FrameRequest(HostileFrame())),
-                    300),
-          2, {}}});
+          UnaryCall("/bsls.v1.Processing/ProcessFrame", Bytes(FrameRequest(HostileFrame())), 300),
+          2,
+          {}}});
   }
 
   // Calibration images above the pixel budget: six PNGs of 8192 x 8192.
@@ -424,10 +431,9 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
     std::vector<Attack> malformed;
     for (const char* method : {"ProcessFrame", "ReconstructSession", "Measure", "Calibrate",
                                "PutCalibration", "GetCalibration", "GetServerInfo"})
-      malformed.push_back({std::string("malformed bytes to ") + method,
-                           UnaryCall(std::string("/bsls.v1.Processing/") + method, kMalformed,
-                                     5000),
-                           2, refused});
+      malformed.push_back(
+          {std::string("malformed bytes to ") + method,
+           UnaryCall(std::string("/bsls.v1.Processing/") + method, kMalformed, 5000), 2, refused});
     run("malformed protobuf", malformed);
   }
 
@@ -455,8 +461,10 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
          {"plane model -3, strips 9", UnaryCall(frame, Bytes(plane), 5000), 1, refused},
          {"join 42", UnaryCall("/bsls.v1.Processing/ReconstructSession", Bytes(join), 5000), 1,
           refused},
-         {"calibration id of 60 KB", UnaryCall("/bsls.v1.Processing/GetCalibration", Bytes(id), 5000),
-          1, {StatusCode::INVALID_ARGUMENT, StatusCode::NOT_FOUND}},
+         {"calibration id of 60 KB",
+          UnaryCall("/bsls.v1.Processing/GetCalibration", Bytes(id), 5000),
+          1,
+          {StatusCode::INVALID_ARGUMENT, StatusCode::NOT_FOUND}},
          {"request tag of 60 KB", UnaryCall(frame, Bytes(tag), 5000), 1, refused},
          {"manifest path of 60 KB",
           CalibrateCall("side: left\ncamera_views:\n  - {image: " + std::string(60 << 10, 'p') +
@@ -478,7 +486,9 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
     std::printf("  %s: %zu connections made\n", name.c_str(), flood.size());
     std::this_thread::sleep_for(milliseconds(500));
     Send(target, {{name + ": a caller meanwhile",
-                   UnaryCall("/bsls.v1.Processing/GetServerInfo", "", 2000), 2, {StatusCode::OK}}});
+                   UnaryCall("/bsls.v1.Processing/GetServerInfo", "", 2000),
+                   2,
+                   {StatusCode::OK}}});
     CloseAll(&flood);
     after(name);
     const long rss = SettledRss(processd.pid(), before_rss);
@@ -515,9 +525,9 @@ TEST(AttackSuite, BslsdStaysAliveFreeAndClean) {
   rlimit low = saved;
   low.rlim_cur = 64;
   ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &low), 0);
-  testing::DaemonProcess daemon(dir, config,
-                                {"--set", "listen.max_connections=1000", "--set",
-                                 "listen.max_connections_per_user=1000"});
+  testing::DaemonProcess daemon(
+      dir, config,
+      {"--set", "listen.max_connections=1000", "--set", "listen.max_connections_per_user=1000"});
   ASSERT_EQ(::setrlimit(RLIMIT_NOFILE, &saved), 0);
   ASSERT_TRUE(daemon.ready()) << daemon.Log();
   const std::string target = "unix:" + daemon.socket().string();
@@ -539,8 +549,8 @@ TEST(AttackSuite, BslsdStaysAliveFreeAndClean) {
     EXPECT_TRUE(status_ok(milliseconds(2000))) << name << ": GetStatus not served afterwards";
     EXPECT_LE(Clock::now() - start, milliseconds(2000 + 1000)) << name;
     const int fds = SettledFds(daemon.pid(), base_fds);
-    EXPECT_LE(fds, base_fds + kFdSlack) << name << ": descriptors " << fds << ", baseline "
-                                        << base_fds;
+    EXPECT_LE(fds, base_fds + kFdSlack)
+        << name << ": descriptors " << fds << ", baseline " << base_fds;
   };
   auto run = [&](const std::string& group, const std::vector<Attack>& attacks) {
     SCOPED_TRACE(group);
@@ -638,7 +648,9 @@ TEST(AttackSuite, BslsdStaysAliveFreeAndClean) {
     std::this_thread::sleep_for(milliseconds(300));
     const double cpu_before = CpuSeconds(daemon.pid());
     Send(target, {{"EMFILE flood: a caller meanwhile",
-                   UnaryCall("/bsls.v1.CaptureDaemon/GetStatus", "", 2000), 1, {}}});
+                   UnaryCall("/bsls.v1.CaptureDaemon/GetStatus", "", 2000),
+                   1,
+                   {}}});
     std::this_thread::sleep_for(seconds(3));
     const double cpu = CpuSeconds(daemon.pid()) - cpu_before;
     std::printf("  EMFILE flood: %zu connections, bslsd used %.2f s of CPU in the ~5 s held\n",

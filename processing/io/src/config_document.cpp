@@ -43,8 +43,8 @@ YAML::Node LoadConfigDocument(const std::optional<std::string>& path,
     // another: yaml-cpp would rebind the tree's own node).
     const auto check = [&](const YAML::Node& node, const std::string& prefix) {
       if (node && !node.IsNull() && !node.IsMap())
-        throw ConfigKeyError(prefix, "is not a mapping: override '" + assignment +
-                                         "' cannot set a key inside it");
+        throw ConfigKeyError(
+            prefix, "is not a mapping: override '" + assignment + "' cannot set a key inside it");
     };
     const YAML::Node& readonly = root;
     if (parts.size() >= 2) {
