@@ -670,6 +670,14 @@ std::string ObjFrom(FuzzInput& in) {
 }
 
 std::string PngFrom(FuzzInput& in) {
+  if (in.Below(8) == 7) {  // now and then a PNM, the other format frames come in
+    std::string pnm = std::string(in.Pick({"P5", "P2", "P6", "P3", "P5"})) + "\n";
+    if (in.Flip()) pnm += "# comment\n";
+    pnm += std::to_string(in.Below(8) == 0 ? in.Bits(4) : 16 + in.Below(49)) + " " +
+           std::to_string(in.Below(8) == 0 ? in.Bits(4) : 16 + in.Below(49)) + "\n" +
+           std::string(in.Pick({"255", "65535", "0", "1", "70000"})) + "\n";
+    return pnm + in.Rest();
+  }
   auto side = [&]() -> std::uint32_t {
     switch (in.Below(8)) {
       case 0:  // at and around every limit, and far beyond

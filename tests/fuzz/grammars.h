@@ -42,6 +42,7 @@ std::string ObjFrom(FuzzInput& in);
 // the recipe, from the valid ones mostly, with a correct CRC mostly), PLTE
 // and tRNS when the colour type wants them, IDAT of zlib-compressed scan
 // lines (filter bytes included) for up to 64 rows, sometimes cut short, IEND.
+// One recipe in eight makes a PNM (P2, P3, P5, P6) of any size instead.
 std::string PngFrom(FuzzInput& in);
 
 // A JSON document: objects and arrays nested as the recipe says (deeper than

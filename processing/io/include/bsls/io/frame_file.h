@@ -43,10 +43,12 @@ struct FrameConversion {
   std::string Describe() const;
 };
 
-// Reads an image file as an 8-bit grey frame (CV_8UC1). Colour is converted
-// to grey and 16-bit to 8-bit (scaled by 1/257); `conversion` says what was
-// done. Throws InputError naming the file for a missing, unreadable, empty,
-// truncated or undecodable file, or a size outside `limits` (sides or pixels).
+// Reads an image file, PNG or PNM (P2, P3, P5, P6), as an 8-bit grey frame
+// (CV_8UC1); its size is checked against `limits` from its header, before
+// anything is decoded. Colour is converted to grey and 16-bit to 8-bit
+// (scaled by 1/257); `conversion` says what was done. Throws InputError
+// naming the file for a missing, unreadable, empty, truncated or undecodable
+// file, another format, or a size outside `limits` (sides or pixels).
 cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion = nullptr,
                       const FrameLimits& limits = {});
 
