@@ -1,11 +1,12 @@
 #include "parser_targets.h"
 
-#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -105,18 +106,41 @@ const std::vector<std::string>& YamlKeys() {
   return keys;
 }
 
-// A private scratch folder for the targets that read files, made once and
-// removed at exit.
+// A private scratch folder for the targets that read files:
+// $TMPDIR/bsls_parser_fuzz.<pid>, removed at a normal exit. libFuzzer ends
+// its runs with _Exit (no atexit handlers), so each run first removes the
+// folders of this user's earlier runs whose process is gone.
 const fs::path& Scratch() {
   static const fs::path dir = [] {
     const char* base = std::getenv("TMPDIR");
-    std::string pattern = std::string(base && *base ? base : "/tmp") + "/bsls_parser_fuzz_XXXXXX";
-    if (::mkdtemp(pattern.data()) == nullptr) std::abort();
+    const fs::path root = base && *base ? base : "/tmp";
+    constexpr std::string_view kPrefix = "bsls_parser_fuzz.";
+    std::error_code ec;
+    std::vector<fs::path> stale;
+    for (fs::directory_iterator it(root, ec), end; !ec && it != end; it.increment(ec)) {
+      const std::string name = it->path().filename().string();
+      if (name.rfind(kPrefix, 0) != 0) continue;
+      const std::string pid = name.substr(kPrefix.size());
+      struct stat st {};
+      if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos ||
+          ::lstat(it->path().c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != ::geteuid())
+        continue;
+      std::error_code gone;
+      if (!fs::exists("/proc/" + pid, gone)) stale.push_back(it->path());
+    }
+    for (const fs::path& old : stale) fs::remove_all(old, ec);
+    const fs::path d = root / (std::string(kPrefix) + std::to_string(::getpid()));
+    fs::remove_all(d, ec);
+    if (::mkdir(d.c_str(), 0700) != 0) std::abort();
+    // The handler runs after `dir` is destroyed: it keeps its own copy, in
+    // storage that has no destructor.
+    static char removed_at_exit[4096];
+    std::snprintf(removed_at_exit, sizeof removed_at_exit, "%s", d.c_str());
     std::atexit([] {
-      std::error_code ec;
-      fs::remove_all(Scratch(), ec);
+      std::error_code ignored;
+      fs::remove_all(removed_at_exit, ignored);
     });
-    return fs::path(pattern);
+    return d;
   }();
   return dir;
 }
