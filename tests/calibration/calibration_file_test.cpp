@@ -296,6 +296,23 @@ TEST_F(CalibrationFile, WrongTypeIsNamed) {
       << list;
 }
 
+// Found by the calibration-file fuzz target (issue 26): a list item written
+// as a value (camera.views: [a, b]) threw yaml-cpp's BadSubscript out of
+// CalibrationFromYaml; bsls-processd answered such a calibration with
+// INTERNAL instead of INVALID_ARGUMENT.
+TEST_F(CalibrationFile, AValueWhereAMappingBelongsIsNamed) {
+  const std::string text = Text();
+  const std::size_t views = text.find("  views:\n");
+  ASSERT_NE(views, std::string::npos);
+  const std::size_t end = text.find("\nprojector:", views);
+  ASSERT_NE(end, std::string::npos);
+  std::string damaged = text;
+  damaged.replace(views, end - views, "  views: [a.png, b.png]");
+  const std::string what = LoadError(damaged);
+  EXPECT_NE(what.find("'camera.views[0]' must be a mapping with 'image'"), std::string::npos)
+      << what;
+}
+
 TEST_F(CalibrationFile, NonFiniteNumberIsRefused) {
   const std::string what = LoadError(Replaced("intrinsics: {fx: ", "intrinsics: {fx: .nan, x: "));
   EXPECT_NE(what.find("'camera.intrinsics.fx' is not a finite number"), std::string::npos) << what;

@@ -100,6 +100,26 @@ TEST_F(ManifestFiles, BadManifestsSayWhy) {
   EXPECT_NE(e.find("manifest.yaml"), std::string::npos) << e;
 }
 
+// Found by the manifest fuzz target (issue 26): a field that should be a
+// mapping but is a scalar or a list threw yaml-cpp's BadSubscript ("operator[]
+// call on a scalar"), which bsls-processd answered with INTERNAL.
+TEST_F(ManifestFiles, ScalarsWhereMappingsBelongSayWhy) {
+  std::string text = kGood;
+  std::string target = text;
+  target.replace(target.find("{rows: 8, cols: 8, pitch_mm: 6.5, square_mm: 4.0}"), 48, "5");
+  EXPECT_NE(Error(target).find("target: expected a mapping with 'rows'"), std::string::npos)
+      << Error(target);
+  std::string view = text;
+  view.replace(view.find("{image: t0.png, z_mm: 0}"), 24, "t0.png");
+  EXPECT_NE(Error(view).find("camera_views[0]: expected a mapping with 'image'"),
+            std::string::npos)
+      << Error(view);
+  std::string pattern = text;
+  pattern.replace(pattern.find("{lines: 20, rows: 24}"), 21, "[20, 24]");
+  EXPECT_NE(Error(pattern).find("pattern: expected a mapping with 'lines'"), std::string::npos)
+      << Error(pattern);
+}
+
 TEST(Manifest, MissingFileIsNamed) {
   try {
     LoadManifest("/nonexistent/session/manifest.yaml");

@@ -1,7 +1,7 @@
 // libFuzzer target: arbitrary bytes through the frame loader and the decoder.
-// Byte 0 chooses the path: even = the bytes are an image file (any format
-// OpenCV reads), odd = raw 8-bit pixels of a small frame whose size and side
-// come from bytes 1-3. Bit 2 of byte 0 chooses the decoding chain (skeleton
+// Byte 0 chooses the path: even = the bytes are an image file (PNG or PNM;
+// others are refused), odd = raw 8-bit pixels of a small frame whose size
+// and side come from bytes 1-3. Bit 2 of byte 0 chooses the decoding chain (skeleton
 // or tracks). Neither path may crash, hang or leak; errors are fine.
 #include <cstddef>
 #include <cstdint>

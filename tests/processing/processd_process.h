@@ -84,7 +84,8 @@ inline double CpuSeconds(pid_t pid) {
 }
 
 // One bsls-processd replica: `--socket "" --tcp 127.0.0.1:0` with plain
-// loopback TCP, `--workers`, `--replica`, plus `extra` arguments. Its stdout
+// loopback TCP (and a Unix socket too when `socket` is given), `--workers`,
+// `--replica`, plus `extra` arguments. Its stdout
 // and stderr go to <folder>/<replica>.log (a file, never a pipe that could
 // fill up and stall the replica).
 class ProcessdProcess : public bsls::testing::ChildProcess {
@@ -95,11 +96,11 @@ class ProcessdProcess : public bsls::testing::ChildProcess {
   ProcessdProcess(const std::string& binary, const fs::path& folder, const std::string& replica,
                   int workers, const std::vector<std::string>& extra = {},
                   std::chrono::seconds timeout = std::chrono::seconds(120),
-                  const std::string& tcp = "127.0.0.1:0")
+                  const std::string& tcp = "127.0.0.1:0", const std::string& socket = "")
       : name_(replica), log_(folder / (replica + ".log")) {
     std::vector<std::string> argv = {binary,
                                      "--socket",
-                                     "",
+                                     socket,
                                      "--tcp",
                                      tcp,
                                      "--workers",

@@ -101,8 +101,11 @@ class Reader {
 
   YAML::Node Child(const YAML::Node& node, const std::string& key, const std::string& where,
                    bool map = true) const {
-    const YAML::Node child = node[key];
     const std::string path = where.empty() ? key : where + "." + key;
+    // A list item written as a value, or a value where a mapping belongs:
+    // yaml-cpp's operator[] would throw its own BadSubscript.
+    if (!node.IsMap()) Fail("", "'" + where + "' must be a mapping with '" + key + "'");
+    const YAML::Node child = node[key];
     if (!child) Fail("", "missing key '" + path + "'");
     if (map && !child.IsMap()) Fail("", "'" + path + "' must be a mapping");
     return child;

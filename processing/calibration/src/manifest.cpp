@@ -12,9 +12,13 @@
 namespace bsls::calibration {
 namespace {
 
-// Reads `key` of `node` as T; throws ManifestError naming the field.
+// Reads `key` of `node` as T; throws ManifestError naming the field. A
+// `node` that is not a mapping (`target: 5`, a view written as a bare path)
+// is a ManifestError too: yaml-cpp's operator[] on a scalar or a sequence
+// would throw its own BadSubscript.
 template <typename T>
 T Required(const YAML::Node& node, const std::string& key, const std::string& where) {
+  if (!node.IsMap()) throw ManifestError(where + ": expected a mapping with '" + key + "'");
   const YAML::Node value = node[key];
   if (!value) throw ManifestError(where + ": missing field '" + key + "'");
   try {

@@ -62,11 +62,12 @@ bool Fail(std::string* error, const std::string& why) {
 }
 
 // Reads a listed image as 8-bit grey of the session's size (the first image
-// read sets it).
-cv::Mat LoadView(const ManifestView& view, const std::string& name, int* width, int* height) {
+// read sets it), within `limits`.
+cv::Mat LoadView(const ManifestView& view, const std::string& name, const io::FrameLimits& limits,
+                 int* width, int* height) {
   cv::Mat grey;
   try {
-    grey = io::LoadGreyFrame(view.image.string());
+    grey = io::LoadGreyFrame(view.image.string(), nullptr, limits);
   } catch (const io::InputError& e) {
     Throw(CalibrationErrorReason::kUnreadableInput, "calibration: " + std::string(e.what()));
   }
@@ -317,7 +318,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
     const ManifestView& view = manifest.camera_views[i];
     const std::string name = ViewName(view, ViewKind::kCamera, i);
     begin_view(name);
-    const cv::Mat grey = LoadView(view, name, &width, &height);
+    const cv::Mat grey = LoadView(view, name, params.images, &width, &height);
     const TargetDetection detection = DetectTarget(grey, manifest.target, params.target);
     if (!detection.ok) {
       drop(view, ViewKind::kCamera, i, "target not found: " + detection.error);
@@ -370,7 +371,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
     const ManifestView& view = manifest.screen_views[i];
     const std::string name = ViewName(view, ViewKind::kScreen, i);
     begin_view(name);
-    const cv::Mat grey = LoadView(view, name, &width, &height);
+    const cv::Mat grey = LoadView(view, name, params.images, &width, &height);
     decoder::DecodeResult result = decoder::Decode(grey, manifest.side, decode, cancel);
     if (!result.ok) {
       drop(view, ViewKind::kScreen, i, "the brick pattern could not be decoded: " + result.error);
@@ -443,7 +444,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
     const ManifestView& view = manifest.reference_views[i];
     const std::string name = ViewName(view, ViewKind::kReference, i);
     begin_view(name);
-    const cv::Mat grey = LoadView(view, name, &width, &height);
+    const cv::Mat grey = LoadView(view, name, params.images, &width, &height);
     std::string cross_why;
     const auto cross = FindReferenceCross(grey, params.cross, &cross_why);
     if (!cross) {

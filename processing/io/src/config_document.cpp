@@ -36,6 +36,23 @@ YAML::Node LoadConfigDocument(const std::optional<std::string>& path,
     std::vector<std::string> parts;
     std::stringstream stream(key);
     for (std::string part; std::getline(stream, part, '.');) parts.push_back(part);
+    // Every level above the last must be a mapping (or absent, then made
+    // one): yaml-cpp's operator[] on a value or a list throws its own
+    // BadSubscript, which reached bslsd's main uncaught. Read through const
+    // nodes, which add nothing to the tree (and never assign one node to
+    // another: yaml-cpp would rebind the tree's own node).
+    const auto check = [&](const YAML::Node& node, const std::string& prefix) {
+      if (node && !node.IsNull() && !node.IsMap())
+        throw ConfigKeyError(
+            prefix, "is not a mapping: override '" + assignment + "' cannot set a key inside it");
+    };
+    const YAML::Node& readonly = root;
+    if (parts.size() >= 2) {
+      const YAML::Node first = readonly[parts[0]];
+      check(first, parts[0]);
+      if (parts.size() >= 3 && first && first.IsMap())
+        check(first[parts[1]], parts[0] + "." + parts[1]);
+    }
     // yaml-cpp nodes are references: index the path in one expression.
     if (parts.size() == 1) {
       root[parts[0]] = value;

@@ -686,9 +686,11 @@ Status ProcessingService::Calibrate(
                      "folder)");
       }
     calibration::SideCalibration result;
+    calibration::SideCalibrationParams params;
+    params.images.max_pixels = options_.max_frame_pixels;  // images are frames: the same budget
     try {
-      result =
-          calibration::CalibrateSide(manifest, {}, [&w](const std::string& view, double fraction) {
+      result = calibration::CalibrateSide(
+          manifest, params, [&w](const std::string& view, double fraction) {
             if (w.observer.cancelled && w.observer.cancelled()) return false;
             w.observer.Report("calibrate " + view, 0.05 + 0.9 * fraction);
             return true;

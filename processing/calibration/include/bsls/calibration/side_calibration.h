@@ -67,6 +67,7 @@
 #include "bsls/calibration/target_detect.h"
 #include "bsls/decoder/decoder.h"
 #include "bsls/geometry/pinhole_model.h"
+#include "bsls/io/frame_file.h"
 #include "bsls/pattern/brick_pattern.h"
 
 namespace bsls::calibration {
@@ -90,6 +91,10 @@ struct SideCalibrationParams {
   // (all at distinct z): two depths determine each light plane (two lines of
   // it), a third gives it a residual. Cross views, when any are listed: two
   // determine the reference ray, which fixes every screen view's rows.
+  // The views' images (io::LoadGreyFrame): bsls-processd sets max_pixels to
+  // its frame budget (max_frame_pixels), so an upload cannot make it decode
+  // and search images larger than the frames it takes.
+  io::FrameLimits images;
   int min_camera_views = 3;                 // >= 2
   int min_screen_views = 3;                 // >= 2
   int min_reference_views = 2;              // >= 2

@@ -3,6 +3,7 @@
 #ifndef BSLS_IO_FRAME_FILE_H_
 #define BSLS_IO_FRAME_FILE_H_
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -27,6 +28,10 @@ class OutputError : public std::runtime_error {
 struct FrameLimits {
   int min_side = 16;     // px: smaller frames cannot hold the pattern
   int max_side = 16384;  // px: larger ones are refused as absurd
+  // width x height: the largest frame the processing API carries (4096 x
+  // 4096). A PNG's header is checked against it before anything is decoded
+  // or allocated (a 16384 x 16384 16-bit RGBA header claims 2 GiB).
+  std::int64_t max_pixels = std::int64_t{4096} * 4096;
 };
 
 // What LoadGreyFrame had to do to the file's pixels, for the user to know.
@@ -38,10 +43,12 @@ struct FrameConversion {
   std::string Describe() const;
 };
 
-// Reads an image file as an 8-bit grey frame (CV_8UC1). Colour is converted
-// to grey and 16-bit to 8-bit (scaled by 1/257); `conversion` says what was
-// done. Throws InputError naming the file for a missing, unreadable, empty,
-// truncated or undecodable file, or a size outside `limits`.
+// Reads an image file, PNG or PNM (P2, P3, P5, P6), as an 8-bit grey frame
+// (CV_8UC1); its size is checked against `limits` from its header, before
+// anything is decoded. Colour is converted to grey and 16-bit to 8-bit
+// (scaled by 1/257); `conversion` says what was done. Throws InputError
+// naming the file for a missing, unreadable, empty, truncated or undecodable
+// file, another format, or a size outside `limits` (sides or pixels).
 cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion = nullptr,
                       const FrameLimits& limits = {});
 
