@@ -191,12 +191,21 @@ bool OneYaml(const std::string& text) {
   return true;
 }
 
-bool RunYaml(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OneYaml(std::string(reinterpret_cast<const char*>(data), size));
-  static const std::vector<std::string> templates = YamlTemplates("yaml");
+// The raw bytes through `one`, then the same bytes read as a recipe by
+// `grammar` (a structured input) through `one` again; whether the raw bytes
+// were accepted (the seed replay's verdict).
+template <typename One, typename Grammar>
+bool RawThenGrammar(const std::uint8_t* data, std::size_t size, One one, Grammar grammar) {
+  const bool accepted = one(std::string(reinterpret_cast<const char*>(data), size));
   FuzzInput in(data, size);
-  OneYaml(YamlFrom(in, templates, YamlKeys()));
+  one(grammar(in));
   return accepted;
+}
+
+bool RunYaml(const std::uint8_t* data, std::size_t size) {
+  static const std::vector<std::string> templates = YamlTemplates("yaml");
+  return RawThenGrammar(data, size, OneYaml,
+                        [](FuzzInput& in) { return YamlFrom(in, templates, YamlKeys()); });
 }
 
 // ------------------------------------------------------------------ manifest
@@ -243,11 +252,9 @@ bool OneManifest(const std::string& text) {
 }
 
 bool RunManifest(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OneManifest(std::string(reinterpret_cast<const char*>(data), size));
   static const std::vector<std::string> templates = YamlTemplates("manifest");
-  FuzzInput in(data, size);
-  OneManifest(YamlFrom(in, templates, YamlKeys()));
-  return accepted;
+  return RawThenGrammar(data, size, OneManifest,
+                        [](FuzzInput& in) { return YamlFrom(in, templates, YamlKeys()); });
 }
 
 // ------------------------------------------------------------------ calibration file
@@ -285,11 +292,9 @@ bool OneCalibration(const std::string& text) {
 }
 
 bool RunCalibration(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OneCalibration(std::string(reinterpret_cast<const char*>(data), size));
   static const std::vector<std::string> templates = YamlTemplates("calibration");
-  FuzzInput in(data, size);
-  OneCalibration(YamlFrom(in, templates, YamlKeys()));
-  return accepted;
+  return RawThenGrammar(data, size, OneCalibration,
+                        [](FuzzInput& in) { return YamlFrom(in, templates, YamlKeys()); });
 }
 
 // ------------------------------------------------------------------ service configurations
@@ -402,10 +407,7 @@ bool OnePly(const std::string& bytes) {
 }
 
 bool RunPly(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OnePly(std::string(reinterpret_cast<const char*>(data), size));
-  FuzzInput in(data, size);
-  OnePly(PlyFrom(in));
-  return accepted;
+  return RawThenGrammar(data, size, OnePly, [](FuzzInput& in) { return PlyFrom(in); });
 }
 
 // ------------------------------------------------------------------ OBJ
@@ -431,10 +433,7 @@ bool OneObj(const std::string& text) {
 }
 
 bool RunObj(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OneObj(std::string(reinterpret_cast<const char*>(data), size));
-  FuzzInput in(data, size);
-  OneObj(ObjFrom(in));
-  return accepted;
+  return RawThenGrammar(data, size, OneObj, [](FuzzInput& in) { return ObjFrom(in); });
 }
 
 // ------------------------------------------------------------------ PNG frames
@@ -459,10 +458,7 @@ bool OnePng(const std::string& bytes) {
 }
 
 bool RunPng(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OnePng(std::string(reinterpret_cast<const char*>(data), size));
-  FuzzInput in(data, size);
-  OnePng(PngFrom(in));
-  return accepted;
+  return RawThenGrammar(data, size, OnePng, [](FuzzInput& in) { return PngFrom(in); });
 }
 
 // ------------------------------------------------------------------ JSON
@@ -481,10 +477,7 @@ bool OneJson(const std::string& text) {
 }
 
 bool RunJson(const std::uint8_t* data, std::size_t size) {
-  const bool accepted = OneJson(std::string(reinterpret_cast<const char*>(data), size));
-  FuzzInput in(data, size);
-  OneJson(JsonFrom(in));
-  return accepted;
+  return RawThenGrammar(data, size, OneJson, [](FuzzInput& in) { return JsonFrom(in); });
 }
 
 }  // namespace
