@@ -36,6 +36,20 @@ namespace fs = std::filesystem;
   throw ContractViolation(std::string(parser) + ": " + how);
 }
 
+// What `parse` returns, or nullopt where it refused with `Refusal`, the
+// parser's own error; any other exception breaks the parser's contract.
+template <typename Refusal, typename Parse>
+auto ParsedOrRefused(const char* parser, const char* refusal, Parse parse)
+    -> std::optional<decltype(parse())> {
+  try {
+    return parse();
+  } catch (const Refusal&) {
+    return std::nullopt;
+  } catch (const std::exception& e) {
+    Violation(parser, std::string("threw another error than ") + refusal + ": " + e.what());
+  }
+}
+
 // The seeds of `target` that load as plain YAML within the default limits:
 // the templates of its YAML grammar. Read once.
 std::vector<std::string> YamlTemplates(const std::string& target) {
@@ -226,14 +240,10 @@ const fs::path& ManifestFolder() {
 bool OneManifest(const std::string& text) {
   const fs::path path = ManifestFolder() / "manifest.yaml";
   WriteFile(path, text);
-  calibration::Manifest m;
-  try {
-    m = calibration::LoadManifest(path);
-  } catch (const calibration::ManifestError&) {
-    return false;
-  } catch (const std::exception& e) {
-    Violation("LoadManifest", std::string("threw another error than ManifestError: ") + e.what());
-  }
+  const auto loaded = ParsedOrRefused<calibration::ManifestError>(
+      "LoadManifest", "ManifestError", [&] { return calibration::LoadManifest(path); });
+  if (!loaded) return false;
+  const calibration::Manifest& m = *loaded;
   std::string why;
   if (!m.target.IsValid(&why)) Violation("LoadManifest", "accepted an invalid target: " + why);
   if (m.camera_views.size() < 2) Violation("LoadManifest", "accepted fewer than two camera views");
@@ -260,15 +270,11 @@ bool RunManifest(const std::uint8_t* data, std::size_t size) {
 // ------------------------------------------------------------------ calibration file
 
 bool OneCalibration(const std::string& text) {
-  calibration::CalibrationRecord record;
-  try {
-    record = calibration::CalibrationFromYaml(text, "fuzz.yaml");
-  } catch (const calibration::CalibrationFileError&) {
-    return false;
-  } catch (const std::exception& e) {
-    Violation("CalibrationFromYaml",
-              std::string("threw another error than CalibrationFileError: ") + e.what());
-  }
+  const auto loaded = ParsedOrRefused<calibration::CalibrationFileError>(
+      "CalibrationFromYaml", "CalibrationFileError",
+      [&] { return calibration::CalibrationFromYaml(text, "fuzz.yaml"); });
+  if (!loaded) return false;
+  const calibration::CalibrationRecord& record = *loaded;
   const calibration::SideCalibration& c = record.calibration;
   if (record.format_version != calibration::kCalibrationFormatVersion)
     Violation("CalibrationFromYaml", "accepted another format version");
@@ -354,15 +360,11 @@ bool RunBslsdConfig(const std::uint8_t* data, std::size_t size) {
 bool OneProcessdConfig(const std::string& text, const std::vector<std::string>& overrides) {
   const fs::path path = Scratch() / "processd.yaml";
   WriteFile(path, text);
-  processd::Config config;
-  try {
-    config = processd::LoadConfig(path.string(), overrides);
-  } catch (const processd::ConfigError&) {
-    return false;
-  } catch (const std::exception& e) {
-    Violation("processd::LoadConfig",
-              std::string("threw another error than ConfigError: ") + e.what());
-  }
+  const auto loaded = ParsedOrRefused<processd::ConfigError>(
+      "processd::LoadConfig", "ConfigError",
+      [&] { return processd::LoadConfig(path.string(), overrides); });
+  if (!loaded) return false;
+  const processd::Config& config = *loaded;
   if (processd::Workers(config) < 1) Violation("processd::LoadConfig", "accepted no worker");
   if (config.max_frame_pixels < 512 * 512 || config.max_frame_pixels > 4096 * 4096)
     Violation("processd::LoadConfig", "accepted a pixel budget outside [512^2, 4096^2]");
@@ -390,14 +392,10 @@ bool RunProcessdConfig(const std::uint8_t* data, std::size_t size) {
 // ------------------------------------------------------------------ PLY
 
 bool OnePly(const std::string& bytes) {
-  geometry::SurfaceMesh mesh;
-  try {
-    mesh = io::DecodePly(bytes, "fuzz.ply");
-  } catch (const io::InputError&) {
-    return false;
-  } catch (const std::exception& e) {
-    Violation("DecodePly", std::string("threw another error than InputError: ") + e.what());
-  }
+  const auto loaded = ParsedOrRefused<io::InputError>(
+      "DecodePly", "InputError", [&] { return io::DecodePly(bytes, "fuzz.ply"); });
+  if (!loaded) return false;
+  const geometry::SurfaceMesh& mesh = *loaded;
   std::string why;
   if (!mesh.IsValid(&why)) Violation("DecodePly", "returned an invalid mesh: " + why);
   // Every vertex and every triangle of a fan takes at least a byte of the body.
@@ -415,14 +413,10 @@ bool RunPly(const std::uint8_t* data, std::size_t size) {
 bool OneObj(const std::string& text) {
   const fs::path path = Scratch() / "mesh.obj";
   WriteFile(path, text);
-  simulator::IndexedMesh mesh;
-  try {
-    mesh = simulator::LoadObj(path);
-  } catch (const simulator::MeshLoadError&) {
-    return false;
-  } catch (const std::exception& e) {
-    Violation("LoadObj", std::string("threw another error than MeshLoadError: ") + e.what());
-  }
+  const auto loaded = ParsedOrRefused<simulator::MeshLoadError>(
+      "LoadObj", "MeshLoadError", [&] { return simulator::LoadObj(path); });
+  if (!loaded) return false;
+  const simulator::IndexedMesh& mesh = *loaded;
   const auto n = static_cast<int>(mesh.vertices.size());
   for (const auto& t : mesh.triangles)
     for (const int i : t)
@@ -441,14 +435,11 @@ bool RunObj(const std::uint8_t* data, std::size_t size) {
 bool OnePng(const std::string& bytes) {
   const std::vector<unsigned char> buffer(bytes.begin(), bytes.end());
   const io::FrameLimits limits;  // what the services and the CLI read frames with
-  cv::Mat grey;
-  try {
-    grey = io::DecodeGreyFrame(buffer, "fuzz.png", nullptr, limits);
-  } catch (const io::InputError&) {
-    return false;
-  } catch (const std::exception& e) {
-    Violation("DecodeGreyFrame", std::string("threw another error than InputError: ") + e.what());
-  }
+  const auto loaded = ParsedOrRefused<io::InputError>("DecodeGreyFrame", "InputError", [&] {
+    return io::DecodeGreyFrame(buffer, "fuzz.png", nullptr, limits);
+  });
+  if (!loaded) return false;
+  const cv::Mat& grey = *loaded;
   if (grey.type() != CV_8UC1 || !grey.isContinuous())
     Violation("DecodeGreyFrame", "returned another than a continuous 8-bit grey image");
   if (grey.cols < limits.min_side || grey.rows < limits.min_side || grey.cols > limits.max_side ||

@@ -30,21 +30,28 @@ TEST(FrameFile, APngWithinTheLimitsIsRead) {
   EXPECT_EQ(cv::countNonZero(grey != 7), 0);
 }
 
-TEST(FrameFile, APngClaimingAHugeSizeIsRefusedFromItsHeader) {
-  // A real PNG whose header is changed to claim 200000 x 200000 pixels
-  // (40 GB as 8-bit grey); its CRC no longer matches, so only a check of
-  // the header can name the size.
+// The refusal's message for a real 32 x 32 PNG whose header is changed to
+// claim `side` x `side` pixels and is read as `name`; its CRC no longer
+// matches, so only a check of the header can name the size. Empty (and a
+// failure) when it was decoded.
+std::string RefusalOfAPngClaiming(std::uint32_t side, const std::string& name) {
   std::vector<unsigned char> bytes = Png(cv::Mat(32, 32, CV_8UC1, cv::Scalar(0)));
-  PutBe32(&bytes, 16, 200000);
-  PutBe32(&bytes, 20, 200000);
+  PutBe32(&bytes, 16, side);
+  PutBe32(&bytes, 20, side);
   try {
-    (void)DecodeGreyFrame(bytes, "bomb.png");
-    FAIL() << "a PNG claiming 200000 x 200000 was decoded";
+    (void)DecodeGreyFrame(bytes, name);
   } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("bomb.png"), std::string::npos) << what;
-    EXPECT_NE(what.find("200000x200000"), std::string::npos) << what;
+    return e.what();
   }
+  ADD_FAILURE() << "a PNG claiming " << side << " x " << side << " was decoded";
+  return "";
+}
+
+TEST(FrameFile, APngClaimingAHugeSizeIsRefusedFromItsHeader) {
+  // 200000 x 200000 pixels: 40 GB as 8-bit grey.
+  const std::string what = RefusalOfAPngClaiming(200000, "bomb.png");
+  EXPECT_NE(what.find("bomb.png"), std::string::npos) << what;
+  EXPECT_NE(what.find("200000x200000"), std::string::npos) << what;
 }
 
 TEST(FrameFile, LimitsAreTheCallersOwn) {
@@ -56,24 +63,15 @@ TEST(FrameFile, LimitsAreTheCallersOwn) {
   EXPECT_EQ(DecodeGreyFrame(bytes, "big.png", nullptr, limits).cols, 600);
 }
 
-// Issue 26: sides within max_side (16384) still allowed 268 Mpx, 2 GiB
-// allocated for a 16-bit RGBA header; bsls-processd read calibration images
-// up to that size whatever its frame budget. The pixel count is a limit of
-// its own, checked on the header too.
+// Sides within max_side (16384) would still allow 268 Mpx (2 GiB for a
+// 16-bit RGBA header), whatever a service's frame budget: the pixel count
+// is a limit of its own, checked on the header too.
 TEST(FrameFile, APngAboveThePixelBudgetIsRefusedFromItsHeader) {
-  std::vector<unsigned char> bytes = Png(cv::Mat(32, 32, CV_8UC1, cv::Scalar(0)));
-  PutBe32(&bytes, 16, 16384);
-  PutBe32(&bytes, 20, 16384);
-  try {
-    (void)DecodeGreyFrame(bytes, "wide.png");
-    FAIL() << "a PNG claiming 16384 x 16384 was decoded";
-  } catch (const InputError& e) {
-    const std::string what = e.what();
-    EXPECT_NE(what.find("wide.png: size 16384x16384 = 268435456 pixels is above the budget of "
-                        "16777216"),
-              std::string::npos)
-        << what;
-  }
+  const std::string what = RefusalOfAPngClaiming(16384, "wide.png");
+  EXPECT_NE(what.find("wide.png: size 16384x16384 = 268435456 pixels is above the budget of "
+                      "16777216"),
+            std::string::npos)
+      << what;
   const std::vector<unsigned char> real = Png(cv::Mat(300, 300, CV_8UC1, cv::Scalar(1)));
   FrameLimits limits;
   limits.max_pixels = 300 * 300 - 1;
