@@ -8,6 +8,7 @@ packages=(
   # toolchain and build
   build-essential cmake ninja-build ccache pkg-config git
   clang libclang-rt-14-dev          # libFuzzer and the sanitizer runtimes
+  clang-format                      # the style check (tests/style)
   # processing library
   libopencv-dev
   libeigen3-dev

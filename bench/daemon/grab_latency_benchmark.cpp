@@ -61,8 +61,8 @@ std::unique_ptr<Running> Start(Backend backend, benchmark::State& state) {
     return nullptr;
   }
   running->daemon = std::move(started).value();
-  running->stub = v1::CaptureDaemon::NewStub(grpc::CreateChannel(
-      "unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials()));
+  running->stub = v1::CaptureDaemon::NewStub(
+      grpc::CreateChannel("unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials()));
   return running;
 }
 
@@ -135,13 +135,25 @@ void BM_GrabBothThroughTheDaemon(benchmark::State& state) {
 constexpr int kSimulated = static_cast<int>(Backend::kSimulated);
 constexpr int kEmulatedIsa = static_cast<int>(Backend::kEmulatedIsa);
 
-BENCHMARK(BM_GrabBothFromTheDevice)->Arg(kSimulated)->Iterations(60)->UseManualTime()
+BENCHMARK(BM_GrabBothFromTheDevice)
+    ->Arg(kSimulated)
+    ->Iterations(60)
+    ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_GrabBothThroughTheDaemon)->Arg(kSimulated)->Iterations(60)->UseManualTime()
+BENCHMARK(BM_GrabBothThroughTheDaemon)
+    ->Arg(kSimulated)
+    ->Iterations(60)
+    ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_GrabBothFromTheDevice)->Arg(kEmulatedIsa)->Iterations(20)->UseManualTime()
+BENCHMARK(BM_GrabBothFromTheDevice)
+    ->Arg(kEmulatedIsa)
+    ->Iterations(20)
+    ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_GrabBothThroughTheDaemon)->Arg(kEmulatedIsa)->Iterations(20)->UseManualTime()
+BENCHMARK(BM_GrabBothThroughTheDaemon)
+    ->Arg(kEmulatedIsa)
+    ->Iterations(20)
+    ->UseManualTime()
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -14,9 +14,9 @@
 #include <vector>
 
 #include "bsls/decoder/decoder.h"
+#include "bsls/simulator/evaluation.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
-#include "bsls/simulator/evaluation.h"
 
 namespace {
 
@@ -47,7 +47,8 @@ void BM_Method(benchmark::State& state) {
   for (auto _ : state) {
     const auto t = std::chrono::steady_clock::now();
     r = bsls::decoder::Decode(frame.image, Side::kLeft, params);
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
+    ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count());
   }
   std::vector<bsls::simulator::PointLabel> decoded;
   for (const auto& j : r.junctions) decoded.push_back({j.p, j.q, j.position});
@@ -55,20 +56,23 @@ void BM_Method(benchmark::State& state) {
       bsls::simulator::ScoreLabels(bsls::simulator::VisibleJunctions(frame.truth), decoded, 2.5);
   std::vector<bsls::simulator::LinePoints> decoded_lines;
   for (const auto& line : r.lines) decoded_lines.push_back({line.p, line.points});
-  const auto lines = bsls::simulator::ScoreLines(bsls::simulator::TruthLines(frame.truth), decoded_lines);
+  const auto lines =
+      bsls::simulator::ScoreLines(bsls::simulator::TruthLines(frame.truth), decoded_lines);
   std::nth_element(ms.begin(), ms.begin() + ms.size() / 2, ms.end());
   state.counters["recall"] = score.Recall();
   state.counters["wrong"] = score.Wrong();
   state.counters["centre_rms_px"] = lines.rms;
   state.counters["median_ms"] = ms[ms.size() / 2];
   state.SetLabel(std::string(method == ExtractionMethod::kModern ? "modern " : "thesis ") +
-                 std::string(bsls::simulator::ToString(kind)) + (r.ok ? "" : " FAILED: " + r.error));
+                 std::string(bsls::simulator::ToString(kind)) +
+                 (r.ok ? "" : " FAILED: " + r.error));
 }
 
 }  // namespace
 
 BENCHMARK(BM_Method)
-    ->ArgsProduct({{static_cast<int>(ExtractionMethod::kModern), static_cast<int>(ExtractionMethod::kThesis)},
+    ->ArgsProduct({{static_cast<int>(ExtractionMethod::kModern),
+                    static_cast<int>(ExtractionMethod::kThesis)},
                    {static_cast<int>(SurfaceKind::kPlane), static_cast<int>(SurfaceKind::kBall),
                     static_cast<int>(SurfaceKind::kFace)}})
     ->Unit(benchmark::kMillisecond)

@@ -144,11 +144,16 @@ void Report(SurfaceKind kind, Side side, std::uint32_t seed, const Options& o, T
   const auto t0 = std::chrono::steady_clock::now();
   bsls::decoder::DecodeParams decode;
   decode.chain = o.chain;
-  if (const char* v = std::getenv("BSLS_TRACK_STEP")) decode.track_chain.tracks.max_step = std::atof(v);
-  if (const char* v = std::getenv("BSLS_TRACK_SIGMA")) decode.track_chain.smoothing_sigma = std::atof(v);
-  if (const char* v = std::getenv("BSLS_TRACK_PROMINENCE")) decode.track_chain.ridge.min_prominence = std::atoi(v);
-  if (const char* v = std::getenv("BSLS_TRACK_WINDOW")) decode.track_chain.ridge.half_window = std::atoi(v);
-  if (const char* v = std::getenv("BSLS_TRACK_SEGCOLS")) decode.track_chain.segment_columns = std::atoi(v);
+  if (const char* v = std::getenv("BSLS_TRACK_STEP"))
+    decode.track_chain.tracks.max_step = std::atof(v);
+  if (const char* v = std::getenv("BSLS_TRACK_SIGMA"))
+    decode.track_chain.smoothing_sigma = std::atof(v);
+  if (const char* v = std::getenv("BSLS_TRACK_PROMINENCE"))
+    decode.track_chain.ridge.min_prominence = std::atoi(v);
+  if (const char* v = std::getenv("BSLS_TRACK_WINDOW"))
+    decode.track_chain.ridge.half_window = std::atoi(v);
+  if (const char* v = std::getenv("BSLS_TRACK_SEGCOLS"))
+    decode.track_chain.segment_columns = std::atoi(v);
   if (const char* v = std::getenv("BSLS_TRACK_FITROWS")) decode.junction_fit_rows = std::atoi(v);
   const bsls::decoder::DecodeResult r = bsls::decoder::Decode(frame.image, side, decode);
   const double ms =
@@ -238,8 +243,8 @@ int main(int argc, char** argv) {
       o.extra = true;
     } else if (a == "--crops" && i + 1 < argc) {
       o.crops = argv[++i];
-    } else if (a == "--chain" && i + 1 < argc && (std::string(argv[i + 1]) == "tracks" ||
-                                                  std::string(argv[i + 1]) == "skeleton")) {
+    } else if (a == "--chain" && i + 1 < argc &&
+               (std::string(argv[i + 1]) == "tracks" || std::string(argv[i + 1]) == "skeleton")) {
       o.chain = std::string(argv[++i]) == "tracks" ? bsls::decoder::DecodeChain::kTracks
                                                    : bsls::decoder::DecodeChain::kSkeleton;
     } else {

@@ -23,12 +23,12 @@
 // ratio = whole / decode alone, serial_decode_ms (the two decodes one after
 // the other) and goal_ratio = whole / 10 ms (the goal: a quarter of one 40 ms camera frame).
 #include <benchmark/benchmark.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 #include <vector>
 
 #include "bsls/calibration/manifest.h"
@@ -129,8 +129,8 @@ const bsls::calibration::SideCalibration& Calibration(bsls::pattern::Side side) 
     const fs::path folder = fs::temp_directory_path() /
                             ("bsls_bench_session_" + std::string(bsls::pattern::ToString(s)) + "_" +
                              std::to_string(::getpid()));
-    bsls::simulator::WriteCalibrationSession(
-        bsls::simulator::SimulateCalibrationSession(s, {}), folder);
+    bsls::simulator::WriteCalibrationSession(bsls::simulator::SimulateCalibrationSession(s, {}),
+                                             folder);
     const bsls::calibration::SideCalibration c = bsls::calibration::CalibrateSide(
         bsls::calibration::LoadManifest(folder / bsls::simulator::kSessionManifestName));
     std::error_code ec;

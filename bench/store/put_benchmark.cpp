@@ -55,8 +55,7 @@ double Percentile(std::vector<double> values, double fraction) {
 
 // A store in `root` without a free-space reserve; on failure the benchmark
 // is marked skipped with the reason.
-Result<std::unique_ptr<CaptureStore>> OpenStore(const std::string& root,
-                                               benchmark::State& state) {
+Result<std::unique_ptr<CaptureStore>> OpenStore(const std::string& root, benchmark::State& state) {
   CaptureStoreOptions options;
   options.root = root;
   options.free_space_reserve_bytes = 0;

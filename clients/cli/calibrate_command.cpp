@@ -47,8 +47,8 @@ void RunCalibrateRemote(const CalibrateOptions& o) {
                                                    ? fs::path(".")
                                                    : fs::path(o.manifest).parent_path());
   std::vector<processing::UploadFile> files;
-  for (const auto* views : {&manifest.camera_views, &manifest.screen_views,
-                            &manifest.reference_views})
+  for (const auto* views :
+       {&manifest.camera_views, &manifest.screen_views, &manifest.reference_views})
     for (const calibration::ManifestView& view : *views) {
       const fs::path image = fs::weakly_canonical(view.image);
       const fs::path relative = image.lexically_relative(folder);
@@ -59,9 +59,9 @@ void RunCalibrateRemote(const CalibrateOptions& o) {
       files.push_back({relative.generic_string(), ReadInputFile(image.string(), "image")});
     }
   processing::ProcessingClient client = OpenProcessingClient(o.server);
-  const processing::WorkOutcome out = client.Calibrate(
-      ReadInputFile(o.manifest, "manifest"), files, o.manifest.substr(0, 256),
-      ProgressPrinter(o.quiet));
+  const processing::WorkOutcome out =
+      client.Calibrate(ReadInputFile(o.manifest, "manifest"), files, o.manifest.substr(0, 256),
+                       ProgressPrinter(o.quiet));
   CheckWork(out.status, o.manifest, o.server);
   const nlohmann::json report = nlohmann::json::parse(out.files.at("calibration-report.json"));
   if (!o.report.empty()) io::WriteFileAtomically(o.report, out.files.at("calibration-report.json"));
@@ -164,7 +164,8 @@ void AddCalibrateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", opts->output, "Output calibration file (YAML)")->required();
   cmd->add_option("--report", opts->report, "Also write the figures as JSON");
   cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
-  cmd->add_flag("--json", opts->json, "Print the figures as one JSON object instead of the summary");
+  cmd->add_flag("--json", opts->json,
+                "Print the figures as one JSON object instead of the summary");
   AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunCalibrate(*opts); });
 }

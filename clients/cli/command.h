@@ -13,10 +13,9 @@
 #ifndef BSLS_CLIENTS_CLI_COMMAND_H_
 #define BSLS_CLIENTS_CLI_COMMAND_H_
 
+#include <CLI/CLI.hpp>
 #include <stdexcept>
 #include <string>
-
-#include <CLI/CLI.hpp>
 
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/reconstruction/side_pipeline.h"

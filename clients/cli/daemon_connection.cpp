@@ -104,8 +104,8 @@ std::shared_ptr<grpc::Channel> OpenChannel(const ServiceAddress& address) {
                                        " is TCP, which is mutual TLS only: give --tls-ca, "
                                        "--tls-cert and --tls-key");
   try {
-    return grpc::CreateCustomChannel(address.target, rpc::MutualTlsChannelCredentials(TlsOf(address)),
-                                     args);
+    return grpc::CreateCustomChannel(address.target,
+                                     rpc::MutualTlsChannelCredentials(TlsOf(address)), args);
   } catch (const rpc::TlsFileError& e) {
     throw CommandError(kExitInput, e.what());
   }

@@ -352,8 +352,7 @@ void AddDeviceCommands(CLI::App& app) {
       }
     }
     CheckCall(reader->Finish(), "GetCaptureResult", options->address);
-    if (!damage.empty())
-      throw CommandError(kExitServiceFailed, "GetCaptureResult: " + damage);
+    if (!damage.empty()) throw CommandError(kExitServiceFailed, "GetCaptureResult: " + damage);
     MakeFolder(results_args->out);
     for (const auto& [name, bytes] : assembler.files()) {
       const std::string path = results_args->out + "/" + name;
@@ -387,10 +386,9 @@ void AddDeviceCommands(CLI::App& app) {
     bool show = false;
   };
   auto preview_args = std::make_shared<PreviewArgs>();
-  CLI::App* preview =
-      AddDeviceCommand(app, "preview",
-                       "live frames of one camera, written as PNG files or shown in a window",
-                       *options);
+  CLI::App* preview = AddDeviceCommand(
+      app, "preview", "live frames of one camera, written as PNG files or shown in a window",
+      *options);
   preview->add_option("--camera", preview_args->camera, "left, right or third (default: selected)")
       ->check(CLI::IsMember({"left", "right", "third"}));
   preview->add_option("--frames", preview_args->frames, "how many frames to take")

@@ -6,9 +6,8 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <string>
-
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "bsls/io/frame_file.h"
 #include "bsls/simulator/evaluation.h"
@@ -40,14 +39,14 @@ nlohmann::json ReadJson(const std::string& path) {
 // line's centre points are its "points" or its "samples" (whose first two
 // values are x and the row). `what` names the kind of file in errors.
 void ReadLabels(const std::string& path, const char* what,
-                          std::vector<simulator::PointLabel>* junctions,
-                          std::vector<simulator::LinePoints>* lines) {
+                std::vector<simulator::PointLabel>* junctions,
+                std::vector<simulator::LinePoints>* lines) {
   const nlohmann::json j = ReadJson(path);
   try {
     for (const auto& k : j.at("junctions")) {
       const int row = k.contains("q") ? k.at("q").get<int>() : k.at("v").get<int>();
-      junctions->push_back({k.at("p").get<int>(), row,
-                            {k.at("x").get<double>(), k.at("y").get<double>()}});
+      junctions->push_back(
+          {k.at("p").get<int>(), row, {k.at("x").get<double>(), k.at("y").get<double>()}});
     }
     for (const auto& l : j.at("lines")) {
       simulator::LinePoints line{l.at("p").get<int>(), {}};
@@ -68,19 +67,26 @@ void RunEvaluate(const EvaluateOptions& o) {
   const simulator::LabelScore score = simulator::ScoreLabels(truth, decoded, o.reach);
   const simulator::LineScore lines = simulator::ScoreLines(truth_lines, decoded_lines);
   if (o.json) {
-    const nlohmann::json out = {{"truth", score.truth},       {"found", score.found},
-                                {"recall", score.Recall()},   {"right", score.Right()},
-                                {"right_recall", score.RightRecall()}, {"wrong_p", score.wrong_p},
-                                {"wrong_q", score.wrong_v},   {"unmatched", score.unmatched},
-                                {"q_offset", score.v_offset}, {"junction_rms_px", score.position_rms},
-                                {"line_points", lines.points}, {"line_rms_px", lines.rms}};
+    const nlohmann::json out = {{"truth", score.truth},
+                                {"found", score.found},
+                                {"recall", score.Recall()},
+                                {"right", score.Right()},
+                                {"right_recall", score.RightRecall()},
+                                {"wrong_p", score.wrong_p},
+                                {"wrong_q", score.wrong_v},
+                                {"unmatched", score.unmatched},
+                                {"q_offset", score.v_offset},
+                                {"junction_rms_px", score.position_rms},
+                                {"line_points", lines.points},
+                                {"line_rms_px", lines.rms}};
     std::cout << out.dump() << "\n";
     return;
   }
-  std::printf("junctions: %d of %d found (%.1f %%), %d wrong p, %d wrong q, %d not in the truth, "
-              "position RMS %.3f px\nlines: %d points, centre RMS %.3f px\n",
-              score.found, score.truth, 100.0 * score.Recall(), score.wrong_p, score.wrong_v,
-              score.unmatched, score.position_rms, lines.points, lines.rms);
+  std::printf(
+      "junctions: %d of %d found (%.1f %%), %d wrong p, %d wrong q, %d not in the truth, "
+      "position RMS %.3f px\nlines: %d points, centre RMS %.3f px\n",
+      score.found, score.truth, 100.0 * score.Recall(), score.wrong_p, score.wrong_v,
+      score.unmatched, score.position_rms, lines.points, lines.rms);
 }
 
 }  // namespace
@@ -89,8 +95,10 @@ void AddEvaluateCommand(CLI::App& app) {
   auto opts = std::make_shared<EvaluateOptions>();
   CLI::App* cmd = app.add_subcommand(
       "evaluate", "Score decoded junctions and lines against a simulated frame's ground truth");
-  cmd->add_option("JUNCTIONS", opts->junctions, "Output of bsls process (contracts JSON)")->required();
-  cmd->add_option("TRUTH", opts->truth, "Ground truth written by bsls simulate --truth")->required();
+  cmd->add_option("JUNCTIONS", opts->junctions, "Output of bsls process (contracts JSON)")
+      ->required();
+  cmd->add_option("TRUTH", opts->truth, "Ground truth written by bsls simulate --truth")
+      ->required();
   cmd->add_option("--reach", opts->reach, "Largest distance (px) of a match (default 2.5)")
       ->check(CLI::Range(0.1, 50.0));
   cmd->add_flag("--json", opts->json, "Print the scores as one JSON object");

@@ -1,8 +1,8 @@
 // bsls measure: clinical figures on a reconstructed surface (thesis 7.2):
 // heights above the base plane, straight and along-the-surface distances,
 // areas of regions, and lumps or cavities against a reference surface fitted
-// around them or against an earlier scan of the same face (--baseline). Every figure comes with its 1-sigma uncertainty; a plain table
-// goes to stdout and, on request, a JSON report to a file.
+// around them or against an earlier scan of the same face (--baseline). Every figure comes with its
+// 1-sigma uncertainty; a plain table goes to stdout and, on request, a JSON report to a file.
 //
 // Points and regions are world (x, y) in millimetres (contracts section 3): a
 // point is "X,Y"; a region is a closed polygon "X,Y X,Y X,Y ..." (>= 3 points).
@@ -107,8 +107,9 @@ void RunMeasureRemote(const MeasureOptions& o, const measurement::MeasurementPla
   processing::ProcessingClient client = OpenProcessingClient(o.server);
   const processing::WorkOutcome out = client.Measure(request, ProgressPrinter(true));
   CheckWork(out.status, o.surface, o.server);
-  nlohmann::json report = {{"surface", o.surface},
-                           {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
+  nlohmann::json report = {
+      {"surface", o.surface},
+      {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
   nlohmann::json measured = nlohmann::json::parse(out.files.at("measurements.json"));
   // The service's table has 2 decimals; the rows give the figures for ours.
   std::vector<measurement::ReportRow> rows;
@@ -146,8 +147,8 @@ void RunMeasure(const MeasureOptions& o) {
       throw CommandError(kExitUsage, "--distance \"" + d + "\": give two points \"X,Y X,Y\"");
     plan.distances.push_back({points[0], points[1]});
   }
-  for (const auto& [texts, regions, option] :
-       {std::tuple{&o.areas, &plan.areas, "--area"}, std::tuple{&o.lesions, &plan.lesions, "--lesion"}})
+  for (const auto& [texts, regions, option] : {std::tuple{&o.areas, &plan.areas, "--area"},
+                                               std::tuple{&o.lesions, &plan.lesions, "--lesion"}})
     for (const std::string& text : *texts) {
       regions->push_back(ParsePoints(text, option));
       if (regions->back().size() < 3)
@@ -167,8 +168,9 @@ void RunMeasure(const MeasureOptions& o) {
   } catch (const measurement::MeasurementError& e) {
     throw CommandError(kExitNotProcessed, o.surface + ": " + e.what());
   }
-  nlohmann::json report = {{"surface", o.surface},
-                           {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
+  nlohmann::json report = {
+      {"surface", o.surface},
+      {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
   report.update(outcome.report);
   if (!o.json.empty()) io::WriteFileAtomically(o.json, report.dump(2) + "\n");
   std::cout << measurement::FormatTable(outcome.rows, o.decimals);

@@ -80,7 +80,8 @@ namespace {
 void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   if (o.geometric_setup)
     throw CommandError(kExitUsage, "--geometric-setup runs here only: drop --server");
-  if (!o.skeleton.empty()) throw CommandError(kExitUsage, "--skeleton runs here only: drop --server");
+  if (!o.skeleton.empty())
+    throw CommandError(kExitUsage, "--skeleton runs here only: drop --server");
   io::FrameConversion conversion;
   const cv::Mat frame = io::LoadGreyFrame(o.image, &conversion);
   if (conversion.converted())
@@ -96,9 +97,10 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   request.mutable_decode()->set_method(o.method == "thesis" ? v1::DecodeOptions::METHOD_THESIS
                                                             : v1::DecodeOptions::METHOD_MODERN);
   request.mutable_decode()->set_no_repair(o.no_repair);
-  request.mutable_decode()->set_chain(o.chain == "tracks"     ? v1::DecodeOptions::CHAIN_TRACKS
-                                      : o.chain == "skeleton" ? v1::DecodeOptions::CHAIN_SKELETON
-                                                              : v1::DecodeOptions::CHAIN_UNSPECIFIED);
+  request.mutable_decode()->set_chain(o.chain == "tracks" ? v1::DecodeOptions::CHAIN_TRACKS
+                                      : o.chain == "skeleton"
+                                          ? v1::DecodeOptions::CHAIN_SKELETON
+                                          : v1::DecodeOptions::CHAIN_UNSPECIFIED);
   ApplySurfaceChoices(o.surface_choices, request.mutable_surface());
   request.mutable_surface()->set_ascii_ply(o.ascii);
   request.set_request_tag(o.image.substr(0, 256));
@@ -129,15 +131,17 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
                         {"replica", out.result.replica()},
                         {"attempts", out.attempts}};
     if (!o.surface.empty())
-      j["surface"] = {{"vertices", s.vertices()}, {"triangles", s.triangles()},
+      j["surface"] = {{"vertices", s.vertices()},
+                      {"triangles", s.triangles()},
                       {"bridged", s.bridged_samples()}};
     std::cout << j.dump() << "\n";
   } else {
-    std::printf("%s (%s): %u junctions (%u interpolated, %u unlabelled) on %u lines, %u repairs, "
-                "q %s, %.1f ms on %s\n",
-                o.image.c_str(), o.side.c_str(), s.junctions(), s.interpolated_junctions(),
-                s.unlabelled_junctions(), s.lines(), s.repairs(), s.q_absolute() ? "absolute" : "relative", total_ms,
-                out.result.replica().c_str());
+    std::printf(
+        "%s (%s): %u junctions (%u interpolated, %u unlabelled) on %u lines, %u repairs, "
+        "q %s, %.1f ms on %s\n",
+        o.image.c_str(), o.side.c_str(), s.junctions(), s.interpolated_junctions(),
+        s.unlabelled_junctions(), s.lines(), s.repairs(), s.q_absolute() ? "absolute" : "relative",
+        total_ms, out.result.replica().c_str());
     if (!o.surface.empty())
       std::printf("%s: %u vertices (%u bridged), %u triangles\n", o.surface.c_str(), s.vertices(),
                   s.bridged_samples(), s.triangles());
@@ -155,8 +159,8 @@ void RunProcess(const ProcessOptions& o) {
     throw CommandError(kExitUsage, "--calibration and --geometric-setup exclude each other");
   if (!o.server.target.empty()) return RunProcessRemote(o, *side);
   reconstruction::SidePipelineParams params;
-  params.decode.extraction.method =
-      o.method == "thesis" ? extraction::ExtractionMethod::kThesis : extraction::ExtractionMethod::kModern;
+  params.decode.extraction.method = o.method == "thesis" ? extraction::ExtractionMethod::kThesis
+                                                         : extraction::ExtractionMethod::kModern;
   params.decode.interpretation.enable_repair = !o.no_repair;
   std::optional<decoder::DecodeChain> named;
   if (o.chain == "tracks") named = decoder::DecodeChain::kTracks;
@@ -178,7 +182,8 @@ void RunProcess(const ProcessOptions& o) {
   }
 
   cv::Mat frame;
-  const reconstruction::SideOutcome outcome = ProcessFrame(o.image, *side, geometry, params, &frame);
+  const reconstruction::SideOutcome outcome =
+      ProcessFrame(o.image, *side, geometry, params, &frame);
   const decoder::DecodeResult& result = outcome.decode;
   // The skeleton helps to see why a frame failed, so it is written either way.
   if (!o.skeleton.empty() && !result.skeleton.empty())
@@ -211,17 +216,19 @@ void RunProcess(const ProcessOptions& o) {
                         {"interpretation_ms", result.times.interpretation_ms},
                         {"subpixel_ms", result.times.subpixel_ms}};
     if (outcome.surface)
-      s["surface"] = {{"vertices", r.vertices},         {"triangles", r.triangles},
-                      {"bridged", r.bridged_samples},   {"dropped_samples", r.dropped_samples},
-                      {"junctions", r.junctions},       {"junctions_by_projector", r.junctions_by_projector},
-                      {"time_ms", r.time_ms}};
+      s["surface"] = {
+          {"vertices", r.vertices},       {"triangles", r.triangles},
+          {"bridged", r.bridged_samples}, {"dropped_samples", r.dropped_samples},
+          {"junctions", r.junctions},     {"junctions_by_projector", r.junctions_by_projector},
+          {"time_ms", r.time_ms}};
     std::cout << s.dump() << "\n";
   } else {
-    std::printf("%s (%s): %zu junctions (%d interpolated, %zu unlabelled) on %zu lines, %d repairs, "
-                "q %s, %.1f ms\n",
-                o.image.c_str(), o.side.c_str(), result.junctions.size(), interpolated,
-                result.unlabelled.size(), result.lines.size(), result.repairs, result.q_absolute ? "absolute" : "relative",
-                result.times.total_ms);
+    std::printf(
+        "%s (%s): %zu junctions (%d interpolated, %zu unlabelled) on %zu lines, %d repairs, "
+        "q %s, %.1f ms\n",
+        o.image.c_str(), o.side.c_str(), result.junctions.size(), interpolated,
+        result.unlabelled.size(), result.lines.size(), result.repairs,
+        result.q_absolute ? "absolute" : "relative", result.times.total_ms);
     if (outcome.surface)
       std::printf("%s: %d vertices (%d bridged), %d triangles, %.1f ms\n", o.surface.c_str(),
                   r.vertices, r.bridged_samples, r.triangles, r.time_ms);
@@ -237,12 +244,15 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_option("IMAGE", opts->image, "Frame to decode (8-bit grey PNG; others are converted)")
       ->required();
   cmd->add_option("--side", opts->side, "Side of the face: left or right")->required();
-  cmd->add_option("--junctions", opts->junctions, "Output JSON of junctions and lines (contracts 5)")
+  cmd->add_option("--junctions", opts->junctions,
+                  "Output JSON of junctions and lines (contracts 5)")
       ->required();
   cmd->add_option("--overlay", opts->overlay, "Output PNG with the lines coloured by p");
-  cmd->add_option("--skeleton", opts->skeleton, "Output PNG of what was traced: the repaired one-pixel skeleton, or the "
+  cmd->add_option("--skeleton", opts->skeleton,
+                  "Output PNG of what was traced: the repaired one-pixel skeleton, or the "
                   "track chain's tracks");
-  cmd->add_option("--method", opts->method, "Skeleton chain's feature extraction: modern (default) or thesis")
+  cmd->add_option("--method", opts->method,
+                  "Skeleton chain's feature extraction: modern (default) or thesis")
       ->check(CLI::IsMember({"modern", "thesis"}));
   cmd->add_option("--chain", opts->chain,
                   "Decoding chain: tracks (default: ridge points linked into tracks) or "
@@ -258,7 +268,8 @@ void AddProcessCommand(CLI::App& app) {
                 "Tables 2.1/2.2 (a fallback: millimetres only as good as those distances)");
   AddSurfaceChoices(cmd, &opts->surface_choices);
   cmd->add_flag("--ascii", opts->ascii, "Write an ASCII PLY instead of binary");
-  cmd->add_flag("--no-repair", opts->no_repair, "Skeleton chain: label what is seen; seal no discontinuity");
+  cmd->add_flag("--no-repair", opts->no_repair,
+                "Skeleton chain: label what is seen; seal no discontinuity");
   cmd->add_flag("--json", opts->json_summary, "Print the summary as one JSON object");
   cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
   AddServerOptions(*cmd, opts->server);

@@ -15,8 +15,8 @@
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"
-#include "bsls/session/session.h"
 #include "bsls/rpc/frame_message.h"
+#include "bsls/session/session.h"
 #include "command.h"
 #include "daemon_connection.h"
 #include "surface_choices.h"
@@ -82,8 +82,8 @@ void RunReconstructRemote(const ReconstructOptions& o) {
   v1::ReconstructSessionRequest request;
   rpc::ToFrameMessage(LoadFrame(o.left_image), request.mutable_left());
   rpc::ToFrameMessage(LoadFrame(o.right_image), request.mutable_right());
-  *request.mutable_left_calibration() = processing::ProcessingClient::Inline(
-      ReadInputFile(o.left_calibration, "--calibration-left"));
+  *request.mutable_left_calibration() =
+      processing::ProcessingClient::Inline(ReadInputFile(o.left_calibration, "--calibration-left"));
   *request.mutable_right_calibration() = processing::ProcessingClient::Inline(
       ReadInputFile(o.right_calibration, "--calibration-right"));
   request.set_join(o.join == "shared"     ? v1::ReconstructSessionRequest::JOIN_SHARED
@@ -145,9 +145,9 @@ void RunReconstruct(const ReconstructOptions& o) {
         {session::SessionPart::kJoin, o.left_image + " + " + o.right_image},
         {session::SessionPart::kMeasurements, o.left_image + " + " + o.right_image}};
     const std::string subject = subjects.at(e.part());
-    throw CommandError(e.reason() == session::SessionErrorReason::kInvalidInput ? kExitInput
-                                                                                : kExitNotProcessed,
-                       subject + ": " + e.what());
+    throw CommandError(
+        e.reason() == session::SessionErrorReason::kInvalidInput ? kExitInput : kExitNotProcessed,
+        subject + ": " + e.what());
   }
   for (const auto* side : {&s.left, &s.right})
     if (!side->decode.q_absolute)

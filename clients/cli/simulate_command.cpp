@@ -1,7 +1,7 @@
 // bsls simulate: render frames of the projected pattern on a simulated
 // surface, with their exact ground truth.
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <sstream>
 #include <string>

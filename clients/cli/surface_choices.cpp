@@ -6,14 +6,16 @@ void AddSurfaceChoices(CLI::App* cmd, SurfaceChoices* choices) {
   cmd->add_option("--plane-model", choices->plane_model,
                   "Light planes: perspective (thesis 6.2.2, default) or parallel (6.2.1)")
       ->check(CLI::IsMember({"perspective", "parallel"}));
-  cmd->add_option("--strips", choices->strips,
-                  "Mesh strips: stitched (the samples facing each other, default; "
-                  "docs/reconstruction.md) or rows (the samples of the same image row, thesis 5.2.1)")
+  cmd->add_option(
+         "--strips", choices->strips,
+         "Mesh strips: stitched (the samples facing each other, default; "
+         "docs/reconstruction.md) or rows (the samples of the same image row, thesis 5.2.1)")
       ->check(CLI::IsMember({"rows", "stitched"}));
   cmd->add_flag("--smooth", choices->smooth, "Smooth along each line (thesis eq. 5.32) first");
 }
 
-void ApplySurfaceChoices(const SurfaceChoices& choices, reconstruction::SidePipelineParams* params) {
+void ApplySurfaceChoices(const SurfaceChoices& choices,
+                         reconstruction::SidePipelineParams* params) {
   params->planes = choices.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
                                                      : reconstruction::PlaneModelKind::kPerspective;
   params->reconstruction.mesh.strips = choices.strips == "rows"
@@ -27,7 +29,7 @@ void ApplySurfaceChoices(const SurfaceChoices& choices, v1::SurfaceOptions* opti
                                ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL
                                : v1::SurfaceOptions::PLANE_MODEL_PERSPECTIVE);
   options->set_strips(choices.strips == "rows" ? v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS
-                                              : v1::SurfaceOptions::STRIP_METHOD_STITCHED);
+                                               : v1::SurfaceOptions::STRIP_METHOD_STITCHED);
   options->set_smooth_lines(choices.smooth);
 }
 

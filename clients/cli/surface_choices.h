@@ -5,9 +5,8 @@
 #ifndef BSLS_CLIENTS_CLI_SURFACE_CHOICES_H_
 #define BSLS_CLIENTS_CLI_SURFACE_CHOICES_H_
 
-#include <string>
-
 #include <CLI/CLI.hpp>
+#include <string>
 
 #include "bsls/reconstruction/side_pipeline.h"
 #include "bsls/v1/processing.pb.h"

@@ -62,7 +62,8 @@ class SimulatedVideo {
     picture->pixels.resize(static_cast<std::size_t>(grabbed->width) * grabbed->height);
     for (int y = 0; y < grabbed->height; ++y)
       std::copy_n(grabbed->pixels.begin() + static_cast<std::ptrdiff_t>(y) * grabbed->stride,
-                  grabbed->width, picture->pixels.begin() + static_cast<std::ptrdiff_t>(y) * grabbed->width);
+                  grabbed->width,
+                  picture->pixels.begin() + static_cast<std::ptrdiff_t>(y) * grabbed->width);
     last_ = picture;
     last_input_ = input;
     last_frame_ = frame;
@@ -115,7 +116,7 @@ Result<PrivilegedDevices> OpenPrivileged(const Config& config) {
 }
 
 Result<std::unique_ptr<slides::SlideController>> OpenSlides(const Config& config,
-                                                           service::EventHub* events) {
+                                                            service::EventHub* events) {
   std::unique_ptr<slides::GpioLines> lines;
   switch (config.slides.backend) {
     case SlideBackend::kNone:

@@ -27,7 +27,7 @@ framestore::Result<PrivilegedDevices> OpenPrivileged(const Config& config);
 // The configured slide controller (nullptr for slides.backend none); its
 // state changes are published on `events`.
 framestore::Result<std::unique_ptr<slides::SlideController>> OpenSlides(const Config& config,
-                                                                         service::EventHub* events);
+                                                                        service::EventHub* events);
 
 // The configured framestore. The simulated backends show the slide that
 // `slides` has in place (when given).

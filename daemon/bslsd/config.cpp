@@ -4,13 +4,13 @@
 #include <pwd.h>
 #include <yaml-cpp/yaml.h>
 
-#include "bsls/io/config_document.h"
-#include "bsls/rpc/tls.h"
-
 #include <cstdio>
 #include <filesystem>
 #include <set>
 #include <sstream>
+
+#include "bsls/io/config_document.h"
+#include "bsls/rpc/tls.h"
 
 namespace bsls::bslsd {
 
@@ -32,8 +32,8 @@ void Read(const YAML::Node& parent, const std::string& where, const char* key, T
 }
 
 template <typename Number>
-void ReadInRange(const YAML::Node& parent, const std::string& where, const char* key,
-                 Number& out, Number min, Number max) {
+void ReadInRange(const YAML::Node& parent, const std::string& where, const char* key, Number& out,
+                 Number min, Number max) {
   io::ReadKeyInRange(parent, where, key, out, min, max);
 }
 
@@ -50,13 +50,19 @@ void ParseFramestore(const YAML::Node& node, FramestoreConfig& out) {
   if (!node) return;
   if (node["backend"]) {
     const std::string backend = node["backend"].as<std::string>();
-    if (backend == "simulated") out.backend = Backend::kSimulated;
-    else if (backend == "isa") out.backend = Backend::kIsa;
-    else if (backend == "emulated-isa") out.backend = Backend::kEmulatedIsa;
-    else if (backend == "usb") out.backend = Backend::kUsb;
-    else if (backend == "emulated-usb") out.backend = Backend::kEmulatedUsb;
-    else Fail("framestore.backend",
-              "'" + backend + "' is not simulated, isa, emulated-isa, usb or emulated-usb");
+    if (backend == "simulated")
+      out.backend = Backend::kSimulated;
+    else if (backend == "isa")
+      out.backend = Backend::kIsa;
+    else if (backend == "emulated-isa")
+      out.backend = Backend::kEmulatedIsa;
+    else if (backend == "usb")
+      out.backend = Backend::kUsb;
+    else if (backend == "emulated-usb")
+      out.backend = Backend::kEmulatedUsb;
+    else
+      Fail("framestore.backend",
+           "'" + backend + "' is not simulated, isa, emulated-isa, usb or emulated-usb");
   }
   int base = out.isa_base;
   ReadInRange(node, "framestore", "isa_base", base, 0x100, 0x3FC);
@@ -71,8 +77,8 @@ void ParseFramestore(const YAML::Node& node, FramestoreConfig& out) {
 }
 
 void ParseStore(const YAML::Node& node, store::CaptureStoreOptions& out) {
-  OnlyKeys(node, "store", {"root", "reserve_mib", "max_total_mib", "max_age_days",
-                           "verify_hashes_on_open"});
+  OnlyKeys(node, "store",
+           {"root", "reserve_mib", "max_total_mib", "max_age_days", "verify_hashes_on_open"});
   if (!node) return;
   Read(node, "store", "root", out.root);
   std::uint64_t reserve = out.free_space_reserve_bytes >> 20;
@@ -83,8 +89,8 @@ void ParseStore(const YAML::Node& node, store::CaptureStoreOptions& out) {
   out.retention.max_total_bytes = total ? std::optional<std::uint64_t>(total << 20) : std::nullopt;
   int days = out.retention.max_age ? static_cast<int>(out.retention.max_age->count() / 86400) : 0;
   ReadInRange(node, "store", "max_age_days", days, 0, 100000);
-  out.retention.max_age = days ? std::optional<std::chrono::seconds>(std::chrono::hours(24) * days)
-                               : std::nullopt;
+  out.retention.max_age =
+      days ? std::optional<std::chrono::seconds>(std::chrono::hours(24) * days) : std::nullopt;
   Read(node, "store", "verify_hashes_on_open", out.verify_hashes_on_open);
 }
 
@@ -134,8 +140,8 @@ void ParseListen(const YAML::Node& node, ListenConfig& out) {
 void ParseRoles(const YAML::Node& node, RolesConfig& out) {
   OnlyKeys(node, "roles", {"admin", "operator", "viewer", "others", "certificates"});
   if (!node) return;
-  for (service::Role role : {service::Role::kViewer, service::Role::kOperator,
-                             service::Role::kAdmin}) {
+  for (service::Role role :
+       {service::Role::kViewer, service::Role::kOperator, service::Role::kAdmin}) {
     const std::string key(service::ToString(role));
     if (!node[key]) continue;
     if (!node[key].IsSequence()) Fail("roles." + key, "must be a list of user names and @groups");
@@ -146,7 +152,8 @@ void ParseRoles(const YAML::Node& node, RolesConfig& out) {
     if (!certs.IsMap()) Fail("roles.certificates", "must map certificate names to roles");
     for (const auto& item : certs) {
       const std::string name = item.first.as<std::string>();
-      out.certificates[name] = RoleFrom("roles.certificates." + name, item.second.as<std::string>());
+      out.certificates[name] =
+          RoleFrom("roles.certificates." + name, item.second.as<std::string>());
     }
   }
 }
@@ -180,10 +187,14 @@ void ParseSlides(const YAML::Node& node, SlidesConfig& out) {
   if (!node) return;
   if (node["backend"]) {
     const std::string backend = node["backend"].as<std::string>();
-    if (backend == "none") out.backend = SlideBackend::kNone;
-    else if (backend == "simulated") out.backend = SlideBackend::kSimulated;
-    else if (backend == "gpio") out.backend = SlideBackend::kGpio;
-    else Fail("slides.backend", "'" + backend + "' is not none, simulated or gpio");
+    if (backend == "none")
+      out.backend = SlideBackend::kNone;
+    else if (backend == "simulated")
+      out.backend = SlideBackend::kSimulated;
+    else if (backend == "gpio")
+      out.backend = SlideBackend::kGpio;
+    else
+      Fail("slides.backend", "'" + backend + "' is not none, simulated or gpio");
   }
   slides::SlideControllerConfig& c = out.controller;
   Read(node, "slides", "chip", c.chip);
@@ -299,8 +310,9 @@ Status Validate(const Config& config) {
   if (!config.listen.tcp.empty() &&
       (config.listen.tls_certificate.empty() || config.listen.tls_key.empty() ||
        config.listen.tls_client_ca.empty()))
-    return fail("listen.tcp is set, so listen.tls_certificate, listen.tls_key and "
-                "listen.tls_client_ca are required (TCP is mutual TLS only)");
+    return fail(
+        "listen.tcp is set, so listen.tls_certificate, listen.tls_key and "
+        "listen.tls_client_ca are required (TCP is mutual TLS only)");
   if (config.limits.default_deadline > config.limits.max_deadline)
     return fail("limits.default_deadline_ms is above limits.max_deadline_ms");
   if (config.slides.backend != SlideBackend::kNone) {
@@ -311,8 +323,7 @@ Status Validate(const Config& config) {
   const bool tls = !p.tls_ca.empty() || !p.tls_certificate.empty() || !p.tls_key.empty();
   if (tls && (p.tls_ca.empty() || p.tls_certificate.empty() || p.tls_key.empty()))
     return fail("processing: give all of tls_ca, tls_certificate and tls_key, or none");
-  if (!p.server.empty() && !tls && !rpc::IsUnixTarget(p.server) &&
-      !rpc::IsLoopbackTarget(p.server))
+  if (!p.server.empty() && !tls && !rpc::IsUnixTarget(p.server) && !rpc::IsLoopbackTarget(p.server))
     return fail("processing.server " + p.server +
                 " is another machine: mutual TLS only (give processing.tls_ca, "
                 "processing.tls_certificate and processing.tls_key)");
@@ -331,8 +342,8 @@ Result<service::RolePolicy> ResolveRoles(const RolesConfig& roles) {
       if (!member.empty() && member[0] == '@') {
         group* entry = ::getgrnam(member.c_str() + 1);
         if (entry == nullptr)
-          return Status(ErrorCode::kInvalidArgument, key + ": group '" + member.substr(1) +
-                                                         "' does not exist on this machine");
+          return Status(ErrorCode::kInvalidArgument,
+                        key + ": group '" + member.substr(1) + "' does not exist on this machine");
         auto& slot = policy.groups[entry->gr_gid];
         slot = std::max(slot, role);
       } else {
@@ -340,8 +351,7 @@ Result<service::RolePolicy> ResolveRoles(const RolesConfig& roles) {
         uid_t uid;
         if (entry != nullptr) {
           uid = entry->pw_uid;
-        } else if (!member.empty() &&
-                   member.find_first_not_of("0123456789") == std::string::npos) {
+        } else if (!member.empty() && member.find_first_not_of("0123456789") == std::string::npos) {
           uid = static_cast<uid_t>(std::stoul(member));  // a numeric uid without a name
         } else {
           return Status(ErrorCode::kInvalidArgument,
@@ -418,7 +428,8 @@ std::string Dump(const Config& config) {
   for (const auto& [role, members] : config.roles.members)
     out << YAML::Key << std::string(service::ToString(role)) << YAML::Value << YAML::Flow
         << members;
-  out << YAML::Key << "others" << YAML::Value << std::string(service::ToString(config.roles.others));
+  out << YAML::Key << "others" << YAML::Value
+      << std::string(service::ToString(config.roles.others));
   out << YAML::EndMap;
   const ProcessingConfig& p = config.processing;
   out << YAML::Key << "processing" << YAML::Value << YAML::BeginMap;

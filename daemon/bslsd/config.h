@@ -26,9 +26,9 @@ enum class Backend { kSimulated, kIsa, kEmulatedIsa, kUsb, kEmulatedUsb };
 
 struct FramestoreConfig {
   Backend backend = Backend::kSimulated;
-  std::uint16_t isa_base = 0x300;       // the card's 8255 (thesis 3.1)
+  std::uint16_t isa_base = 0x300;            // the card's 8255 (thesis 3.1)
   std::string isa_port_access = "dev-port";  // "dev-port" (/dev/port) or "ioperm"
-  double simulated_noise_sigma = 3.0;   // grey levels
+  double simulated_noise_sigma = 3.0;        // grey levels
   double simulated_frame_rate_hz = 25.0;
   double simulated_breathing_mm = 0.5;  // peak motion of the simulated head; 0: still
 };
@@ -51,13 +51,13 @@ struct ListenConfig {
   // uid); more are closed as soon as they are accepted.
   int max_connections = 128;
   int max_connections_per_user = 32;
-  rpc::Http2Limits http2;     // keep-alive, pings, idle connections, streams
-  std::string tcp;            // "host:port" with mutual TLS; "" : no TCP (the default)
+  rpc::Http2Limits http2;       // keep-alive, pings, idle connections, streams
+  std::string tcp;              // "host:port" with mutual TLS; "" : no TCP (the default)
   std::string tls_certificate;  // PEM files, required with tcp
   std::string tls_key;
   std::string tls_client_ca;
-  int max_receive_message_bytes = 64 * 1024;         // requests are small
-  int max_send_message_bytes = 16 * 1024 * 1024;     // a capture with three 8192^2... capped
+  int max_receive_message_bytes = 64 * 1024;      // requests are small
+  int max_send_message_bytes = 16 * 1024 * 1024;  // a capture with three 8192^2... capped
 };
 
 enum class SlideBackend { kNone, kSimulated, kGpio };
@@ -75,11 +75,11 @@ struct ProcessingConfig {
   std::string tls_ca;  // mutual TLS (required for a server on another machine)
   std::string tls_certificate;
   std::string tls_key;
-  std::string calibration_left;   // calibration files (bsls calibrate); "" : none
+  std::string calibration_left;  // calibration files (bsls calibrate); "" : none
   std::string calibration_right;
-  int timeout_ms = 120000;        // deadline of one call
-  int retry_initial_ms = 1000;    // back-off after a failed attempt, doubled
-  int retry_max_ms = 60000;       // up to this
+  int timeout_ms = 120000;      // deadline of one call
+  int retry_initial_ms = 1000;  // back-off after a failed attempt, doubled
+  int retry_max_ms = 60000;     // up to this
 };
 
 struct Config {

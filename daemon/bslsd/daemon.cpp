@@ -1,10 +1,10 @@
 #include "daemon.h"
 
 #include <grp.h>
+#include <grpcpp/security/server_credentials.h>
 #include <spdlog/spdlog.h>
 
 #include <fstream>
-#include <grpcpp/security/server_credentials.h>
 #include <tuple>
 
 #include "bsls/calibration/calibration_file.h"
@@ -110,8 +110,12 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   service::ProcessingQueueOptions processing;
   const ProcessingConfig& p = config.processing;
   processing.client.target = p.server;
-  processing.client.tls = {p.tls_ca, p.tls_certificate, p.tls_key, "processing.tls_ca",
-                           "processing.tls_certificate", "processing.tls_key"};
+  processing.client.tls = {p.tls_ca,
+                           p.tls_certificate,
+                           p.tls_key,
+                           "processing.tls_ca",
+                           "processing.tls_certificate",
+                           "processing.tls_key"};
   processing.client.timeout = std::chrono::milliseconds(p.timeout_ms);
   processing.retry_initial = std::chrono::milliseconds(p.retry_initial_ms);
   processing.retry_max = std::chrono::milliseconds(p.retry_max_ms);
@@ -142,8 +146,7 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   } catch (const std::invalid_argument& e) {
     return Status(ErrorCode::kInvalidArgument, std::string("processing.server: ") + e.what());
   }
-  if (d->processing_->enabled())
-    spdlog::info("processing: every grab goes to {}", p.server);
+  if (d->processing_->enabled()) spdlog::info("processing: every grab goes to {}", p.server);
 
   d->service_ = std::make_unique<service::CaptureService>(
       d->device_.get(), d->store_.get(), d->slides_.get(), &d->events_, &d->peers_, &d->policy_,
@@ -174,8 +177,7 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   if (!d->server_ || (!config.listen.tcp.empty() && d->tcp_port_ == 0))
     return Status(ErrorCode::kUnavailable,
                   "the gRPC server could not start" +
-                      (config.listen.tcp.empty() ? std::string()
-                                                 : " on TCP " + config.listen.tcp));
+                      (config.listen.tcp.empty() ? std::string() : " on TCP " + config.listen.tcp));
   if (!listener) {
     Result<std::unique_ptr<service::UnixListener>> socket = OpenUnixListener(config);
     if (!socket.ok()) return socket.status();

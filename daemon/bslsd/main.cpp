@@ -17,6 +17,7 @@
 // daemon fails once with its cause instead of restart-looping.
 #include <grp.h>
 #include <signal.h>
+#include <spdlog/spdlog.h>
 #include <systemd/sd-daemon.h>
 #include <unistd.h>
 
@@ -26,7 +27,6 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
-#include <spdlog/spdlog.h>
 
 #include "bsls/rpc/server_limits.h"
 #include "config.h"
@@ -55,7 +55,8 @@ class Watchdog {
     if (interval_.count() == 0) return;
     const auto now = std::chrono::steady_clock::now().time_since_epoch().count();
     const auto last = last_.load();
-    if (now - last < std::chrono::duration_cast<std::chrono::steady_clock::duration>(interval_).count())
+    if (now - last <
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(interval_).count())
       return;
     last_ = now;
     sd_notify(0, "WATCHDOG=1");
@@ -96,7 +97,7 @@ int Run(const bslsd::Config& config) {
   if (!privileged.ok()) {
     spdlog::critical("{}", privileged.status().message());
     return privileged.status().code() == framestore::ErrorCode::kPermissionDenied ? kExitConfig
-                                                                                : kExitRuntime;
+                                                                                  : kExitRuntime;
   }
   framestore::Result<std::unique_ptr<service::UnixListener>> listener =
       bslsd::OpenUnixListener(config);
@@ -130,13 +131,13 @@ int Run(const bslsd::Config& config) {
   if (!started.ok()) {
     spdlog::critical("{}", started.status().message());
     return started.status().code() == framestore::ErrorCode::kInvalidArgument ? kExitConfig
-                                                                             : kExitRuntime;
+                                                                              : kExitRuntime;
   }
   std::unique_ptr<bslsd::Daemon> daemon = std::move(started).value();
   spdlog::info("bslsd {} serving on {}{}", BSLS_VERSION, config.listen.unix_socket,
-               daemon->tcp_port() ? " and TCP port " + std::to_string(daemon->tcp_port()) +
-                                        " (mutual TLS)"
-                                  : "");
+               daemon->tcp_port()
+                   ? " and TCP port " + std::to_string(daemon->tcp_port()) + " (mutual TLS)"
+                   : "");
   sd_notify(0, "READY=1\nSTATUS=serving");
 
   // 4. Until SIGTERM/SIGINT. Meanwhile freed memory goes back to the system
@@ -175,7 +176,8 @@ int main(int argc, char** argv) {
   app.add_option("--set", overrides, "override a key, e.g. --set framestore.backend=usb")
       ->take_all();
   app.add_flag("--check-config", check, "check the configuration, print it and exit");
-  app.add_option("--backend", backend, "framestore.backend: simulated, isa, emulated-isa, usb, emulated-usb");
+  app.add_option("--backend", backend,
+                 "framestore.backend: simulated, isa, emulated-isa, usb, emulated-usb");
   app.add_option("--store", store_root, "store.root: the capture store's directory");
   app.add_option("--socket", socket, "listen.unix_socket");
   app.add_option("--tcp", tcp, "listen.tcp (host:port, mutual TLS)");

@@ -68,8 +68,9 @@ int main(int argc, char** argv) {
   bsls::rpc::TuneAllocator();
   // Logs on stderr: stdout carries only the tcp_port=N line scripts read.
   spdlog::set_default_logger(spdlog::stderr_color_mt("bsls-processd"));
-  CLI::App app{"bsls-processd: the BSLS processing service (frames to junctions, surfaces, "
-               "measurements and calibrations)"};
+  CLI::App app{
+      "bsls-processd: the BSLS processing service (frames to junctions, surfaces, "
+      "measurements and calibrations)"};
   std::string config_path;
   std::vector<std::string> overrides;
   bool check = false;

@@ -40,10 +40,9 @@ void ArtifactAssembler::Add(const v1::Artifact& chunk) {
     p.total_size = chunk.total_size();
   }
   if (chunk.offset() != p.bytes.size())
-    throw ArtifactError(name + ": a chunk at offset " + std::to_string(chunk.offset()) +
-                        " after " + std::to_string(p.bytes.size()) + " bytes");
-  if (chunk.total_size() != p.total_size ||
-      p.bytes.size() + chunk.data().size() > p.total_size)
+    throw ArtifactError(name + ": a chunk at offset " + std::to_string(chunk.offset()) + " after " +
+                        std::to_string(p.bytes.size()) + " bytes");
+  if (chunk.total_size() != p.total_size || p.bytes.size() + chunk.data().size() > p.total_size)
     throw ArtifactError(name + ": more bytes than the " + std::to_string(p.total_size) +
                         " announced");
   received_ += chunk.data().size();

@@ -24,8 +24,8 @@ std::string LabelScore::Summary() const {
   return s.str();
 }
 
-LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
-                       const std::vector<PointLabel>& decoded, double reach) {
+LabelScore ScoreLabels(const std::vector<PointLabel>& truth, const std::vector<PointLabel>& decoded,
+                       double reach) {
   LabelScore score;
   score.truth = static_cast<int>(truth.size());
   std::vector<int> match(truth.size(), -1);
@@ -109,7 +109,8 @@ LineScore ScoreLines(const std::vector<LinePoints>& truth, const std::vector<Lin
       const auto range = r.equal_range(std::lround(p.y));
       if (range.first == range.second) continue;
       double best = 1e300;
-      for (auto it = range.first; it != range.second; ++it) best = std::min(best, std::abs(it->second - p.x));
+      for (auto it = range.first; it != range.second; ++it)
+        best = std::min(best, std::abs(it->second - p.x));
       sum2 += best * best;
       ++score.points;
     }

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <opencv2/core/utility.hpp>
+#include <optional>
 #include <stdexcept>
 
 namespace bsls::simulator {

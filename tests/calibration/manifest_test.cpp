@@ -111,8 +111,7 @@ TEST_F(ManifestFiles, ScalarsWhereMappingsBelongSayWhy) {
       << Error(target);
   std::string view = text;
   view.replace(view.find("{image: t0.png, z_mm: 0}"), 24, "t0.png");
-  EXPECT_NE(Error(view).find("camera_views[0]: expected a mapping with 'image'"),
-            std::string::npos)
+  EXPECT_NE(Error(view).find("camera_views[0]: expected a mapping with 'image'"), std::string::npos)
       << Error(view);
   std::string pattern = text;
   pattern.replace(pattern.find("{lines: 20, rows: 24}"), 21, "[20, 24]");

@@ -5,8 +5,8 @@
 #define BSLS_TESTS_DAEMON_DAEMON_PROCESS_H_
 
 #include <arpa/inet.h>
-#include <grpcpp/grpcpp.h>
 #include <fcntl.h>
+#include <grpcpp/grpcpp.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -33,8 +33,8 @@ namespace fs = std::filesystem;
 // A fresh directory under the test temp dir, world-searchable so that
 // callers of other uids reach the socket inside.
 inline fs::path MakeDaemonDir(const std::string& name) {
-  const fs::path dir = fs::path(::testing::TempDir()) /
-                       ("bslsd_" + name + "_" + std::to_string(::getpid()));
+  const fs::path dir =
+      fs::path(::testing::TempDir()) / ("bslsd_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   ::chmod(dir.c_str(), 0755);
@@ -111,10 +111,12 @@ class DaemonProcess : public ChildProcess {
   // A new channel to the daemon's socket with `args` (transport settings of
   // a particular client).
   std::shared_ptr<grpc::Channel> Channel(const grpc::ChannelArguments& args) const {
-    return grpc::CreateCustomChannel("unix:" + socket_.string(),
-                                     grpc::InsecureChannelCredentials(), args);
+    return grpc::CreateCustomChannel("unix:" + socket_.string(), grpc::InsecureChannelCredentials(),
+                                     args);
   }
-  std::unique_ptr<v1::CaptureDaemon::Stub> Stub() const { return v1::CaptureDaemon::NewStub(Channel()); }
+  std::unique_ptr<v1::CaptureDaemon::Stub> Stub() const {
+    return v1::CaptureDaemon::NewStub(Channel());
+  }
   // A stub on a connection of its own with `args`.
   std::unique_ptr<v1::CaptureDaemon::Stub> Stub(grpc::ChannelArguments args) const {
     args.SetInt(GRPC_ARG_USE_LOCAL_SUBCHANNEL_POOL, 1);

@@ -29,8 +29,8 @@ std::unique_ptr<ProcessdProcess> StartReplica(const fs::path& dir, const std::st
                                               const std::string& tcp = "127.0.0.1:0") {
   return std::make_unique<ProcessdProcess>(
       BSLS_PROCESSD_PATH, dir, name, 1,
-      std::vector<std::string>{"--set", "scratch_dir=" + dir.string()},
-      std::chrono::seconds(120), tcp);
+      std::vector<std::string>{"--set", "scratch_dir=" + dir.string()}, std::chrono::seconds(120),
+      tcp);
 }
 
 class Pipeline : public ::testing::Test {
@@ -46,8 +46,8 @@ class Pipeline : public ::testing::Test {
   // bslsd handing its grabs to `server`, retrying quickly.
   void StartDaemon(const std::string& server) {
     config_ = WriteDaemonConfig(
-        dir_, "roles:\n  admin: [root]\nslides:\n  backend: simulated\nprocessing:\n  server: \"" + server +
-                  "\"\n  calibration_left: " + (dir_ / "left.yaml").string() +
+        dir_, "roles:\n  admin: [root]\nslides:\n  backend: simulated\nprocessing:\n  server: \"" +
+                  server + "\"\n  calibration_left: " + (dir_ / "left.yaml").string() +
                   "\n  calibration_right: " + (dir_ / "right.yaml").string() +
                   "\n  retry_initial_ms: 100\n  retry_max_ms: 400\n");
     daemon_ = std::make_unique<DaemonProcess>(dir_, config_);
@@ -72,7 +72,8 @@ class Pipeline : public ::testing::Test {
     v1::GetCaptureRequest request;
     request.set_capture_id(id);
     v1::CaptureInfo info;
-    EXPECT_TRUE(daemon_->Stub()->GetCapture(Deadline(milliseconds(10000)).get(), request, &info).ok());
+    EXPECT_TRUE(
+        daemon_->Stub()->GetCapture(Deadline(milliseconds(10000)).get(), request, &info).ok());
     return info;
   }
   // Polls until the capture's processing is no longer pending.
@@ -128,13 +129,14 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
 
   const v1::CaptureInfo info = WaitProcessed(id);
   ASSERT_EQ(info.processing().state(), v1::ProcessingStatus::STATE_DONE)
-      << info.processing().last_error() << "\n" << daemon_->Log();
+      << info.processing().last_error() << "\n"
+      << daemon_->Log();
   EXPECT_EQ(info.processing().replica(), "p");
   const std::map<std::string, std::string> files = Results(id);
   ASSERT_TRUE(last_status_.ok()) << last_status_.error_message();
-  for (const char* name : {"surface.ply", "left.ply", "right.ply", "report.json", "record.json",
-                           "left.junctions.json", "right.junctions.json",
-                           "calibration-left.yaml", "calibration-right.yaml"})
+  for (const char* name :
+       {"surface.ply", "left.ply", "right.ply", "report.json", "record.json", "left.junctions.json",
+        "right.junctions.json", "calibration-left.yaml", "calibration-right.yaml"})
     EXPECT_TRUE(files.count(name)) << name;
   EXPECT_EQ(io::Sha256Hex(files.at("record.json")), info.processing().record_sha256());
 
@@ -171,7 +173,8 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
   v1::DeleteCaptureRequest remove;
   remove.set_capture_id(id);
   v1::DeleteCaptureResponse removed;
-  ASSERT_TRUE(daemon_->Stub()->DeleteCapture(Deadline(milliseconds(10000)).get(), remove, &removed).ok());
+  ASSERT_TRUE(
+      daemon_->Stub()->DeleteCapture(Deadline(milliseconds(10000)).get(), remove, &removed).ok());
   for (const auto& entry : fs::directory_iterator(dir_ / "store" / "results"))
     EXPECT_NE(entry.path().filename().string().rfind(id, 0), 0u) << entry.path();
 }
@@ -203,7 +206,8 @@ TEST_F(Pipeline, CapturesWaitThroughAnOutageAndARestartOfTheDaemon) {
   for (const std::string& id : {first, second}) {
     const v1::CaptureInfo done = WaitProcessed(id);
     EXPECT_EQ(done.processing().state(), v1::ProcessingStatus::STATE_DONE)
-        << done.processing().last_error() << "\n" << daemon_->Log();
+        << done.processing().last_error() << "\n"
+        << daemon_->Log();
   }
 }
 
@@ -236,7 +240,8 @@ TEST_F(Pipeline, AReplicaKilledMidCallLosesNoCapture) {
   for (const std::string& id : ids) {
     const v1::CaptureInfo done = WaitProcessed(id);
     EXPECT_EQ(done.processing().state(), v1::ProcessingStatus::STATE_DONE)
-        << done.processing().last_error() << "\n" << daemon_->Log();
+        << done.processing().last_error() << "\n"
+        << daemon_->Log();
   }
   stop = true;
   killer.join();

@@ -17,7 +17,7 @@ using std::chrono::milliseconds;
 using Clock = std::chrono::steady_clock;
 
 struct StreamFigures {
-  int frames = 0;          // received inside the window
+  int frames = 0;  // received inside the window
   std::uint64_t dropped = 0;
   bool ok = true;
 };
@@ -60,8 +60,8 @@ TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
   }
   constexpr double kWindowSeconds = 5.0;
   const Clock::time_point start = Clock::now() + std::chrono::seconds(1);
-  const Clock::time_point end =
-      start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kWindowSeconds));
+  const Clock::time_point end = start + std::chrono::duration_cast<Clock::duration>(
+                                            std::chrono::duration<double>(kWindowSeconds));
   StreamFigures figures[4];
   std::vector<std::thread> clients;
   for (int i = 0; i < 4; ++i) {

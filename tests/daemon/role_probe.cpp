@@ -65,9 +65,9 @@ int main(int argc, char** argv) {
   }
   {
     auto context = Context(10000);
-    Print("StreamPreview", FirstOf<decltype(stub->StreamPreview(context.get(), {})),
-                                   bsls::v1::PreviewFrame>(
-                               context.get(), stub->StreamPreview(context.get(), {})));
+    Print("StreamPreview",
+          FirstOf<decltype(stub->StreamPreview(context.get(), {})), bsls::v1::PreviewFrame>(
+              context.get(), stub->StreamPreview(context.get(), {})));
   }
   {
     bsls::v1::GrabRequest request;

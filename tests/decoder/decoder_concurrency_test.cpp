@@ -6,9 +6,8 @@
 // show that it measures ahead at all (one full `ctest -j2` run failed so).
 #include <gtest/gtest.h>
 
-#include <string>
-
 #include <opencv2/core/utility.hpp>
+#include <string>
 
 #include "bsls/decoder/decoder.h"
 #include "decoder_evaluation.h"

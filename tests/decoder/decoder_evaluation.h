@@ -18,8 +18,8 @@ namespace bsls::decoder::test {
 using pattern::Side;
 using simulator::SurfaceKind;
 
-constexpr double kMatchReach = 2.5;   // px between a decoded and a true junction
-constexpr double kNoiseSigma = 3.0;   // grey levels
+constexpr double kMatchReach = 2.5;  // px between a decoded and a true junction
+constexpr double kNoiseSigma = 3.0;  // grey levels
 // Junctions this close to the image border have their line cut off by it
 // within a few pixels; they are scored separately.
 constexpr double kBorderMargin = 10.0;  // px
@@ -37,7 +37,7 @@ inline simulator::Frame RenderFrame(SurfaceKind kind, Side side, std::uint32_t s
 struct Evaluation {
   simulator::LabelScore inner;  // junctions clear of the image border
   simulator::LabelScore all;    // every lit and visible junction
-  double line_rms = 0.0;      // px, decoded line points against the true crossings
+  double line_rms = 0.0;        // px, decoded line points against the true crossings
   int line_points = 0;
 };
 

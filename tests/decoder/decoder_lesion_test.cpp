@@ -23,10 +23,18 @@ class LesionFace : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     simulator::ThesisSceneOptions options;
-    options.face_lesions = {
-        {.centre_xy_mm = {-42.0, -32.0}, .height_mm = 15.0, .radius_mm = 30.0, .top_radius_mm = 12.0},
-        {.centre_xy_mm = {-28.0, 50.0}, .height_mm = -15.0, .radius_mm = 28.0, .top_radius_mm = 11.0},
-        {.centre_xy_mm = {42.0, -30.0}, .height_mm = -10.0, .radius_mm = 16.0, .top_radius_mm = 7.0}};
+    options.face_lesions = {{.centre_xy_mm = {-42.0, -32.0},
+                             .height_mm = 15.0,
+                             .radius_mm = 30.0,
+                             .top_radius_mm = 12.0},
+                            {.centre_xy_mm = {-28.0, 50.0},
+                             .height_mm = -15.0,
+                             .radius_mm = 28.0,
+                             .top_radius_mm = 11.0},
+                            {.centre_xy_mm = {42.0, -30.0},
+                             .height_mm = -10.0,
+                             .radius_mm = 16.0,
+                             .top_radius_mm = 7.0}};
     simulator::RenderParams render;
     render.noise_sigma = kNoiseSigma;
     render.seed = 5;
@@ -118,8 +126,9 @@ TEST_F(LesionFace, ALineComingOutFromBehindTheFoldLeavesItsNeighbourWhole) {
   auto score = [](const DecodeResult& r) { return ScoreStretch(r, 3, 5, 336, 348); };
   const auto [now_points, now_rms] = score(*skeleton_);
   const auto [before_points, before_rms] = score(as_before);
-  std::printf("[ figures  ] lines 3-5, rows 336-348: %d points, RMS %.3f px; as before %d, RMS %.3f px\n",
-              now_points, now_rms, before_points, before_rms);
+  std::printf(
+      "[ figures  ] lines 3-5, rows 336-348: %d points, RMS %.3f px; as before %d, RMS %.3f px\n",
+      now_points, now_rms, before_points, before_rms);
   // 14 points at 0.202 px against 8 at 0.266 px (2026-11-26).
   EXPECT_GE(now_points, before_points + 5);
   EXPECT_LE(now_rms, before_rms);
@@ -180,11 +189,11 @@ TEST_F(LesionFace, TrackChainLabelsOnlyWhatItProves) {
 // on this frame.
 TEST_F(LesionFace, SteepLinesKeepTheRowsLeaningAwayFromASegment) {
   for (const auto& [chain, decoded_by] : SkeletonChainOnly()) {
-      SCOPED_TRACE(chain);
-      ASSERT_TRUE(decoded_by->ok) << decoded_by->error;
-      const Evaluation e = Evaluate(*frame_, *decoded_by);
-      EXPECT_GE(e.line_points, 4100);
-      EXPECT_LE(e.line_rms, 0.13) << "points " << e.line_points;
+    SCOPED_TRACE(chain);
+    ASSERT_TRUE(decoded_by->ok) << decoded_by->error;
+    const Evaluation e = Evaluate(*frame_, *decoded_by);
+    EXPECT_GE(e.line_points, 4100);
+    EXPECT_LE(e.line_rms, 0.13) << "points " << e.line_points;
   }
 }
 
@@ -206,7 +215,8 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
     for (const cv::Point2d& q : line.points)
       truth[line.p][static_cast<int>(std::lround(q.y))] = q.x;
   for (const DecodedLine& line : unfilled.lines)
-    for (const cv::Point2d& q : line.points) before[line.p][static_cast<int>(std::lround(q.y))] = q.x;
+    for (const cv::Point2d& q : line.points)
+      before[line.p][static_cast<int>(std::lround(q.y))] = q.x;
   int refilled = 0;
   double sum_sq = 0.0;
   for (const DecodedLine& line : skeleton_->lines)
@@ -219,9 +229,10 @@ TEST_F(LesionFace, SteepStretchesAreRefilledWhereTheirFitHoldsClosely) {
     }
   const double rms = std::sqrt(sum_sq / std::max(refilled, 1));
   const Evaluation with = Evaluate(*frame_, *skeleton_), without = Evaluate(*frame_, unfilled);
-  std::printf("[ figures  ] steep stretches refilled: %d points, RMS %.3f px; whole frame %d points, "
-              "RMS %.4f px (without: %d, %.4f px)\n",
-              refilled, rms, with.line_points, with.line_rms, without.line_points, without.line_rms);
+  std::printf(
+      "[ figures  ] steep stretches refilled: %d points, RMS %.3f px; whole frame %d points, "
+      "RMS %.4f px (without: %d, %.4f px)\n",
+      refilled, rms, with.line_points, with.line_rms, without.line_points, without.line_rms);
   // 2026-11-26: 164 points at 0.069 px on this frame; the whole frame 4321
   // points at 0.1132 px against 4157 at 0.1146 px.
   EXPECT_GE(refilled, 40);
@@ -246,15 +257,18 @@ TEST_F(LesionFace, LinesCrowdedAtAFoldAreMeasuredTogether) {
   auto score = [](const DecodeResult& r) { return ScoreStretch(r, 4, 5, 300, 335); };
   const auto [joint_points, joint_rms] = score(*skeleton_);
   const auto [alone_points, alone_rms] = score(one_by_one);
-  std::printf("[ figures  ] lines 4-5, rows 300-335: jointly %d points, RMS %.3f px; one by one %d, RMS %.3f px\n",
-              joint_points, joint_rms, alone_points, alone_rms);
+  std::printf(
+      "[ figures  ] lines 4-5, rows 300-335: jointly %d points, RMS %.3f px; one by one %d, RMS "
+      "%.3f px\n",
+      joint_points, joint_rms, alone_points, alone_rms);
   // 34 points at 0.028 px against 28 at 0.091 px (2026-11-26).
   EXPECT_GE(joint_points, alone_points + 4);
   EXPECT_LE(joint_rms, 0.5 * alone_rms);
   // The whole frame no worse.
   const Evaluation joint = Evaluate(*frame_, *skeleton_), apart = Evaluate(*frame_, one_by_one);
-  std::printf("[ figures  ] whole frame: jointly %d points, RMS %.4f px; one by one %d, RMS %.4f px\n",
-              joint.line_points, joint.line_rms, apart.line_points, apart.line_rms);
+  std::printf(
+      "[ figures  ] whole frame: jointly %d points, RMS %.4f px; one by one %d, RMS %.4f px\n",
+      joint.line_points, joint.line_rms, apart.line_points, apart.line_rms);
   EXPECT_GE(joint.line_points, apart.line_points);
   EXPECT_LE(joint.line_rms, apart.line_rms + 0.005);
   EXPECT_EQ(joint.all.Wrong(), 0);

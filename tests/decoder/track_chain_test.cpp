@@ -2,9 +2,8 @@
 // on objects and faces hold it with the skeleton chain in decoder_test.cpp.
 #include <gtest/gtest.h>
 
-#include <string>
-
 #include <opencv2/core/utility.hpp>
+#include <string>
 
 #include "bsls/decoder/decode_output.h"
 #include "bsls/decoder/decoder.h"

@@ -163,7 +163,8 @@ TEST(StripeCentre, CrowdedStripesFittedJointlyAreNotPulledByTheirNeighbours) {
     cv::Mat image(100, 48, CV_8UC1);
     for (int y = 0; y < image.rows; ++y)
       for (int x = 0; x < image.cols; ++x)
-        image.at<uchar>(y, x) = cv::saturate_cast<uchar>(clean[static_cast<size_t>(x)] + noise(rng));
+        image.at<uchar>(y, x) =
+            cv::saturate_cast<uchar>(clean[static_cast<size_t>(x)] + noise(rng));
     double joint_sq = 0.0, single_sq = 0.0;
     int joint_found = 0, single_found = 0;
     for (int y = 0; y < image.rows; ++y) {
@@ -185,8 +186,9 @@ TEST(StripeCentre, CrowdedStripesFittedJointlyAreNotPulledByTheirNeighbours) {
     }
     const double joint_rms = std::sqrt(joint_sq / std::max(joint_found, 1));
     const double single_rms = std::sqrt(single_sq / std::max(single_found, 1));
-    std::printf("[ figures  ] gap %.0f px: joint fit %d of 300, RMS %.3f px; one by one %d, RMS %.3f px\n",
-                gap, joint_found, joint_rms, single_found, single_rms);
+    std::printf(
+        "[ figures  ] gap %.0f px: joint fit %d of 300, RMS %.3f px; one by one %d, RMS %.3f px\n",
+        gap, joint_found, joint_rms, single_found, single_rms);
     EXPECT_GE(joint_found, 297) << gap;
     EXPECT_LT(joint_rms, 0.15) << gap;
     // 6 px apart the stripes barely touch and one by one works as well.

@@ -110,7 +110,8 @@ TEST(SimulatedFramestore, PacedGrabsComeOnTheCamerasFrameClock) {
   ASSERT_TRUE(a.ok() && b.ok());
   // Consecutive grabs are whole frame periods (40 ms) apart.
   const double gap_ms =
-      std::chrono::duration<double, std::milli>(b->timestamps.exposed - a->timestamps.exposed).count();
+      std::chrono::duration<double, std::milli>(b->timestamps.exposed - a->timestamps.exposed)
+          .count();
   EXPECT_NEAR(std::fmod(gap_ms + 1.0, 40.0), 1.0, 0.01) << gap_ms;
   EXPECT_LE(a->timestamps.requested, a->timestamps.exposed);
   EXPECT_LE(a->timestamps.exposed, a->timestamps.delivered);

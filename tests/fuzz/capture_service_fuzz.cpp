@@ -7,6 +7,7 @@
 // sent as an empty request). No input may crash the daemon, hang it past
 // the call deadline, leak, or lose a stored capture.
 #include <grpcpp/grpcpp.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -16,8 +17,6 @@
 #include <filesystem>
 #include <memory>
 #include <string>
-
-#include <spdlog/spdlog.h>
 
 #include "daemon.h"
 
@@ -60,8 +59,8 @@ Fixture& Instance() {
       std::abort();
     }
     f->daemon = std::move(started).value();
-    f->stub = v1::CaptureDaemon::NewStub(grpc::CreateChannel(
-        "unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials()));
+    f->stub = v1::CaptureDaemon::NewStub(grpc::CreateChannel("unix:" + config.listen.unix_socket,
+                                                             grpc::InsecureChannelCredentials()));
     // The fuzzer exits without destructors; the temporary directory goes with it.
     std::atexit([] { std::filesystem::remove_all(Instance().dir); });
     return f;

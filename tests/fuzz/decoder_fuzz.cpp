@@ -12,8 +12,8 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 4) return 0;
-  const bsls::pattern::Side side = (data[0] & 2) ? bsls::pattern::Side::kRight
-                                                 : bsls::pattern::Side::kLeft;
+  const bsls::pattern::Side side =
+      (data[0] & 2) ? bsls::pattern::Side::kRight : bsls::pattern::Side::kLeft;
   cv::Mat frame;
   if ((data[0] & 1) == 0) {
     const std::vector<unsigned char> bytes(data + 1, data + size);
@@ -30,11 +30,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     frame = cv::Mat(height, width, CV_8UC1);
     const std::size_t payload = size - 4;
     for (int i = 0; i < width * height; ++i)
-      frame.data[i] = payload ? data[4 + (i * 7919u) % payload] ^ static_cast<std::uint8_t>(i * data[3]) : 0;
+      frame.data[i] =
+          payload ? data[4 + (i * 7919u) % payload] ^ static_cast<std::uint8_t>(i * data[3]) : 0;
   }
   bsls::decoder::DecodeParams params;
-  params.chain = (data[0] & 4) ? bsls::decoder::DecodeChain::kTracks
-                               : bsls::decoder::DecodeChain::kSkeleton;
+  params.chain =
+      (data[0] & 4) ? bsls::decoder::DecodeChain::kTracks : bsls::decoder::DecodeChain::kSkeleton;
   const bsls::decoder::DecodeResult result = bsls::decoder::Decode(frame, side, params);
   (void)result;
   return 0;

@@ -17,8 +17,7 @@ TEST(ChainCode, CodesRunAnticlockwiseFromPlusX) {
   EXPECT_EQ(DirectionCode(0, 1), 6);
   EXPECT_EQ(DirectionCode(2, 0), -1);
   // Every unit step has its code, and nothing else has one.
-  for (int c = 0; c < 8; ++c)
-    EXPECT_EQ(DirectionCode(CodeStep(c).x, CodeStep(c).y), c) << c;
+  for (int c = 0; c < 8; ++c) EXPECT_EQ(DirectionCode(CodeStep(c).x, CodeStep(c).y), c) << c;
   for (int dy = -3; dy <= 3; ++dy)
     for (int dx = -3; dx <= 3; ++dx)
       if (std::max(std::abs(dx), std::abs(dy)) != 1) {
@@ -28,9 +27,9 @@ TEST(ChainCode, CodesRunAnticlockwiseFromPlusX) {
 
 TEST(ChainCode, DifferenceCodeFollowsEquation54) {
   EXPECT_EQ(DifferenceCode(0, 1), 1);
-  EXPECT_EQ(DifferenceCode(7, 0), 1);   // wraps
+  EXPECT_EQ(DifferenceCode(7, 0), 1);  // wraps
   EXPECT_EQ(DifferenceCode(1, 7), -2);
-  EXPECT_EQ(DifferenceCode(2, 6), 4);   // reversal: an end point
+  EXPECT_EQ(DifferenceCode(2, 6), 4);  // reversal: an end point
   EXPECT_EQ(DifferenceCode(6, 2), 4);
   EXPECT_EQ(InverseCode(6), 2);
 }

@@ -64,9 +64,9 @@ struct EdgeCorner {
   cv::Mat mask = cv::Mat::zeros(64, 64, CV_8UC1);
   cv::Rect imaged{4, 4, 56, 56};
   explicit EdgeCorner(int corner_row) {
-    cv::line(skeleton, {30, 50}, {30, corner_row}, 255);       // line A, up to the corner
+    cv::line(skeleton, {30, 50}, {30, corner_row}, 255);          // line A, up to the corner
     cv::line(skeleton, {30, corner_row}, {22, corner_row}, 255);  // the segment's piece
-    cv::line(skeleton, {30, 40}, {40, 40}, 255);               // a junction below
+    cv::line(skeleton, {30, 40}, {40, 40}, 255);                  // a junction below
     // The stripes: line A's stroke going on up, the segment's along the row.
     cv::rectangle(mask, cv::Rect(29, 0, 3, 52), 255, cv::FILLED);
     cv::rectangle(mask, cv::Rect(10, corner_row - 1, 21, 3), 255, cv::FILLED);
@@ -76,9 +76,8 @@ struct EdgeCorner {
 
 TEST(CornerExtension, ACornerWhoseLineRunsOutOfTheFrameTakesAShortSegment) {
   EdgeCorner at_edge(4);  // the corner on the first imaged row
-  const std::vector<cv::Point> corners = ExtendCorners(SkeletonGraph::Build(at_edge.skeleton), {},
-                                                       at_edge.skeleton, at_edge.mask,
-                                                       at_edge.imaged);
+  const std::vector<cv::Point> corners = ExtendCorners(
+      SkeletonGraph::Build(at_edge.skeleton), {}, at_edge.skeleton, at_edge.mask, at_edge.imaged);
   ASSERT_EQ(corners.size(), 1u);
   EXPECT_NEAR(corners[0].x, 30, 1);
   EXPECT_NEAR(corners[0].y, 4, 1);
@@ -88,9 +87,8 @@ TEST(CornerExtension, ACornerWhoseLineRunsOutOfTheFrameTakesAShortSegment) {
 
 TEST(CornerExtension, TheSameShortSegmentInsideTheFrameIsAHook) {
   EdgeCorner inside(20);  // the same shape well inside the frame
-  const std::vector<cv::Point> corners =
-      ExtendCorners(SkeletonGraph::Build(inside.skeleton), {}, inside.skeleton, inside.mask,
-                    inside.imaged);
+  const std::vector<cv::Point> corners = ExtendCorners(SkeletonGraph::Build(inside.skeleton), {},
+                                                       inside.skeleton, inside.mask, inside.imaged);
   EXPECT_TRUE(corners.empty());
 }
 

@@ -120,7 +120,7 @@ TEST_F(TwoPatches, ALoneJunctionJoinsThroughTwoAgreeingLinks) {
   const int lone = g.Add(1, 4);
   g.Link(a5, lone, false);
   Consensus c = Run();
-  EXPECT_EQ(c.p[lone], kNone);  // one plain link: not proof
+  EXPECT_EQ(c.p[lone], kNone);     // one plain link: not proof
   const int beside = g.Add(0, 4);  // a lone neighbour whose own link agrees
   g.Link(a1, beside, false);
   g.Link(beside, lone, false);

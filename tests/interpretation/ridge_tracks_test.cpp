@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
 #include <opencv2/imgproc.hpp>
+#include <tuple>
 
 #include "bsls/testing/synthetic_brick.h"
 
@@ -48,11 +48,14 @@ TEST(RidgeTracks, PointsLinkRowToRowWithinTheStep) {
     at.push_back({40.0f + (y >= 4 ? 3.0f : 0.0f), y});
     if (y < 2) at.push_back({70.0f, y});
   }
-  std::sort(at.begin(), at.end(), [](auto a, auto b) { return a.second != b.second ? a.second < b.second : a.first < b.first; });
+  std::sort(at.begin(), at.end(), [](auto a, auto b) {
+    return a.second != b.second ? a.second < b.second : a.first < b.first;
+  });
   const RidgePoints points = Points(8, at);
   std::vector<int> track_of;
   const std::vector<Track> tracks = LinkTracks(points, {}, &track_of);
-  ASSERT_EQ(tracks.size(), 3u);  // the leaning line and the jumping one's two halves; not the short one
+  ASSERT_EQ(tracks.size(),
+            3u);  // the leaning line and the jumping one's two halves; not the short one
   EXPECT_EQ(tracks[0].points.size(), 8u);
   EXPECT_EQ(tracks[1].points.size(), 4u);
   EXPECT_EQ(tracks[2].points.size(), 4u);
@@ -65,7 +68,8 @@ TEST(RidgeTracks, PointsLinkRowToRowWithinTheStep) {
 
 TEST(RidgeTracks, TheNearerClaimantKeepsAPoint) {
   // Two points of row 0 both nearest to the one point of row 1.
-  const RidgePoints points = Points(4, {{10.0f, 0}, {11.0f, 0}, {10.8f, 1}, {10.8f, 2}, {10.8f, 3}});
+  const RidgePoints points =
+      Points(4, {{10.0f, 0}, {11.0f, 0}, {10.8f, 1}, {10.8f, 2}, {10.8f, 3}});
   TrackParams params;
   params.min_track = 1;
   std::vector<int> track_of;
@@ -101,7 +105,9 @@ TEST_P(CleanBrickTracks, EveryJunctionFoundWithItsKind) {
 
 INSTANTIATE_TEST_SUITE_P(BothSides, CleanBrickTracks,
                          ::testing::Values(pattern::Side::kLeft, pattern::Side::kRight),
-                         [](const auto& test_info) { return std::string(pattern::ToString(test_info.param)); });
+                         [](const auto& test_info) {
+                           return std::string(pattern::ToString(test_info.param));
+                         });
 
 TEST(RidgeTracks, AGapInALineIsBridged) {
   SyntheticBrickParams params;
@@ -176,8 +182,8 @@ TEST(RidgeTracks, ASegmentWhoseEndsMeetOneLineMakesNoJunction) {
   std::sort(column_points.begin(), column_points.end(), [](auto a, auto b) {
     return a.second != b.second ? a.second < b.second : a.first < b.first;
   });
-  const TrackNetwork net = BuildTrackNetwork(Points(30, line_points), Points(40, column_points),
-                                             pattern::Side::kLeft);
+  const TrackNetwork net =
+      BuildTrackNetwork(Points(30, line_points), Points(40, column_points), pattern::Side::kLeft);
   ASSERT_EQ(net.junctions.size(), 2u);  // the segment's two ends, none of the speck's
   for (const TrackJunction& j : net.junctions) EXPECT_NEAR(j.position.y, 20.0, 1.0);
   EXPECT_NE(net.junctions[0].line, net.junctions[1].line);

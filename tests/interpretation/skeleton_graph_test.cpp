@@ -120,11 +120,11 @@ TEST(SkeletonGraph, TwoJunctionsJoinedByAShortSegmentAreTwoNodes) {
 TEST(JunctionNetwork, ALineMergingAtAFoldIsNotTakenForASegment) {
   cv::Mat sk = cv::Mat::zeros(90, 60, CV_8UC1);
   const cv::Point y_node{30, 40}, junction{26, 44};
-  cv::line(sk, {30, 5}, y_node, 255);        // line 5 from above
-  cv::line(sk, y_node, junction, 255);       // its short way on (3 px between)
-  cv::line(sk, junction, {26, 85}, 255);     // line 5 below its junction
-  cv::line(sk, junction, {8, 44}, 255);      // that junction's segment
-  cv::line(sk, y_node, {42, 80}, 255);       // line 3, come out from behind the fold
+  cv::line(sk, {30, 5}, y_node, 255);     // line 5 from above
+  cv::line(sk, y_node, junction, 255);    // its short way on (3 px between)
+  cv::line(sk, junction, {26, 85}, 255);  // line 5 below its junction
+  cv::line(sk, junction, {8, 44}, 255);   // that junction's segment
+  cv::line(sk, y_node, {42, 80}, 255);    // line 3, come out from behind the fold
   const SkeletonGraph g = SkeletonGraph::Build(sk);
   const JunctionNetwork net(g, pattern::Side::kLeft);
   auto node_near = [&](cv::Point p) {

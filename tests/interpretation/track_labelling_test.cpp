@@ -27,8 +27,8 @@ Labelled Label(const cv::Mat& grey, pattern::Side side) {
   cv::Mat s;
   cv::GaussianBlur(grey, s, cv::Size(0, 0), 1.0, 1.0, cv::BORDER_REPLICATE);
   Labelled out;
-  out.net = BuildTrackNetwork(extraction::FindRidgePoints(s), extraction::FindColumnRidgePoints(s),
-                              side);
+  out.net =
+      BuildTrackNetwork(extraction::FindRidgePoints(s), extraction::FindColumnRidgePoints(s), side);
   out.labels = LabelTracks(out.net, side, {});
   return out;
 }
@@ -66,7 +66,9 @@ TEST_P(CleanBrickLabels, EveryJunctionLabelledAndEveryLineNumbered) {
 
 INSTANTIATE_TEST_SUITE_P(BothSides, CleanBrickLabels,
                          ::testing::Values(pattern::Side::kLeft, pattern::Side::kRight),
-                         [](const auto& test_info) { return std::string(pattern::ToString(test_info.param)); });
+                         [](const auto& test_info) {
+                           return std::string(pattern::ToString(test_info.param));
+                         });
 
 // Thesis Table 5.5: the discontinuities that leave every junction in sight.
 // A break in a line or a segment takes one link away; the label comes

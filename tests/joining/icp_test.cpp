@@ -103,8 +103,8 @@ TEST(AlignToCurveTest, RecoversARigidMotionOfACurve) {
 TEST(AlignToCurveTest, StopsWhenItsCallerAsks) {
   const std::vector<Eigen::Vector3d> fixed_points = Helix(300, 0.4);
   const StripeCurve fixed = StripeCurve::FromMesh(LineMesh(fixed_points, 0), 0, 1.0);
-  const Eigen::Isometry3d motion = Eigen::Translation3d(2.0, -1.5, 1.0) *
-                                   Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY());
+  const Eigen::Isometry3d motion =
+      Eigen::Translation3d(2.0, -1.5, 1.0) * Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitY());
   std::vector<Eigen::Vector3d> moving;
   for (const Eigen::Vector3d& p : fixed_points) moving.push_back(motion * p);
   int asked = 0;
@@ -112,8 +112,8 @@ TEST(AlignToCurveTest, StopsWhenItsCallerAsks) {
   EXPECT_THROW(AlignToCurve(fixed, moving, Eigen::Isometry3d::Identity(), {}, third), Cancelled);
   EXPECT_EQ(asked, 3);
   // Never asked to stop, the same alignment converges.
-  EXPECT_TRUE(AlignToCurve(fixed, moving, Eigen::Isometry3d::Identity(), {}, Cancellation())
-                  .converged);
+  EXPECT_TRUE(
+      AlignToCurve(fixed, moving, Eigen::Isometry3d::Identity(), {}, Cancellation()).converged);
 }
 
 TEST(AlignToCurveTest, AStraightLineIsDegenerate) {

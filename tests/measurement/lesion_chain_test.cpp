@@ -91,9 +91,8 @@ decoder::DecodeResult PerfectDecode(const simulator::Frame& frame, Side side) {
   d.q_absolute = true;
   for (const simulator::TruthJunction& j : frame.truth.junctions)
     if (j.visible) d.junctions.push_back({cv::Point2d(j.image.x(), j.image.y()), j.p, j.v, j.kind});
-  std::sort(d.junctions.begin(), d.junctions.end(), [](const auto& a, const auto& b) {
-    return a.p != b.p ? a.p < b.p : a.q < b.q;
-  });
+  std::sort(d.junctions.begin(), d.junctions.end(),
+            [](const auto& a, const auto& b) { return a.p != b.p ? a.p < b.p : a.q < b.q; });
   for (const simulator::TruthLine& l : frame.truth.lines) {
     decoder::DecodedLine line{l.p, {}};
     for (const Eigen::Vector2d& q : l.points) line.points.emplace_back(q.x(), q.y());
@@ -141,7 +140,9 @@ const JoinedFaces& Joined(bool with_lesions) {
     perfect_rows[k] = reconstruction::Reconstruct(truth, model, row_pairs);
   }
   if (!sides[0] || !sides[1]) throw std::runtime_error("a side was not reconstructed");
-  auto join = [](const auto& both) { return joining::JoinSharedFrame(*both[0], *both[1], {}).mesh; };
+  auto join = [](const auto& both) {
+    return joining::JoinSharedFrame(*both[0], *both[1], {}).mesh;
+  };
   return cache[with_lesions] = {join(sides), join(perfect), join(sides_rows), join(perfect_rows)};
 }
 
@@ -149,12 +150,11 @@ const geometry::SurfaceMesh& JoinedFace(bool with_lesions) { return Joined(with_
 
 // The world frame of the calibrations: the rig frame moved to the target's origin.
 Eigen::Vector2d ToCalibrationWorld(const Eigen::Vector2d& rig_xy) {
-  const Eigen::Vector3d world = simulator::RigToCalibrationWorld(
-      calibration::testing::SessionParams(SessionKind::kLeftNoisy),
-      Eigen::Vector3d(rig_xy.x(), rig_xy.y(), 0.0));
+  const Eigen::Vector3d world =
+      simulator::RigToCalibrationWorld(calibration::testing::SessionParams(SessionKind::kLeftNoisy),
+                                       Eigen::Vector3d(rig_xy.x(), rig_xy.y(), 0.0));
   return world.head<2>();
 }
-
 
 struct Errors {
   double peak_mm, area_relative, volume_relative;
@@ -209,9 +209,9 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
   const SurfaceQuery surface(JoinedFace(true));
   const geometry::SurfaceMesh& baseline = JoinedFace(false);
   geometry::SurfaceMesh moved = baseline;
-  const Eigen::Isometry3d motion =
-      Eigen::Translation3d(2.0, -1.5, 2.0) *
-      Eigen::AngleAxisd(2.0 * std::numbers::pi / 180.0, Eigen::Vector3d(0.3, 1.0, 0.2).normalized());
+  const Eigen::Isometry3d motion = Eigen::Translation3d(2.0, -1.5, 2.0) *
+                                   Eigen::AngleAxisd(2.0 * std::numbers::pi / 180.0,
+                                                     Eigen::Vector3d(0.3, 1.0, 0.2).normalized());
   for (Eigen::Vector3d& p : moved.positions) p = motion * p;
   for (Eigen::Vector3d& n : moved.normals) n = motion.linear() * n;
 

@@ -33,7 +33,6 @@ std::shared_ptr<const simulator::Surface> Face() {
   return std::make_shared<simulator::MeshSurface>(simulator::LoadFaceMesh(face), "face");
 }
 
-
 struct Case {
   const char* name;
   simulator::LesionParams lesion;
@@ -269,8 +268,8 @@ TEST(SimulatedLesionTest, HolesInTheRegionAreFilledAndFlagged) {
   // hole reaches the region's boundary, beyond which the face is taken as
   // undisturbed (d = 0), and is filled between the lump's flank and there;
   // a wider spread says the guess is rougher.
-  const geometry::SurfaceMesh cut_mesh = WithoutFaces(
-      whole, [&](const Eigen::Vector2d& xy) { return xy.x() < centre.x() - 10.0; });
+  const geometry::SurfaceMesh cut_mesh =
+      WithoutFaces(whole, [&](const Eigen::Vector2d& xy) { return xy.x() < centre.x() - 10.0; });
   const SurfaceQuery cut(cut_mesh);
   const LesionMeasurement edge = MeasureLesion(cut, region, params);
   const Relative open = RelativeErrors("open to the region's boundary", edge, truth);

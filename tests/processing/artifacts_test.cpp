@@ -10,12 +10,13 @@ namespace {
 
 std::vector<v1::Artifact> Chunks(const std::string& bytes, std::size_t chunk) {
   std::vector<v1::Artifact> out;
-  EXPECT_TRUE(EmitArtifact("a.bin", "application/octet-stream", bytes,
-                           [&](const v1::WorkEvent& e) {
-                             out.push_back(e.artifact());
-                             return true;
-                           },
-                           chunk));
+  EXPECT_TRUE(EmitArtifact(
+      "a.bin", "application/octet-stream", bytes,
+      [&](const v1::WorkEvent& e) {
+        out.push_back(e.artifact());
+        return true;
+      },
+      chunk));
   return out;
 }
 

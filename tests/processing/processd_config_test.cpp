@@ -1,10 +1,9 @@
 // bsls-processd's configuration: defaults, overrides, and the network rules
 // (mutual TLS for TCP; plain TCP only on loopback when asked for).
-#include "config.h"
-
 #include <gtest/gtest.h>
 
 #include "bsls/rpc/tls.h"
+#include "config.h"
 
 namespace bsls::processd {
 namespace {

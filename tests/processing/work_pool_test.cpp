@@ -56,9 +56,7 @@ TEST(WorkPool, ACancelledWaiterLeavesTheQueue) {
   ASSERT_TRUE(worker->WaitForWorker({}));
   auto waiter = pool.TryAdmit();
   std::atomic<bool> cancel{false};
-  std::thread t([&] {
-    EXPECT_FALSE(waiter->WaitForWorker([&] { return cancel.load(); }));
-  });
+  std::thread t([&] { EXPECT_FALSE(waiter->WaitForWorker([&] { return cancel.load(); })); });
   std::this_thread::sleep_for(std::chrono::milliseconds(30));
   EXPECT_EQ(pool.Stats().waiting, 1);
   cancel = true;

@@ -1,6 +1,5 @@
 // Reconstruct (thesis 5.2): errors, bridging, smoothing and junctions, on
 // decodes made exact from the simulator's ground truth (no rendering).
-#include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/reconstruction/reconstruction.h"
 
 #include <gtest/gtest.h>
@@ -11,6 +10,7 @@
 #include <optional>
 #include <random>
 
+#include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/simulator/ground_truth.h"
 #include "bsls/simulator/scene.h"
 
@@ -135,8 +135,8 @@ TEST(Reconstruct, BridgesShortGapsOnly) {
 // the line are bridged through it. On the face's exact decode, every
 // junction on a stretch steeper than |dx/dy| 0.5 gets such a gap (9 rows
 // each side of it); the bridged vertices lie within 0.5 mm of the exact
-// ones (0.15 mm RMS; measured 0.41 and 0.10 mm). A junction moved 4 px off its line pins nothing (the
-// gap stays a hole), and without junctions the gaps stay holes.
+// ones (0.15 mm RMS; measured 0.41 and 0.10 mm). A junction moved 4 px off its line pins nothing
+// (the gap stays a hole), and without junctions the gaps stay holes.
 TEST(Reconstruct, GapsAroundJunctionsAreBridgedThroughThem) {
   const PlaneCase& setup = SceneSetup(Side::kLeft, simulator::SurfaceKind::kFace);
   const TriangulationModel model = TrueModel(setup.scene);
@@ -169,8 +169,7 @@ TEST(Reconstruct, GapsAroundJunctionsAreBridgedThroughThem) {
       if (std::abs(point.y - (j.position.y - kHalfGap - 1)) < 0.5) above = point;
       if (std::abs(point.y - (j.position.y + kHalfGap + 1)) < 0.5) below = point;
     }
-    if (!above || !below || std::abs((below->x - above->x) / (below->y - above->y)) < 0.5)
-      continue;
+    if (!above || !below || std::abs((below->x - above->x) / (below->y - above->y)) < 0.5) continue;
     const auto before = line->points.size();
     std::erase_if(line->points, [&](const cv::Point2d& point) {
       return std::abs(point.y - j.position.y) <= kHalfGap;

@@ -47,7 +47,8 @@ MeshParams RowPairs() {
 
 TEST(BuildSurfaceMesh, PlaneGivesTwoTrianglesPerQuad) {
   MeshReport report;
-  const geometry::SurfaceMesh mesh = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, RowPairs(), &report);
+  const geometry::SurfaceMesh mesh =
+      BuildSurfaceMesh(PlaneLines(5, 10), kCamera, RowPairs(), &report);
   std::string why;
   ASSERT_TRUE(mesh.IsValid(&why)) << why;
   EXPECT_EQ(mesh.VertexCount(), 50u);
@@ -110,10 +111,9 @@ std::vector<TriangulatedLine> LeaningLines(const std::vector<int>& first, int ro
   for (int p = 0; p < static_cast<int>(first.size()); ++p) {
     TriangulatedLine line{p, {}};
     for (int row = first[p]; row < first[p] + rows; ++row)
-      line.vertices.push_back({row,
-                               Eigen::Vector3d(-kLinePitchMm * p + shift_per_row * row,
-                                               -kRowStepMm * row, 0.0),
-                               0.1f, 0});
+      line.vertices.push_back(
+          {row, Eigen::Vector3d(-kLinePitchMm * p + shift_per_row * row, -kRowStepMm * row, 0.0),
+           0.1f, 0});
     out.push_back(line);
   }
   return out;
@@ -139,7 +139,8 @@ MeshParams Stitched() {
 TEST(BuildSurfaceMesh, StitchedUprightLinesGiveTheRowPairsSurface) {
   MeshReport rows, stitched;
   const geometry::SurfaceMesh a = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, RowPairs(), &rows);
-  const geometry::SurfaceMesh b = BuildSurfaceMesh(PlaneLines(5, 10), kCamera, Stitched(), &stitched);
+  const geometry::SurfaceMesh b =
+      BuildSurfaceMesh(PlaneLines(5, 10), kCamera, Stitched(), &stitched);
   EXPECT_EQ(stitched.triangles, rows.triangles);
   EXPECT_NEAR(FacesArea(b), FacesArea(a), 1e-9);
   EXPECT_NEAR(FacesArea(b), 4 * kLinePitchMm * 9 * kRowStepMm, 1e-9);

@@ -2,11 +2,11 @@
 
 #include <gtest/gtest.h>
 
-#include "test_options.h"
-
 #include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
+
+#include "test_options.h"
 
 namespace bsls::simulator {
 namespace {

@@ -2,13 +2,12 @@
 
 #include <gtest/gtest.h>
 
-#include "test_options.h"
-
 #include <algorithm>
 #include <map>
 #include <random>
 
 #include "bsls/simulator/ground_truth.h"
+#include "test_options.h"
 
 namespace bsls::simulator {
 namespace {

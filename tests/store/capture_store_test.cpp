@@ -19,8 +19,8 @@ namespace bsls::store {
 namespace {
 
 using framestore::Camera;
-using testing::RandomFrame;
 using testing::OpenStore;
+using testing::RandomFrame;
 using testing::RandomRequest;
 using testing::TempDir;
 using testing::TestOptions;

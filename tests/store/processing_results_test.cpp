@@ -85,14 +85,15 @@ TEST(ProcessingResults, DamageIsFoundAndBadNamesAreRefused) {
   std::mt19937 rng(8);
   auto a = store->Put(RandomRequest(rng));
   ASSERT_TRUE(a.ok());
-  for (const std::string& bad : std::vector<std::string>{"../escape", ".hidden", "a/b",
-                                                         std::string(65, 'x'), ""})
+  for (const std::string& bad :
+       std::vector<std::string>{"../escape", ".hidden", "a/b", std::string(65, 'x'), ""})
     EXPECT_EQ(store->PutProcessingResult(a->id.str(), {{bad, "x"}}, "r", "v").code(),
               ErrorCode::kInvalidArgument)
         << bad;
   EXPECT_EQ(store->PutProcessingResult("nope", {{"a.txt", "x"}}, "r", "v").code(),
             ErrorCode::kInvalidArgument);
-  ASSERT_TRUE(store->PutProcessingResult(a->id.str(), {{"report.json", "{\"a\": 1}"}}, "r", "v").ok());
+  ASSERT_TRUE(
+      store->PutProcessingResult(a->id.str(), {{"report.json", "{\"a\": 1}"}}, "r", "v").ok());
   const std::string path = dir.path() + "/results/" + a->id.str() + "-report.json";
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);

@@ -55,7 +55,7 @@ SimulatedFramestore::SimulatedFramestore(const SimulatedFramestoreParams& params
   capabilities_.device = "simulated head in the thesis rig (simulator)";
   capabilities_.cameras = {Camera::kLeft, Camera::kRight};
   capabilities_.gain = {kSimulatedGainMin, kSimulatedGainMax, kSimulatedGainNominal,
-                       "gain code, gain = code / 128"};
+                        "gain code, gain = code / 128"};
   capabilities_.width = simulator::RigParams{}.width;
   capabilities_.height = simulator::RigParams{}.height;
 }
@@ -93,8 +93,7 @@ Status SimulatedFramestore::SetGain(int gain) {
   return {};
 }
 
-const SimulatedFramestore::View& SimulatedFramestore::ViewFor(Camera camera, int slide,
-                                                              int phase) {
+const SimulatedFramestore::View& SimulatedFramestore::ViewFor(Camera camera, int slide, int phase) {
   const auto key = std::make_tuple(static_cast<int>(camera), slide, phase);
   if (auto it = views_.find(key); it != views_.end()) return *it->second;
   const pattern::Side side = SideOf(camera);
@@ -139,8 +138,7 @@ Result<GreyFrame> SimulatedFramestore::Grab(const GrabOptions& options) {
   const double t = std::chrono::duration<double>(exposed - epoch_).count();
   // A still head needs one view per camera and slide.
   const int phases = params_.breathing_amplitude_mm > 0.0 ? params_.breathing_phases : 1;
-  const int phase =
-      static_cast<int>(std::floor(t / params_.breathing_period_s * phases)) % phases;
+  const int phase = static_cast<int>(std::floor(t / params_.breathing_period_s * phases)) % phases;
   const int slide = params_.slide ? params_.slide() : (camera_ == Camera::kRight ? 3 : 2);
   const View* view = nullptr;
   try {

@@ -80,7 +80,8 @@ Result<T> CaptureDevice::Run(std::function<Result<T>(Framestore&)> work,
   // the caller stops waiting at its deadline plus a grace for the device's
   // own timeout to report first.
   if (future.wait_until(deadline + std::chrono::milliseconds(200)) != std::future_status::ready)
-    return Status(ErrorCode::kDeadlineExceeded, "the framestore did not answer before the deadline");
+    return Status(ErrorCode::kDeadlineExceeded,
+                  "the framestore did not answer before the deadline");
   return future.get();
 }
 

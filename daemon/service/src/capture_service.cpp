@@ -108,9 +108,9 @@ google::protobuf::Timestamp ToProto(std::chrono::system_clock::time_point t) {
 }
 
 std::chrono::system_clock::time_point FromProto(const google::protobuf::Timestamp& t) {
-  return std::chrono::system_clock::time_point(std::chrono::duration_cast<
-                                               std::chrono::system_clock::duration>(
-      std::chrono::nanoseconds(TimeUtil::TimestampToNanoseconds(t))));
+  return std::chrono::system_clock::time_point(
+      std::chrono::duration_cast<std::chrono::system_clock::duration>(
+          std::chrono::nanoseconds(TimeUtil::TimestampToNanoseconds(t))));
 }
 
 // The frame's metadata; pixels only when `with_pixels`.
@@ -162,8 +162,8 @@ void FillInfo(const store::CaptureInfo& info, v1::CaptureInfo* out) {
 // A text field within the store's limit, else the field named.
 grpc::Status CheckText(const std::string& value, const char* field) {
   if (value.size() > store::kMaxTextField)
-    return Invalid(std::string(field) + " is " + std::to_string(value.size()) +
-                   " bytes; at most " + std::to_string(store::kMaxTextField) + " are accepted");
+    return Invalid(std::string(field) + " is " + std::to_string(value.size()) + " bytes; at most " +
+                   std::to_string(store::kMaxTextField) + " are accepted");
   return grpc::Status::OK;
 }
 
@@ -222,9 +222,9 @@ grpc::Status CaptureService::Authorize(grpc::ServerContext* context, std::string
   const Role needed = RequiredRole(full);
   if (caller->role < needed) {
     spdlog::warn("refused {} to {}: needs role {}", method, caller->Describe(), ToString(needed));
-    return {grpc::StatusCode::PERMISSION_DENIED,
-            std::string(method) + " needs the " + std::string(ToString(needed)) + " role; " +
-                caller->Describe() + " does not have it"};
+    return {grpc::StatusCode::PERMISSION_DENIED, std::string(method) + " needs the " +
+                                                     std::string(ToString(needed)) + " role; " +
+                                                     caller->Describe() + " does not have it"};
   }
   return grpc::Status::OK;
 }
@@ -318,9 +318,9 @@ grpc::Status CaptureService::StreamPreview(grpc::ServerContext* context,
                    " is above 250 (10 s between frames)");
   if (++preview_streams_ > limits_.max_preview_streams) {
     --preview_streams_;
-    return {grpc::StatusCode::RESOURCE_EXHAUSTED,
-            "bslsd already serves " + std::to_string(limits_.max_preview_streams) +
-                " preview streams; close one first"};
+    return {grpc::StatusCode::RESOURCE_EXHAUSTED, "bslsd already serves " +
+                                                      std::to_string(limits_.max_preview_streams) +
+                                                      " preview streams; close one first"};
   }
   struct Release {
     std::atomic<int>& count;
@@ -388,9 +388,9 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
     for (const auto& [one, side_slide] : {std::pair{GrabSides::kLeft, 2}, {GrabSides::kRight, 3}}) {
       if (framestore::Status changed = slides_->ChangeTo(side_slide, Deadline(context));
           !changed.ok()) {
-        frames = framestore::Status(changed.code(), "slide " + std::to_string(side_slide) +
-                                                        " for the grab of both sides: " +
-                                                        changed.message());
+        frames = framestore::Status(changed.code(),
+                                    "slide " + std::to_string(side_slide) +
+                                        " for the grab of both sides: " + changed.message());
         break;
       }
       framestore::Result<std::vector<framestore::GreyFrame>> grabbed =
@@ -431,8 +431,9 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
   FillCapture(*stored, reply->mutable_capture());
   if (request->include_frames())
     for (std::size_t i = 0; i < capture.frames.size(); ++i)
-      reply->mutable_capture()->mutable_frames(static_cast<int>(i))->set_pixels(
-          capture.frames[i].pixels.data(), capture.frames[i].pixels.size());
+      reply->mutable_capture()
+          ->mutable_frames(static_cast<int>(i))
+          ->set_pixels(capture.frames[i].pixels.data(), capture.frames[i].pixels.size());
   v1::Event event;
   v1::CaptureStored* note = event.mutable_capture_stored();
   note->set_capture_id(stored->id.str());
@@ -452,16 +453,16 @@ grpc::Status CaptureService::ListCaptures(grpc::ServerContext* context,
                    std::to_string(store::kMaxPageSize));
   store::CaptureFilter filter;
   if (!request->session_id().empty()) filter.session_id = request->session_id();
-  if (!request->patient_reference().empty()) filter.patient_reference = request->patient_reference();
+  if (!request->patient_reference().empty())
+    filter.patient_reference = request->patient_reference();
   // Times the store can hold: nanoseconds since 1970 in 64 bits (until 2262).
   for (const auto& [field, has, t] :
        {std::tuple{"taken_from", request->has_taken_from(), &request->taken_from()},
         std::tuple{"taken_before", request->has_taken_before(), &request->taken_before()}})
     if (has && (t->seconds() < 0 || t->seconds() > 9'000'000'000LL || t->nanos() < 0 ||
                 t->nanos() > 999'999'999))
-      return Invalid(std::string(field) + ": seconds " + std::to_string(t->seconds()) +
-                     ", nanos " + std::to_string(t->nanos()) +
-                     " is not a time between 1970 and 2255");
+      return Invalid(std::string(field) + ": seconds " + std::to_string(t->seconds()) + ", nanos " +
+                     std::to_string(t->nanos()) + " is not a time between 1970 and 2255");
   if (request->has_taken_from()) filter.taken_from = FromProto(request->taken_from());
   if (request->has_taken_before()) filter.taken_before = FromProto(request->taken_before());
   filter.page_size = request->page_size();
@@ -483,8 +484,8 @@ grpc::Status CaptureService::GetCapture(grpc::ServerContext* context,
   FillCapture(capture->info, reply);
   for (std::size_t i = 0; i < capture->frames.size(); ++i) {
     const framestore::GreyFrame& frame = capture->frames[i];
-    reply->mutable_frames(static_cast<int>(i))->set_pixels(frame.pixels.data(),
-                                                           frame.pixels.size());
+    reply->mutable_frames(static_cast<int>(i))
+        ->set_pixels(frame.pixels.data(), frame.pixels.size());
   }
   return grpc::Status::OK;
 }
@@ -549,8 +550,7 @@ grpc::Status NoSlides() {
 }  // namespace
 
 grpc::Status CaptureService::GetSlideState(grpc::ServerContext* context,
-                                           const v1::GetSlideStateRequest*,
-                                           v1::SlideState* reply) {
+                                           const v1::GetSlideStateRequest*, v1::SlideState* reply) {
   Caller caller;
   if (grpc::Status s = Authorize(context, "GetSlideState", &caller); !s.ok()) return s;
   FillSlideState(reply);
@@ -611,9 +611,9 @@ grpc::Status CaptureService::WatchEvents(grpc::ServerContext* context,
   if (draining_) return Draining();
   if (++event_streams_ > limits_.max_event_streams) {
     --event_streams_;
-    return {grpc::StatusCode::RESOURCE_EXHAUSTED,
-            "bslsd already serves " + std::to_string(limits_.max_event_streams) +
-                " event streams; close one first"};
+    return {grpc::StatusCode::RESOURCE_EXHAUSTED, "bslsd already serves " +
+                                                      std::to_string(limits_.max_event_streams) +
+                                                      " event streams; close one first"};
   }
   struct Release {
     std::atomic<int>& count;

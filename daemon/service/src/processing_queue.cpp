@@ -126,8 +126,8 @@ void ProcessingQueue::Run() {
     lock.lock();
     if (outcome == Outcome::kRetry) {
       if (stopping_) break;  // the call was cancelled by Stop: still pending
-      spdlog::warn("processing of capture {} will be tried again in {} ms: {}", id,
-                   backoff.count(), error);
+      spdlog::warn("processing of capture {} will be tried again in {} ms: {}", id, backoff.count(),
+                   error);
       lock.unlock();
       if (auto noted = store_->NoteProcessingAttempt(id, error); !noted.ok())
         spdlog::error("processing queue: {}", noted.message());
@@ -142,7 +142,8 @@ void ProcessingQueue::Run() {
     retry_at = {};
     if (outcome == Outcome::kGone) continue;
     ++finished_;
-    if (outcome == Outcome::kFailed) spdlog::error("processing of capture {} failed: {}", id, error);
+    if (outcome == Outcome::kFailed)
+      spdlog::error("processing of capture {} failed: {}", id, error);
     lock.unlock();
     Publish(id);
     lock.lock();
@@ -247,21 +248,20 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
                           {"sha256", f.sha256}});
   nlohmann::json file_hashes = nlohmann::json::object();
   for (const auto& [name, bytes] : files) file_hashes[name] = io::Sha256Hex(bytes);
-  const nlohmann::json record = {
-      {"format", "bsls-processing-record"},
-      {"format_version", 1},
-      {"capture_id", id},
-      {"session_id", info.session_id},
-      {"patient_reference", info.patient_reference},
-      {"side", store::ToString(info.side)},
-      {"frames", frame_list},
-      {"calibrations", calibrations},
-      {"call", call},
-      {"results", results},
-      {"files", file_hashes},
-      {"processing_software_version", version},
-      {"replica", replica},
-      {"daemon_software_version", options_.daemon_version}};
+  const nlohmann::json record = {{"format", "bsls-processing-record"},
+                                 {"format_version", 1},
+                                 {"capture_id", id},
+                                 {"session_id", info.session_id},
+                                 {"patient_reference", info.patient_reference},
+                                 {"side", store::ToString(info.side)},
+                                 {"frames", frame_list},
+                                 {"calibrations", calibrations},
+                                 {"call", call},
+                                 {"results", results},
+                                 {"files", file_hashes},
+                                 {"processing_software_version", version},
+                                 {"replica", replica},
+                                 {"daemon_software_version", options_.daemon_version}};
   files["record.json"] = record.dump(2) + "\n";
   if (auto stored = store_->PutProcessingResult(id, files, replica, version); !stored.ok()) {
     *error = stored.message();

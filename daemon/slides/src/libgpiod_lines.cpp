@@ -80,7 +80,8 @@ class LibgpiodLines final : public GpioLines {
     auto it = lines_.find(offset);
     if (it == lines_.end()) return NotRequested(offset);
     const int value = gpiod_line_get_value(it->second);
-    if (value < 0) return FromErrno(errno, "reading line " + std::to_string(offset) + " of " + name_);
+    if (value < 0)
+      return FromErrno(errno, "reading line " + std::to_string(offset) + " of " + name_);
     return value;
   }
 
@@ -100,17 +101,21 @@ class LibgpiodLines final : public GpioLines {
         events = events_.count(offset) > 0;
       }
       if (events) {
-        timespec timeout{0, static_cast<long>(
-                                std::chrono::duration_cast<std::chrono::nanoseconds>(left).count())};
+        timespec timeout{
+            0,
+            static_cast<long>(std::chrono::duration_cast<std::chrono::nanoseconds>(left).count())};
         const int rc = gpiod_line_event_wait(line, &timeout);
-        if (rc < 0) return FromErrno(errno, "waiting on line " + std::to_string(offset) + " of " + name_);
+        if (rc < 0)
+          return FromErrno(errno, "waiting on line " + std::to_string(offset) + " of " + name_);
         if (rc == 1) {
           gpiod_line_event event{};
           gpiod_line_event_read(line, &event);  // consumed; the level is read above
         }
       } else {
-        ::poll(nullptr, 0, static_cast<int>(
-                               std::chrono::duration_cast<std::chrono::milliseconds>(left).count()) + 1);
+        ::poll(
+            nullptr, 0,
+            static_cast<int>(std::chrono::duration_cast<std::chrono::milliseconds>(left).count()) +
+                1);
       }
     }
   }
@@ -124,9 +129,9 @@ class LibgpiodLines final : public GpioLines {
               "line " + std::to_string(offset) + " of " + name_ + " is requested twice"};
     *out = gpiod_chip_get_line(chip_, offset);
     if (*out == nullptr)
-      return {ErrorCode::kInvalidArgument, "line " + std::to_string(offset) + " does not exist on " +
-                                               name_ + " (" +
-                                               std::to_string(gpiod_chip_num_lines(chip_)) + " lines)"};
+      return {ErrorCode::kInvalidArgument,
+              "line " + std::to_string(offset) + " does not exist on " + name_ + " (" +
+                  std::to_string(gpiod_chip_num_lines(chip_)) + " lines)"};
     return {};
   }
   Status Busy(unsigned offset, gpiod_line* line) {

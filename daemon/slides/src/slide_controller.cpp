@@ -20,7 +20,8 @@ Status Validate(const SlideControllerConfig& config) {
     return Invalid("select0_line and select1_line must both be set or both be absent");
   std::set<unsigned> used;
   auto line = [&used](const char* name, unsigned offset) -> Status {
-    if (offset > 1023) return Invalid(std::string(name) + " " + std::to_string(offset) + " is above 1023");
+    if (offset > 1023)
+      return Invalid(std::string(name) + " " + std::to_string(offset) + " is above 1023");
     if (!used.insert(offset).second)
       return Invalid(std::string(name) + " " + std::to_string(offset) + " is used by another line");
     return {};
@@ -155,9 +156,11 @@ Status SlideController::ChangeTo(int slide, Clock::time_point deadline) {
       if (!back.ok()) return fail(back.status());
       if (!*back)
         return fail({ErrorCode::kFailedPrecondition,
-                     "slide " + std::to_string(slide) + ": the carousel has confirmed no slide "
-                     "since the last change failed (" + lines_->Describe() +
-                     "); free it so that a slide is in place, then retry"});
+                     "slide " + std::to_string(slide) +
+                         ": the carousel has confirmed no slide "
+                         "since the last change failed (" +
+                         lines_->Describe() +
+                         "); free it so that a slide is in place, then retry"});
       from = unconfirmed_;
     }
     pulses = (slide - from + kSlides) % kSlides;

@@ -5,8 +5,8 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cassert>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <map>
@@ -501,8 +501,8 @@ Status CaptureStore::PutProcessingResult(std::string_view text,
   std::uint64_t bytes = 0;
   for (const auto& [name, content] : files) {
     if (!IsResultFileName(name))
-      return Status(ErrorCode::kInvalidArgument, context + ": \"" + name.substr(0, 64) +
-                                                     "\" is not a result file name");
+      return Status(ErrorCode::kInvalidArgument,
+                    context + ": \"" + name.substr(0, 64) + "\" is not a result file name");
     bytes += content.size();
   }
   if (Status status = CheckFreeSpace(*id, bytes); !status.ok()) return WithContext(status, context);
@@ -551,8 +551,8 @@ Result<std::map<std::string, std::string>> CaptureStore::ReadProcessingFiles(
     out[name] = std::move(*content);
   }
   if (!only.empty() && out.empty())
-    return Status(ErrorCode::kNotFound, "capture " + id->str() + " has no result \"" +
-                                            only.substr(0, 64) + "\"");
+    return Status(ErrorCode::kNotFound,
+                  "capture " + id->str() + " has no result \"" + only.substr(0, 64) + "\"");
   return out;
 }
 

@@ -159,7 +159,8 @@ Status WriteFileDurably(FileSystem& fs, const std::string& directory, const std:
       if (!written.ok()) {
         status = Prefixed(written.status(), "writing " + temp_path);
       } else if (*written == 0) {
-        status = Status(ErrorCode::kUnavailable, "writing " + temp_path + ": write returned 0 bytes");
+        status =
+            Status(ErrorCode::kUnavailable, "writing " + temp_path + ": write returned 0 bytes");
       } else {
         piece.remove_prefix(*written);
       }
@@ -167,7 +168,8 @@ Status WriteFileDurably(FileSystem& fs, const std::string& directory, const std:
   }
   // The data must be on disk before the rename can make the name point at it.
   if (status.ok()) {
-    if (Status synced = fs.Fsync(*fd); !synced.ok()) status = Prefixed(synced, "fsync of " + temp_path);
+    if (Status synced = fs.Fsync(*fd); !synced.ok())
+      status = Prefixed(synced, "fsync of " + temp_path);
   }
   if (Status closed = fs.Close(*fd); !closed.ok() && status.ok())
     status = Prefixed(closed, "closing " + temp_path);
@@ -189,8 +191,8 @@ Result<std::string> ReadWholeFile(FileSystem& fs, const std::string& path,
   while (status.ok()) {
     const std::size_t old_size = bytes.size();
     if (old_size > max_bytes) {
-      status = Status(ErrorCode::kDataLoss, path + " is larger than " + std::to_string(max_bytes) +
-                                                " bytes");
+      status = Status(ErrorCode::kDataLoss,
+                      path + " is larger than " + std::to_string(max_bytes) + " bytes");
       break;
     }
     bytes.resize(old_size + kChunk);

@@ -261,8 +261,9 @@ ProjectorPose PoseOfProjector(const PerspectivePlaneFit& perspective,
 SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params,
                               const CalibrationProgress& progress, const Cancellation& cancel) {
   const auto start = Clock::now();
-  const double total_views = static_cast<double>(
-      manifest.camera_views.size() + manifest.screen_views.size() + manifest.reference_views.size());
+  const double total_views =
+      static_cast<double>(manifest.camera_views.size() + manifest.screen_views.size() +
+                          manifest.reference_views.size());
   int views_begun = 0;
   // Every view is announced before it is read; the caller may stop there.
   auto begin_view = [&](const std::string& name) {
@@ -607,7 +608,8 @@ bool SharesWorldFrame(const SideCalibration& left, const SideCalibration& right,
   if (left.side == right.side) return fail("both calibrations are of the same side");
   const TargetGeometry& a = left.target;
   const TargetGeometry& b = right.target;
-  if (a.rows != b.rows || a.cols != b.cols || a.pitch_mm != b.pitch_mm || a.square_mm != b.square_mm)
+  if (a.rows != b.rows || a.cols != b.cols || a.pitch_mm != b.pitch_mm ||
+      a.square_mm != b.square_mm)
     return fail("the two calibrations used different targets");
   const bool matrices = left.projector.matrix_centre_mm && right.projector.matrix_centre_mm;
   const Eigen::Vector3d pa =

@@ -26,11 +26,10 @@
 #define BSLS_DECODER_SRC_CENTRES_AHEAD_H_
 
 #include <atomic>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <utility>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "bsls/extraction/stripe_centre.h"
 

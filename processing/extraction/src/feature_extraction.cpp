@@ -50,9 +50,9 @@ ExtractionResult ExtractFeatures(const cv::Mat& grey, const ExtractionParams& pa
     internal::ZhangSuenThinInPlace(&skeleton, params.zhang_suen, cancel);
     internal::MakeOnePixelWideInPlace(&skeleton, params.t_junctions, cancel);
     if (params.recentre) {
-      const cv::Mat smoothed = smoothing.valid()
-                                   ? smoothing.get()
-                                   : internal::RecentreSmoothing(grey, params.recentre_params, true);
+      const cv::Mat smoothed =
+          smoothing.valid() ? smoothing.get()
+                            : internal::RecentreSmoothing(grey, params.recentre_params, true);
       internal::RecentreOnRidgeInPlace(&skeleton, smoothed, params.recentre_params);
       cancel.ThrowIfRequested("the re-centring on ridges");
     }

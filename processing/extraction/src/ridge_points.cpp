@@ -2,10 +2,9 @@
 
 #include <algorithm>
 #include <bit>
-#include <stdexcept>
-
 #include <opencv2/core.hpp>
 #include <opencv2/core/hal/intrin.hpp>
+#include <stdexcept>
 
 namespace bsls::extraction {
 
@@ -26,9 +25,9 @@ std::span<const RidgePoint> RidgePoints::Row(int y) const {
 
 namespace {
 
-constexpr int kBandRows = 32;    // rows per parallel task
-constexpr int kVector = 16;      // pixels per vector step
-constexpr int kUnjudged = 255;   // the fall of a side cut by the image's edge
+constexpr int kBandRows = 32;   // rows per parallel task
+constexpr int kVector = 16;     // pixels per vector step
+constexpr int kUnjudged = 255;  // the fall of a side cut by the image's edge
 
 // One row or column of the smoothed image as a profile: value(i) for
 // i in 0 .. n-1, replicated beyond.
@@ -158,11 +157,11 @@ void RowCandidates(const uchar* s, int cols, int w, int t, std::vector<Candidate
       right = cv::v_min(right, cv::v_load(s + from + k));
     }
     const cv::v_uint8x16 before = v - left, after = v - right;  // saturating
-    unsigned mask =
-        static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
+    unsigned mask = static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
     mask &= ~0u << (done - from);  // lanes before `done` were taken by the step before
-    ForEachLane(mask, before, after,
-                [&](int k, uchar b, uchar a) { candidates->push_back({from + k, b, a}); });
+    ForEachLane(mask, before, after, [&](int k, uchar b, uchar a) {
+      candidates->push_back({from + k, b, a});
+    });
     done = from + kVector;
   }
   if (vectors) x = inner_end;  // the steps covered the inner part up to here
@@ -173,8 +172,8 @@ void RowCandidates(const uchar* s, int cols, int w, int t, std::vector<Candidate
 // The candidates of columns x0 .. x0 + kVector - 1 of `image`, each
 // column's in increasing row order. `rows_from` holds the start of every
 // image row for rows -w - 1 .. rows + w (clamped: replication), from index 0.
-void ColumnBlockCandidates(const cv::Mat& image, const std::vector<const uchar*>& rows_from,
-                           int x0, int w, int t, std::vector<Candidate> (&candidates)[kVector]) {
+void ColumnBlockCandidates(const cv::Mat& image, const std::vector<const uchar*>& rows_from, int x0,
+                           int w, int t, std::vector<Candidate> (&candidates)[kVector]) {
   for (auto& c : candidates) c.clear();
   const int rows = image.rows;
 #if CV_SIMD128
@@ -192,10 +191,10 @@ void ColumnBlockCandidates(const cv::Mat& image, const std::vector<const uchar*>
     }
     const cv::v_uint8x16 before = y - w < 0 ? unjudged : v - above;  // saturating
     const cv::v_uint8x16 after = y + w > rows - 1 ? unjudged : v - below;
-    unsigned mask =
-        static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
-    ForEachLane(mask, before, after,
-                [&](int k, uchar b, uchar a) { candidates[k].push_back({y, b, a}); });
+    unsigned mask = static_cast<unsigned>(cv::v_signmask(peak & (cv::v_min(before, after) >= vt)));
+    ForEachLane(mask, before, after, [&](int k, uchar b, uchar a) {
+      candidates[k].push_back({y, b, a});
+    });
   }
 #else
   (void)rows_from;

@@ -1,5 +1,6 @@
 #include "bsls/extraction/stripe_centre.h"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -8,8 +9,6 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <stdexcept>
 #include <vector>
-
-#include <Eigen/Dense>
 
 #include "input_checks.h"
 
@@ -290,8 +289,9 @@ std::optional<double> MeasureAcross(const cv::Mat& image, bool row_major, int al
   CoveredRun taken(0, hi - lo);
   auto need = [&](int from, int to) {
     taken.Cover(from, to, [&](int i0, int i1) {
-      ProfileAcross<Pixel>(image, row_major, along, lo + i0, lo + i1, params,
-                           profile.subspan(static_cast<size_t>(i0), static_cast<size_t>(i1 - i0 + 1)));
+      ProfileAcross<Pixel>(
+          image, row_major, along, lo + i0, lo + i1, params,
+          profile.subspan(static_cast<size_t>(i0), static_cast<size_t>(i1 - i0 + 1)));
     });
   };
   const auto m = MeasureProfile(std::span<const double>(profile), approximate - lo, params, need);
@@ -438,8 +438,8 @@ std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
   const double sigma0 = params.min_sigma;
   const double area_per_height = std::sqrt(2.0 * std::numbers::pi) * sigma0;
   for (int j = 0; j < k; ++j) {
-    const int at = std::clamp(static_cast<int>(std::lround(approximate[static_cast<size_t>(j)])), 0,
-                              n - 1);
+    const int at =
+        std::clamp(static_cast<int>(std::lround(approximate[static_cast<size_t>(j)])), 0, n - 1);
     theta[2 + 3 * j] = std::max(1.0, v[static_cast<size_t>(at)] - ground) * area_per_height;
     theta[3 + 3 * j] = approximate[static_cast<size_t>(j)];
     theta[4 + 3 * j] = sigma0;
@@ -517,8 +517,8 @@ std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
         if (cost_new <= cost) {
           double largest_shift = 0.0;
           for (int j = 0; j < k; ++j)
-            largest_shift = std::max({largest_shift, std::abs(delta[3 + 3 * j]),
-                                      std::abs(delta[4 + 3 * j])});
+            largest_shift =
+                std::max({largest_shift, std::abs(delta[3 + 3 * j]), std::abs(delta[4 + 3 * j])});
           theta = candidate;
           // A thousandth of a pixel is far below what the noise allows.
           converged = largest_shift < 1e-3 || cost - cost_new <= 1e-6 * std::max(cost, 1.0);
@@ -574,7 +574,8 @@ std::vector<std::optional<double>> MeasureCrowdedRow(const cv::Mat& image, int y
                                                      const StripeCentreParams& params) {
   const int margin = params.search_radius + 1;
   const int lo = std::max(0, static_cast<int>(std::floor(approximate_x.front())) - margin);
-  const int hi = std::min(image.cols - 1, static_cast<int>(std::ceil(approximate_x.back())) + margin);
+  const int hi =
+      std::min(image.cols - 1, static_cast<int>(std::ceil(approximate_x.back())) + margin);
   Scratch buffer(static_cast<size_t>(hi - lo + 1));
   ProfileAcross<Pixel>(image, true, y, lo, hi, params, buffer.span());
   std::vector<double> local(approximate_x.begin(), approximate_x.end());
@@ -629,8 +630,8 @@ std::optional<double> StripeCentreInColumn(const cv::Mat& image, int x, double a
 }
 
 std::vector<std::optional<double>> StripeCentresInRow(const cv::Mat& image, int y,
-                                                     std::span<const double> approximate_x,
-                                                     const StripeCentreParams& params) {
+                                                      std::span<const double> approximate_x,
+                                                      const StripeCentreParams& params) {
   RequireImageLine(image, y, true, "StripeCentresInRow");
   RequireValid(params, "StripeCentresInRow");
   if (approximate_x.empty())
@@ -662,8 +663,8 @@ std::optional<double> RidgeCentreAlong(const uchar* first, std::ptrdiff_t along,
   }
   int smooth[kSize] = {};
   for (int k = 2; k < kSize - 2; ++k)
-    smooth[k] = profile[k - 2] + 4 * profile[k - 1] + 6 * profile[k] + 4 * profile[k + 1] +
-                profile[k + 2];
+    smooth[k] =
+        profile[k - 2] + 4 * profile[k - 1] + 6 * profile[k] + 4 * profile[k + 1] + profile[k + 2];
   int peak = kReach;
   for (int k = kReach - kPeak; k <= kReach + kPeak; ++k)
     if (smooth[k] > smooth[peak]) peak = k;

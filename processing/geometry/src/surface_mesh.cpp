@@ -22,8 +22,8 @@ bool SurfaceMesh::IsValid(std::string* error) const {
   if (!SizeFits(normals, n))
     return Fail(error, "surface mesh: normals has " + std::to_string(normals.size()) + count);
   if (!SizeFits(uncertainty_mm, n))
-    return Fail(error, "surface mesh: uncertainty_mm has " +
-                           std::to_string(uncertainty_mm.size()) + count);
+    return Fail(
+        error, "surface mesh: uncertainty_mm has " + std::to_string(uncertainty_mm.size()) + count);
   if (!SizeFits(line, n))
     return Fail(error, "surface mesh: line has " + std::to_string(line.size()) + count);
   if (!SizeFits(flags, n))

@@ -10,10 +10,14 @@ namespace bsls::interpretation {
 
 std::string_view ToString(EndDirection ed) {
   switch (ed) {
-    case EndDirection::kTop: return "TEP";
-    case EndDirection::kBottom: return "BEP";
-    case EndDirection::kRight: return "REP";
-    case EndDirection::kLeft: return "LEP";
+    case EndDirection::kTop:
+      return "TEP";
+    case EndDirection::kBottom:
+      return "BEP";
+    case EndDirection::kRight:
+      return "REP";
+    case EndDirection::kLeft:
+      return "LEP";
   }
   return "?";
 }

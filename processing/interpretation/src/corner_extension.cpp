@@ -92,8 +92,8 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     if (edge.from < 0 || edge.to < 0 || edge.from == edge.to) continue;
     const SkeletonNode& a = graph.nodes()[edge.from];
     const SkeletonNode& b = graph.nodes()[edge.to];
-    if (a.kind != NodeKind::kJunction || b.kind != NodeKind::kJunction ||
-        a.rotation.size() != 3 || b.rotation.size() != 3)
+    if (a.kind != NodeKind::kJunction || b.kind != NodeKind::kJunction || a.rotation.size() != 3 ||
+        b.rotation.size() != 3)
       continue;
     const cv::Point2d chord = b.centre - a.centre;
     if (LeanFromVerticalDeg(chord) <= params.leg_tolerance_deg)
@@ -186,12 +186,11 @@ std::vector<cv::Point> ExtendCorners(const SkeletonGraph& graph, const CornerPar
     };
     for (const Corner& c : found) {
       const int step = c.segment_after ? 1 : -1;
-      const double segment_dx = px[std::clamp(c.index + step * params.leg, 0, n - 1)].x -
-                                px[c.index].x;
+      const double segment_dx =
+          px[std::clamp(c.index + step * params.leg, 0, n - 1)].x - px[c.index].x;
       const int line_end = c.segment_after ? edge.from : edge.to;
       const bool pattern = in_pattern(px[c.index], segment_dx, line_end);
-      if (!segment_ends_on_line(c.index, step, line_leaves_frame(px[c.index], c.vertical),
-                                pattern))
+      if (!segment_ends_on_line(c.index, step, line_leaves_frame(px[c.index], c.vertical), pattern))
         continue;
       // A rounded corner passes the leg test a few pixels before its apex:
       // the corner is the pixel farthest from the chord across the bend.

@@ -114,8 +114,8 @@ JunctionAttribute AttributeForSegment(pattern::Side side, double side_dx) {
 }
 
 // Thesis 5.2.3.1: detect a T-junction and its centre (JCP).
-JunctionDetection DetectJunction(const cv::Mat& skeleton, cv::Point candidate,
-                                 pattern::Side side, const JunctionParams& params) {
+JunctionDetection DetectJunction(const cv::Mat& skeleton, cv::Point candidate, pattern::Side side,
+                                 const JunctionParams& params) {
   if (skeleton.empty() || skeleton.type() != CV_8UC1)
     throw std::invalid_argument("DetectJunction: skeleton must be a non-empty CV_8UC1 image");
   std::string why;
@@ -144,7 +144,8 @@ JunctionDetection DetectJunction(const cv::Mat& skeleton, cv::Point candidate,
     for (size_t j = i + 1; j < dir.size(); ++j) {
       const double opposite = 180.0 - AngleBetweenDeg(dir[i], dir[j]);
       const double lean = std::max(LeanFromVerticalDeg(dir[i]), LeanFromVerticalDeg(dir[j]));
-      if (opposite > params.opposite_tolerance_deg || lean > params.vertical_tolerance_deg) continue;
+      if (opposite > params.opposite_tolerance_deg || lean > params.vertical_tolerance_deg)
+        continue;
       if ((dir[i].y > 0) == (dir[j].y > 0)) continue;  // one must go up, one down
       const double score = opposite + lean;
       if (score < best_score) {

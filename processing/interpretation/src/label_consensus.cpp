@@ -33,8 +33,8 @@ bool OddSum(const Label& l) { return ((l.p + l.v) % 2 + 2) % 2 == 1; }
 // be told, so both junctions must be proven again as lone ones), and the
 // patches are made again.
 struct Patches {
-  std::vector<int> of;      // per junction: its patch
-  std::vector<Label> rel;   // per junction: its label within its patch
+  std::vector<int> of;     // per junction: its patch
+  std::vector<Label> rel;  // per junction: its label within its patch
   int count = 0;
 };
 
@@ -78,7 +78,8 @@ Patches MakePatches(const std::vector<char>& odd_kind, const std::vector<Consens
       if (!(*trusted)[k]) continue;
       const ConsensusLink& l = links[k];
       const Label want = out.rel[l.a] + Label{l.dp, l.dv};
-      if (!(want == out.rel[l.b]) || OddSum(want) != static_cast<bool>(odd_kind[l.b])) bad.push_back(k);
+      if (!(want == out.rel[l.b]) || OddSum(want) != static_cast<bool>(odd_kind[l.b]))
+        bad.push_back(k);
     }
     if (bad.empty()) return out;
     if (round + 1 >= kPatchRounds) {
@@ -201,8 +202,10 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
       bool smooth_vote = false;
       for (const auto& [k, d, smooth, abrupt] : adj[j]) {
         std::optional<Label> via;
-        if ((*labelled)[k]) via = (*label)[k];
-        else if (lone(k)) via = own_label(k);
+        if ((*labelled)[k])
+          via = (*label)[k];
+        else if (lone(k))
+          via = own_label(k);
         if (!via) continue;
         // In half votes: a link whose ends' pitch differs abruptly is half a vote.
         const int weight = abrupt ? 1 : 2;
@@ -236,8 +239,7 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
 // contradicts them. The seeds are the second, independent witness that a
 // single link lacks. `votes`: (component, p shift) -> seeds.
 template <typename LabelOf>
-void JoinSeededComponents(const std::vector<ConsensusLink>& links,
-                          const std::vector<char>& trusted,
+void JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::vector<char>& trusted,
                           const std::map<std::pair<int, int>, int>& votes, int main_c,
                           int main_shift, int min_seeds, const ConsensusParams& params,
                           LabelOf label_of, Components* comps) {
@@ -249,8 +251,7 @@ void JoinSeededComponents(const std::vector<ConsensusLink>& links,
     if (count > b.second) b = {key.second, count};
   }
   for (const auto& [c, b] : best) {
-    if (c == main_c || b.second < min_seeds ||
-        total[c] - b.second > params.max_dissent * b.second)
+    if (c == main_c || b.second < min_seeds || total[c] - b.second > params.max_dissent * b.second)
       continue;
     // Shifts from c's frame to the main one's root frame that the links give.
     const auto [root, root_shift] = comps->Find(main_c);
@@ -262,14 +263,19 @@ void JoinSeededComponents(const std::vector<ConsensusLink>& links,
       const auto [ca, la] = label_of(l.a);
       const auto [cb, lb] = label_of(l.b);
       Label h;
-      if (ca == root && cb == c) h = la + Label{l.dp, l.dv} - lb;
-      else if (ca == c && cb == root) h = lb - Label{l.dp, l.dv} - la;
-      else continue;
+      if (ca == root && cb == c)
+        h = la + Label{l.dp, l.dv} - lb;
+      else if (ca == c && cb == root)
+        h = lb - Label{l.dp, l.dv} - la;
+      else
+        continue;
       ++count;
       // c's p is its own label plus b.first; through the link, plus h.p
       // back to main_c's frame and its shift.
-      if (h.p - root_shift.p + main_shift != b.first || OddSum(h)) ++against;
-      else ++shifts[h];
+      if (h.p - root_shift.p + main_shift != b.first || OddSum(h))
+        ++against;
+      else
+        ++shifts[h];
     }
     if (shifts.size() != 1) continue;
     const auto& [h, agree] = *shifts.begin();
@@ -360,9 +366,8 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
         candidates.push_back({best, evidence[i].x, evidence[i].y, best_h});
       i = end;
     }
-    std::sort(candidates.begin(), candidates.end(), [&](const Candidate& a, const Candidate& b) {
-      return a.support > b.support;
-    });
+    std::sort(candidates.begin(), candidates.end(),
+              [&](const Candidate& a, const Candidate& b) { return a.support > b.support; });
     for (const Candidate& c : candidates) {
       if (comps.Find(c.x).first == comps.Find(c.y).first) continue;
       comps.Join(c.x, c.y, c.h);

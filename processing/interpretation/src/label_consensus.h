@@ -57,8 +57,8 @@ struct ConsensusParams {
 // along its line and no link disagreeing.
 
 struct Consensus {
-  std::vector<int> p;  // per junction: line relative to line 0, or kUnlabelled
-  std::vector<int> v;  // per junction: row, relative (any even offset), or kUnlabelled
+  std::vector<int> p;          // per junction: line relative to line 0, or kUnlabelled
+  std::vector<int> v;          // per junction: row, relative (any even offset), or kUnlabelled
   int contradicted_links = 0;  // trusted links dropped as contradicting their patch
 };
 

@@ -271,8 +271,10 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     const int n = g.NodeAt(px);
     if (n < 0 || !seen.insert(n).second || g.nodes()[n].kind != NodeKind::kJunction) continue;
     if (!net.IsPatternJunction(n)) continue;
-    if (KindOf(net, n) == JunctionKind::kDirect) seeds.push_back(n);
-    else ++inner;
+    if (KindOf(net, n) == JunctionKind::kDirect)
+      seeds.push_back(n);
+    else
+      ++inner;
   }
   out->reference_junctions = static_cast<int>(seeds.size());
   if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
@@ -335,7 +337,9 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
         return label[n].p == kNoLabel ? std::nullopt
                                       : std::optional(std::make_pair(label[n].p, label[n].v));
       },
-      [&](int n) { label[n] = {kNoLabel, kNoLabel}; });
+      [&](int n) {
+        label[n] = {kNoLabel, kNoLabel};
+      });
 
   // Thesis point O: line 0's junction nearest the centre row is v = 0.
   const double centre_row = (g.size().height - 1) / 2.0;
@@ -353,8 +357,7 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
   auto support = [&](int n) {
     int agree = 0;
     for (const Link& l : adj[n])
-      if (label[l.to].p != kNoLabel &&
-          label[l.to] == Label{label[n].p + l.dp, label[n].v + l.dv})
+      if (label[l.to].p != kNoLabel && label[l.to] == Label{label[n].p + l.dp, label[n].v + l.dv})
         ++agree;
     return agree;
   };
@@ -436,9 +439,8 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
       out->junctions.push_back(j);
     }
   }
-  std::sort(out->junctions.begin(), out->junctions.end(), [](const auto& a, const auto& b) {
-    return a.p != b.p ? a.p < b.p : a.v < b.v;
-  });
+  std::sort(out->junctions.begin(), out->junctions.end(),
+            [](const auto& a, const auto& b) { return a.p != b.p ? a.p < b.p : a.v < b.v; });
 
   // Lines: walk each labelled line up and down from its junctions.
   std::map<int, std::vector<int>> nodes_of_line;

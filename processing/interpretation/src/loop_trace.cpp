@@ -7,15 +7,24 @@ namespace bsls::interpretation {
 
 std::string_view ToString(LoopClass c) {
   switch (c) {
-    case LoopClass::kComplete: return "complete";
-    case LoopClass::kBoundary: return "boundary";
-    case LoopClass::kOneDiscontinuity: return "one_discontinuity";
-    case LoopClass::kDoubleDiscontinuity: return "double_discontinuity";
-    case LoopClass::kMissingJunction: return "missing_junction";
-    case LoopClass::kTwoMissingJunctions: return "two_missing_junctions";
-    case LoopClass::kLargeArea: return "large_area";
-    case LoopClass::kOverlap: return "overlap";
-    case LoopClass::kIncomplete: return "incomplete";
+    case LoopClass::kComplete:
+      return "complete";
+    case LoopClass::kBoundary:
+      return "boundary";
+    case LoopClass::kOneDiscontinuity:
+      return "one_discontinuity";
+    case LoopClass::kDoubleDiscontinuity:
+      return "double_discontinuity";
+    case LoopClass::kMissingJunction:
+      return "missing_junction";
+    case LoopClass::kTwoMissingJunctions:
+      return "two_missing_junctions";
+    case LoopClass::kLargeArea:
+      return "large_area";
+    case LoopClass::kOverlap:
+      return "overlap";
+    case LoopClass::kIncomplete:
+      return "incomplete";
   }
   return "?";
 }
@@ -112,9 +121,12 @@ LoopClass ClassifyLoop(LoopRecord& r) {
   for (const LoopEvent& e : r.events)
     if (e.is_end && (e.end == EndDirection::kLeft || e.end == EndDirection::kRight)) ++horizontal;
   switch (r.n_e) {
-    case 1: return r.cls = LoopClass::kIncomplete;
-    case 2: return r.cls = LoopClass::kOneDiscontinuity;
-    case 3: return r.cls = LoopClass::kMissingJunction;
+    case 1:
+      return r.cls = LoopClass::kIncomplete;
+    case 2:
+      return r.cls = LoopClass::kOneDiscontinuity;
+    case 3:
+      return r.cls = LoopClass::kMissingJunction;
     case 4: {
       // Figure 5.34: a double break cuts a junction loose, so the walk passes
       // it three times; two missing junctions (Figure 5.36) leave two line
@@ -124,9 +136,10 @@ LoopClass ClassifyLoop(LoopRecord& r) {
       for (const LoopEvent& e : r.events)
         if (!e.is_end) most = std::max(most, ++visits[e.node]);
       return r.cls = (horizontal == 0 && most < 3) ? LoopClass::kTwoMissingJunctions
-                                                    : LoopClass::kDoubleDiscontinuity;
+                                                   : LoopClass::kDoubleDiscontinuity;
     }
-    default: return r.cls = LoopClass::kLargeArea;
+    default:
+      return r.cls = LoopClass::kLargeArea;
   }
 }
 

@@ -70,7 +70,9 @@ bool FindOverlap(const cv::Mat& sk, pattern::Side side, const ReferenceLineParam
 class Tracer {
  public:
   Tracer(cv::Mat& sk, const ReferenceLineParams& params, pattern::Side side)
-      : sk_(sk), params_(params), visited_(sk.size(), CV_8UC1, cv::Scalar(0)),
+      : sk_(sk),
+        params_(params),
+        visited_(sk.size(), CV_8UC1, cv::Scalar(0)),
         inward_(-pattern::ImageDirectionOfIncreasingP(side)) {}
 
   void MarkVisited(cv::Point p) { visited_.at<uchar>(p) = 1; }
@@ -118,8 +120,7 @@ class Tracer {
       if (step.x * dir.x + step.y * dir.y <= 0.2) continue;
       const cv::Point2d ahead = Normalised(cv::Point2d(Lookahead(q, p) - p));
       // Ties go to the inner side: branches of line 0 leave outwards.
-      const double score =
-          ahead.x * dir.x + ahead.y * dir.y + 1e-3 * inward_ * (q.x - p.x);
+      const double score = ahead.x * dir.x + ahead.y * dir.y + 1e-3 * inward_ * (q.x - p.x);
       if (score > best) {
         best = score;
         *next = q;

@@ -25,8 +25,7 @@ struct Candidate {
 
 // Sideways distance of `target` from the ray (origin, dir); negative `along`
 // means the target lies behind the ray.
-void RayMiss(cv::Point2d origin, cv::Point2d dir, cv::Point2d target, double* along,
-             double* miss) {
+void RayMiss(cv::Point2d origin, cv::Point2d dir, cv::Point2d target, double* along, double* miss) {
   const cv::Point2d d = target - origin;
   *along = d.x * dir.x + d.y * dir.y;
   *miss = std::abs(d.x * dir.y - d.y * dir.x);
@@ -47,7 +46,8 @@ bool ChordIsClear(const cv::Mat& sk, cv::Point a, cv::Point b) {
       const cv::Point q = chord[i + 1];
       if (p.x != q.x && p.y != q.y) {
         const cv::Point c1(p.x, q.y), c2(q.x, p.y);
-        if (!near_end(c1) && !near_end(c2) && IsSetPixel(sk, c1) && IsSetPixel(sk, c2)) return false;
+        if (!near_end(c1) && !near_end(c2) && IsSetPixel(sk, c1) && IsSetPixel(sk, c2))
+          return false;
       }
     }
   }
@@ -103,10 +103,14 @@ bool RepairParams::IsValid(std::string* error) const {
 
 std::string_view ToString(RepairKind kind) {
   switch (kind) {
-    case RepairKind::kLineGap: return "line_gap";
-    case RepairKind::kSegmentGap: return "segment_gap";
-    case RepairKind::kSegmentReach: return "segment_reach";
-    case RepairKind::kLineReach: return "line_reach";
+    case RepairKind::kLineGap:
+      return "line_gap";
+    case RepairKind::kSegmentGap:
+      return "segment_gap";
+    case RepairKind::kSegmentReach:
+      return "segment_reach";
+    case RepairKind::kLineReach:
+      return "line_reach";
   }
   return "?";
 }
@@ -146,7 +150,8 @@ std::vector<Repair> RepairRound(const JunctionNetwork& network,
         const EndInfo& b = ends[j];
         RepairKind kind;
         double max_gap;
-        if (a.end == EndDirection::kBottom && b.end == EndDirection::kTop && b.pixel.y > a.pixel.y) {
+        if (a.end == EndDirection::kBottom && b.end == EndDirection::kTop &&
+            b.pixel.y > a.pixel.y) {
           kind = RepairKind::kLineGap;
           max_gap = params.max_line_gap;
         } else if (a.end == EndDirection::kRight && b.end == EndDirection::kLeft &&
@@ -197,8 +202,9 @@ std::vector<Repair> RepairRound(const JunctionNetwork& network,
       if (!Reach(skeleton, g, e, reach, &hit)) continue;
       bool crowded = false;
       for (const SkeletonNode& n : g.nodes())
-        crowded |= n.kind == NodeKind::kJunction &&
-                   std::hypot(n.centre.x - hit.x, n.centre.y - hit.y) < params.min_junction_distance;
+        crowded |=
+            n.kind == NodeKind::kJunction &&
+            std::hypot(n.centre.x - hit.x, n.centre.y - hit.y) < params.min_junction_distance;
       if (crowded) continue;
       FillGap(skeleton, e.pixel, hit);
       used[i] = 1;

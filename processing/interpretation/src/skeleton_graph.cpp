@@ -51,8 +51,9 @@ bool SplitH(const std::vector<cv::Point>& cluster, IsSet is_set, std::vector<cv:
             std::vector<cv::Point>* a, std::vector<cv::Point>* b) {
   // Groups whose centres lie 3 px or more apart in x need a cluster at least
   // that wide: most clusters (one T) are narrower and are not looked into.
-  const auto [left, right] = std::minmax_element(
-      cluster.begin(), cluster.end(), [](const cv::Point& p, const cv::Point& q) { return p.x < q.x; });
+  const auto [left, right] =
+      std::minmax_element(cluster.begin(), cluster.end(),
+                          [](const cv::Point& p, const cv::Point& q) { return p.x < q.x; });
   if (cluster.empty() || right->x - left->x < 3) return false;
   std::vector<cv::Point>& branch = *branch_out;
   branch.clear();
@@ -93,8 +94,8 @@ bool SplitH(const std::vector<cv::Point>& cluster, IsSet is_set, std::vector<cv:
   for (const cv::Point& p : cluster) {
     int best[2] = {1 << 20, 1 << 20};
     for (size_t i = 0; i < branch.size(); ++i)
-      best[group[i]] = std::min(best[group[i]], std::max(std::abs(p.x - branch[i].x),
-                                                         std::abs(p.y - branch[i].y)));
+      best[group[i]] = std::min(best[group[i]],
+                                std::max(std::abs(p.x - branch[i].x), std::abs(p.y - branch[i].y)));
     halves[best[1] < best[0] ? 1 : 0].push_back(p);
   }
   *a = std::move(halves[0]);
@@ -364,7 +365,8 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     const std::vector<cv::Point>& pixels = g.nodes_[id].pixels;  // until a node is added
     if (pixels.size() < 3) continue;
     std::vector<cv::Point> halves[2];
-    if (!SplitH(pixels, [&](int x, int y) { return set(x, y); }, &branch, &halves[0], &halves[1]))
+    if (!SplitH(
+            pixels, [&](int x, int y) { return set(x, y); }, &branch, &halves[0], &halves[1]))
       continue;
     // Each half must leave the cluster on exactly two pixels: its line.
     auto exits = [&](const std::vector<cv::Point>& half) {

@@ -26,10 +26,10 @@ struct Link {
   int dv = 0;
 };
 
-constexpr double kSmoothSpread = 1.2;   // a smooth step's row spacing against its neighbour's
-constexpr double kPitchSpread = 1.4;    // and the pitch beside its two ends
+constexpr double kSmoothSpread = 1.2;       // a smooth step's row spacing against its neighbour's
+constexpr double kPitchSpread = 1.4;        // and the pitch beside its two ends
 constexpr double kAbruptPitchSpread = 1.7;  // pitch at a link's two ends beyond this: abrupt
-constexpr double kCrowded = 0.55;  // lines closer than this times the frame's pitch crowd
+constexpr double kCrowded = 0.55;           // lines closer than this times the frame's pitch crowd
 constexpr double kOwnLine = 2.0;        // px: ridge points this close to a junction are its line's
 constexpr double kSpacingSpread = 1.6;  // a line's own row spacing lies within this factor
                                         // of the frame's

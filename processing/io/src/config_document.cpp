@@ -67,7 +67,8 @@ YAML::Node LoadConfigDocument(const std::optional<std::string>& path,
   return root;
 }
 
-void OnlyKeys(const YAML::Node& node, const std::string& where, const std::set<std::string>& known) {
+void OnlyKeys(const YAML::Node& node, const std::string& where,
+              const std::set<std::string>& known) {
   if (!node) return;
   if (!node.IsMap()) throw ConfigKeyError(where, "must be a mapping");
   for (const auto& item : node) {

@@ -68,8 +68,8 @@ cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::stri
   static constexpr unsigned char kPngHeader[] = {0, 0, 0, 13, 'I', 'H', 'D', 'R'};
   if (bytes.size() >= 8 && std::equal(std::begin(kPngStart), std::end(kPngStart), bytes.begin())) {
     // PNG: the first chunk is IHDR, width and height big-endian.
-    if (bytes.size() < 24 || !std::equal(std::begin(kPngHeader), std::end(kPngHeader),
-                                         bytes.begin() + 8))
+    if (bytes.size() < 24 ||
+        !std::equal(std::begin(kPngHeader), std::end(kPngHeader), bytes.begin() + 8))
       throw InputError(path + ": a PNG without its header (IHDR)");
     auto be32 = [&](size_t at) {
       return std::uint64_t{bytes[at]} << 24 | std::uint64_t{bytes[at + 1]} << 16 |

@@ -114,11 +114,11 @@ BaselineRegistration RegisterToBaseline(const SurfaceQuery& surface, const Surfa
   result.rigid = params.register_rigidly;
   auto check_pairs = [&](const std::vector<Pair>& pairs) {
     if (static_cast<int>(pairs.size()) < params.min_pairs)
-      throw MeasurementError(
-          "baseline: only " + std::to_string(pairs.size()) + " surface vertices outside the " +
-          "region lie within " + std::to_string(params.max_pair_mm) +
-          " mm of the baseline (at least " + std::to_string(params.min_pairs) +
-          " are needed): are they scans of the same face?");
+      throw MeasurementError("baseline: only " + std::to_string(pairs.size()) +
+                             " surface vertices outside the " + "region lie within " +
+                             std::to_string(params.max_pair_mm) + " mm of the baseline (at least " +
+                             std::to_string(params.min_pairs) +
+                             " are needed): are they scans of the same face?");
   };
   std::vector<Pair> pairs = PairUp(outside, baseline, result.transform, params.max_pair_mm);
   check_pairs(pairs);

@@ -122,7 +122,8 @@ FilledField FillHoles(const GridField& field) {
     }
     const int row = static_cast<int>(rhs.size());
     for (int k = 0; k < 5; ++k)
-      if (unknown_index[cells[k]] >= 0) entries.emplace_back(row, unknown_index[cells[k]], weights[k]);
+      if (unknown_index[cells[k]] >= 0)
+        entries.emplace_back(row, unknown_index[cells[k]], weights[k]);
     rhs.push_back(b);
   };
   // The membrane's equations first, one per hole cell in the unknowns'

@@ -1,7 +1,7 @@
 #include "bsls/measurement/report.h"
 
-#include <algorithm>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <iomanip>
 #include <numbers>
 #include <sstream>
@@ -37,8 +37,8 @@ nlohmann::json ToJson(const BaselineRegistration& registration) {
   for (int r = 0; r < 4; ++r) matrix.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
   return {{"rigid", registration.rigid},
           {"surface_to_baseline", matrix},
-          {"rotation_deg", Eigen::AngleAxisd(registration.transform.linear()).angle() * 180.0 /
-                               std::numbers::pi},
+          {"rotation_deg",
+           Eigen::AngleAxisd(registration.transform.linear()).angle() * 180.0 / std::numbers::pi},
           {"translation_mm", registration.transform.translation().norm()},
           {"iterations", registration.iterations},
           {"pairs", registration.pairs},
@@ -48,19 +48,19 @@ nlohmann::json ToJson(const BaselineRegistration& registration) {
 nlohmann::json ToJson(const LesionMeasurement& result) {
   const Eigen::Vector3d& p = result.peak_position;
   nlohmann::json out = {{"kind", result.cavity ? "cavity" : "lump"},
-          {result.cavity ? "depth_mm" : "height_mm", ToJson(result.peak_mm)},
-          {"peak_position_mm", {p.x(), p.y(), p.z()}},
-          {"level_mm", result.level_mm},
-          {"area_mm2", ToJson(result.area_mm2)},
-          {"volume_mm3", ToJson(result.volume_mm3)},
-          {"region_area_mm2", ToJson(result.region_area_mm2)},
-          {"region_vertices", result.region_vertices},
-          {"surface_coverage", result.surface_coverage},
-          {"holes_filled",
-           {{"area_mm2", ToJson(result.filled_area_mm2)},
-            {"volume_mm3", ToJson(result.filled_volume_mm3)},
-            {"share_of_region", result.filled_share}}},
-          {"reference", ToJson(result.reference)}};
+                        {result.cavity ? "depth_mm" : "height_mm", ToJson(result.peak_mm)},
+                        {"peak_position_mm", {p.x(), p.y(), p.z()}},
+                        {"level_mm", result.level_mm},
+                        {"area_mm2", ToJson(result.area_mm2)},
+                        {"volume_mm3", ToJson(result.volume_mm3)},
+                        {"region_area_mm2", ToJson(result.region_area_mm2)},
+                        {"region_vertices", result.region_vertices},
+                        {"surface_coverage", result.surface_coverage},
+                        {"holes_filled",
+                         {{"area_mm2", ToJson(result.filled_area_mm2)},
+                          {"volume_mm3", ToJson(result.filled_volume_mm3)},
+                          {"share_of_region", result.filled_share}}},
+                        {"reference", ToJson(result.reference)}};
   if (result.baseline) out["baseline"] = ToJson(*result.baseline);
   return out;
 }

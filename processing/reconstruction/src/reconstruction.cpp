@@ -124,8 +124,8 @@ std::vector<double> AnchoredBridge(const std::map<int, double>& x_of_row, int ro
   std::size_t k = 0;
   for (int row = row0 + 1; row < row1; ++row) {
     while (k + 2 < anchors.size() && anchors[k + 1].y <= row) ++k;
-    xs.push_back(Hermite(anchors[k].y, anchors[k].x, slopes[k], anchors[k + 1].y,
-                         anchors[k + 1].x, slopes[k + 1], row));
+    xs.push_back(Hermite(anchors[k].y, anchors[k].x, slopes[k], anchors[k + 1].y, anchors[k + 1].x,
+                         slopes[k + 1], row));
   }
   return xs;
 }
@@ -173,7 +173,7 @@ geometry::SurfaceMesh Reconstruct(const decoder::DecodeResult& decode,
   ReconstructionReport r;
   const UncertaintyParams& u = triangulator.model().uncertainty;
   const MeshParams& mesh_params = params.mesh;
-  std::map<int, TriangulatedLine> by_p;  // ordered by p
+  std::map<int, TriangulatedLine> by_p;          // ordered by p
   std::multimap<int, cv::Point2d> junctions_of;  // p -> image position
   for (const decoder::DecodedJunction& j : decode.junctions)
     if (std::isfinite(j.position.x) && std::isfinite(j.position.y))

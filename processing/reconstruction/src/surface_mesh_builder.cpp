@@ -49,7 +49,6 @@ class RowIndex {
   std::vector<int> local_;
 };
 
-
 // The median of the samples of strips p - kSpacingStrips .. p + kSpacingStrips
 // (`samples` by strip), so that one or two strips lying wholly across a depth
 // jump do not set their own reference; nullopt when strip p has none.
@@ -209,10 +208,10 @@ void StitchStrips(const StripInput& in, const AddFace& add_face, MeshReport* r) 
     };
     int i = 0, j = 0;
     while (i + 1 < s.na || j + 1 < s.nb) {
-      const double step_a = i + 1 < s.na ? in.Length(s.a + i + 1, s.b + j)
-                                         : std::numeric_limits<double>::infinity();
-      const double step_b = j + 1 < s.nb ? in.Length(s.a + i, s.b + j + 1)
-                                         : std::numeric_limits<double>::infinity();
+      const double step_a =
+          i + 1 < s.na ? in.Length(s.a + i + 1, s.b + j) : std::numeric_limits<double>::infinity();
+      const double step_b =
+          j + 1 < s.nb ? in.Length(s.a + i, s.b + j + 1) : std::numeric_limits<double>::infinity();
       // The triangle of the step along `along` (its next sample `next`),
       // with the other line's sample `apex`, if its edges may be used.
       const auto step = [&](int along, int next, int apex, int i_next, int j_next) {

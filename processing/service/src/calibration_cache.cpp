@@ -16,7 +16,7 @@ std::string CalibrationCache::IdOf(std::string_view yaml) {
 }
 
 std::shared_ptr<const CachedCalibration> CalibrationCache::Put(std::string yaml,
-                                                              const std::string& name) {
+                                                               const std::string& name) {
   if (yaml.size() > kMaxCalibrationBytes)
     throw calibration::CalibrationFileError(name + ": " + std::to_string(yaml.size()) +
                                             " bytes, more than a calibration file may have (" +

@@ -44,11 +44,11 @@ grpc::Status ReadWork(Reader* reader, const ProgressCallback& progress, WorkOutc
   if (!status.ok()) return status;
   if (!damage.empty()) return grpc::Status(grpc::StatusCode::DATA_LOSS, damage);
   if (!have_result || !artifacts.Unfinished().empty())
-    return grpc::Status(grpc::StatusCode::DATA_LOSS,
-                        "the reply ended without its result" +
-                            (artifacts.Unfinished().empty()
-                                 ? std::string()
-                                 : " (unfinished: " + artifacts.Unfinished() + ")"));
+    return grpc::Status(
+        grpc::StatusCode::DATA_LOSS,
+        "the reply ended without its result" +
+            (artifacts.Unfinished().empty() ? std::string()
+                                            : " (unfinished: " + artifacts.Unfinished() + ")"));
   out->files = artifacts.files();
   return status;
 }

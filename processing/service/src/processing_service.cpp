@@ -690,11 +690,13 @@ Status ProcessingService::Calibrate(
     params.images.max_pixels = options_.max_frame_pixels;  // images are frames: the same budget
     try {
       result = calibration::CalibrateSide(
-          manifest, params, [&w](const std::string& view, double fraction) {
+          manifest, params,
+          [&w](const std::string& view, double fraction) {
             if (w.observer.cancelled && w.observer.cancelled()) return false;
             w.observer.Report("calibrate " + view, 0.05 + 0.9 * fraction);
             return true;
-          }, w.observer.cancellation());
+          },
+          w.observer.cancellation());
     } catch (const calibration::CalibrationError& e) {
       if (e.reason() == calibration::CalibrationErrorReason::kCancelled) throw;
       throw calibration::CalibrationError(e.reason(), strip(e.what()));

@@ -109,12 +109,10 @@ SessionOutcome ReconstructSession(const cv::Mat& left, const calibration::SideCa
   observer.CheckCancelled("the join");
   observer.Report("join", 0.8 - measure_share);
   try {
-    out.joined =
-        out.by_features
-            ? joining::JoinByFeatures(*out.left.surface, *out.right.surface, params.join_params,
-                                      cancel)
-            : joining::JoinSharedFrame(*out.left.surface, *out.right.surface, params.join_params,
-                                       cancel);
+    out.joined = out.by_features ? joining::JoinByFeatures(*out.left.surface, *out.right.surface,
+                                                           params.join_params, cancel)
+                                 : joining::JoinSharedFrame(*out.left.surface, *out.right.surface,
+                                                            params.join_params, cancel);
   } catch (const joining::JoinError& e) {
     throw SessionError(SessionErrorReason::kNotProcessed, SessionPart::kJoin,
                        std::string("join: ") + e.what());

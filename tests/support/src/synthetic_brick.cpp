@@ -1,7 +1,6 @@
 #include "bsls/testing/synthetic_brick.h"
 
 #include <cmath>
-
 #include <opencv2/imgproc.hpp>
 
 namespace bsls::testing {
@@ -43,9 +42,12 @@ SyntheticBrick DrawSyntheticBrick(const SyntheticBrickParams& params) {
     for (int v = params.first_row; v <= params.last_row; ++v) {
       const bool direct_row = ((v - p) % 2 + 2) % 2 == 0;
       pattern::JunctionKind kind;
-      if (direct_row && p + 1 < params.visible_lines) kind = pattern::JunctionKind::kDirect;
-      else if (!direct_row && p >= 1) kind = pattern::JunctionKind::kCorresponding;
-      else continue;
+      if (direct_row && p + 1 < params.visible_lines)
+        kind = pattern::JunctionKind::kDirect;
+      else if (!direct_row && p >= 1)
+        kind = pattern::JunctionKind::kCorresponding;
+      else
+        continue;
       const cv::Point q = pt(p, v);
       b.junctions.push_back({p, v, kind, cv::Point2d(q.x, q.y)});
     }

@@ -9,10 +9,9 @@
 #ifndef BSLS_SIMULATOR_EVALUATION_H_
 #define BSLS_SIMULATOR_EVALUATION_H_
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "bsls/simulator/ground_truth.h"
 
@@ -25,13 +24,13 @@ struct PointLabel {
 };
 
 struct LabelScore {
-  int truth = 0;        // truth junctions considered
-  int found = 0;        // truth junctions with a decoded junction within reach
-  int wrong_p = 0;      // found, but p differs
-  int wrong_v = 0;      // found, p right, v off the image's common offset
-  int unmatched = 0;    // decoded junctions with no truth within reach
-  int v_offset = 0;     // decoded v - true v of the majority
-  double position_rms = 0.0;  // px, over found junctions with the right label
+  int truth = 0;                   // truth junctions considered
+  int found = 0;                   // truth junctions with a decoded junction within reach
+  int wrong_p = 0;                 // found, but p differs
+  int wrong_v = 0;                 // found, p right, v off the image's common offset
+  int unmatched = 0;               // decoded junctions with no truth within reach
+  int v_offset = 0;                // decoded v - true v of the majority
+  double position_rms = 0.0;       // px, over found junctions with the right label
   std::vector<PointLabel> missed;  // truth junctions not found
   std::vector<PointLabel> wrong;   // truth junctions found with a wrong label
 
@@ -53,8 +52,8 @@ struct LinePoints {
 };
 
 struct LineScore {
-  int points = 0;     // decoded points with a true crossing on their row
-  double rms = 0.0;   // px, horizontal distance to the nearest true crossing of the row
+  int points = 0;    // decoded points with a true crossing on their row
+  double rms = 0.0;  // px, horizontal distance to the nearest true crossing of the row
 };
 
 // Scores decoded line points against the true crossings of the same row.
@@ -68,8 +67,8 @@ std::vector<LinePoints> TruthLines(const GroundTruth& truth);
 
 // Matches each truth junction to the nearest decoded one within `reach` px
 // (each decoded junction used once) and scores the labels.
-LabelScore ScoreLabels(const std::vector<PointLabel>& truth,
-                       const std::vector<PointLabel>& decoded, double reach);
+LabelScore ScoreLabels(const std::vector<PointLabel>& truth, const std::vector<PointLabel>& decoded,
+                       double reach);
 
 }  // namespace bsls::simulator
 

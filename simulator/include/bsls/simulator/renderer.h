@@ -64,7 +64,7 @@ struct RenderParams {
   // Shot noise: variance in grey levels^2 per grey level above black_level
   // (the gain in grey levels per photo-electron), >= 0; 0 = none.
   double shot_noise = 0.0;
-  std::uint32_t seed = 1;             // seeds the noise (std::mt19937)
+  std::uint32_t seed = 1;  // seeds the noise (std::mt19937)
 
   TruthParams truth;  // thresholds of the ground truth
 

@@ -31,8 +31,8 @@
 #include "bsls/geometry/pinhole_model.h"
 #include "bsls/pattern/brick_pattern.h"
 #include "bsls/simulator/albedo.h"
-#include "bsls/simulator/mesh.h"
 #include "bsls/simulator/lesion.h"
+#include "bsls/simulator/mesh.h"
 #include "bsls/simulator/surface.h"
 
 namespace bsls::simulator {

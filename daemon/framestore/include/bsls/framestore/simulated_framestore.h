@@ -30,14 +30,14 @@ namespace bsls::framestore {
 using SlideSource = std::function<int()>;
 
 struct SimulatedFramestoreParams {
-  double frame_rate_hz = 25.0;        // PAL, thesis Appendix C
+  double frame_rate_hz = 25.0;          // PAL, thesis Appendix C
   double breathing_amplitude_mm = 0.5;  // peak shift of the head along z
   double breathing_period_s = 4.0;
-  int breathing_phases = 4;            // rendered phases per period, >= 1
-  double noise_sigma = 3.0;            // grey levels at nominal gain
-  std::uint32_t seed = 1;              // seeds the per-frame noise
-  bool paced = true;                   // wait for the next frame time (false: as fast as rendered)
-  SlideSource slide;                   // empty: slide 2 for the left camera, 3 for the right
+  int breathing_phases = 4;  // rendered phases per period, >= 1
+  double noise_sigma = 3.0;  // grey levels at nominal gain
+  std::uint32_t seed = 1;    // seeds the per-frame noise
+  bool paced = true;         // wait for the next frame time (false: as fast as rendered)
+  SlideSource slide;         // empty: slide 2 for the left camera, 3 for the right
 
   // True when usable; otherwise `error` names the field and the reason.
   bool IsValid(std::string* error) const;

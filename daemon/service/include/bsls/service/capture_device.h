@@ -50,8 +50,8 @@ struct DeviceSnapshot {
 
 // What the device reports to the rest of the daemon.
 struct DeviceCallbacks {
-  std::function<void()> tick;                          // every loop pass (watchdog)
-  std::function<void(const std::string& reason)> lost; // a grab found the device gone
+  std::function<void()> tick;                            // every loop pass (watchdog)
+  std::function<void(const std::string& reason)> lost;   // a grab found the device gone
   std::function<void(const std::string& device)> found;  // it answers again
   std::function<void(framestore::Camera, int gain)> camera_changed;
 };
@@ -114,8 +114,8 @@ class CaptureDevice {
   DeviceCallbacks callbacks_;
 
   mutable std::mutex mutex_;
-  std::condition_variable wake_;     // the capture thread: commands, previews, stop
-  std::condition_variable frames_;   // preview streams: a new frame
+  std::condition_variable wake_;    // the capture thread: commands, previews, stop
+  std::condition_variable frames_;  // preview streams: a new frame
   std::deque<Command> commands_;
   bool stopping_ = false;
   int previews_ = 0;

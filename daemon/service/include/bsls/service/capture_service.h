@@ -52,9 +52,9 @@ class CaptureService final : public v1::CaptureDaemon::Service {
   // Everything is borrowed and must outlive the service; `slides` may be
   // nullptr (no slide controller configured: slide calls fail UNAVAILABLE),
   // `processing` too (captures are then reported STATE_DISABLED).
-  CaptureService(CaptureDevice* device, store::CaptureStore* store,
-                 slides::SlideController* slides, EventHub* events, const PeerRegistry* peers,
-                 const RolePolicy* policy, ServiceLimits limits, std::string software_version,
+  CaptureService(CaptureDevice* device, store::CaptureStore* store, slides::SlideController* slides,
+                 EventHub* events, const PeerRegistry* peers, const RolePolicy* policy,
+                 ServiceLimits limits, std::string software_version,
                  ProcessingQueue* processing = nullptr);
 
   // From now on new calls that change anything fail UNAVAILABLE ("shutting
@@ -80,8 +80,7 @@ class CaptureService final : public v1::CaptureDaemon::Service {
   grpc::Status GetCaptureResult(grpc::ServerContext* context,
                                 const v1::GetCaptureResultRequest* request,
                                 grpc::ServerWriter<v1::Artifact>* writer) override;
-  grpc::Status DeleteCapture(grpc::ServerContext* context,
-                             const v1::DeleteCaptureRequest* request,
+  grpc::Status DeleteCapture(grpc::ServerContext* context, const v1::DeleteCaptureRequest* request,
                              v1::DeleteCaptureResponse* reply) override;
   grpc::Status GetSlideState(grpc::ServerContext* context, const v1::GetSlideStateRequest* request,
                              v1::SlideState* reply) override;

@@ -30,9 +30,9 @@ std::optional<Role> ParseRole(std::string_view text);
 
 // The caller of one RPC, as the daemon logs it.
 struct Caller {
-  std::int64_t uid = -1;    // local callers; -1 for TCP
-  std::string name;         // user name, or the certificate's common name
-  std::string transport;    // "unix" or "tcp"
+  std::int64_t uid = -1;  // local callers; -1 for TCP
+  std::string name;       // user name, or the certificate's common name
+  std::string transport;  // "unix" or "tcp"
   Role role = Role::kNone;
 
   // "alice (uid 1000, unix, operator)" for logs and capture metadata.

@@ -50,9 +50,9 @@ class PeerRegistry {
 
 // Where and how the socket is created, and the limits on its connections.
 struct UnixListenerOptions {
-  std::string path;           // socket path; its directory must exist
-  mode_t mode = 0660;         // permissions of the socket file
-  std::optional<gid_t> group; // owning group of the socket file (else the daemon's)
+  std::string path;            // socket path; its directory must exist
+  mode_t mode = 0660;          // permissions of the socket file
+  std::optional<gid_t> group;  // owning group of the socket file (else the daemon's)
   int backlog = 64;
   // Connections open at once (handed to gRPC and not yet closed by it), in
   // all and per peer uid; a connection beyond either is closed as soon as
@@ -68,7 +68,8 @@ class UnixListener {
  public:
   // Binds and listens on options.path (a stale socket file left by a dead
   // daemon is replaced; a live one is kAlreadyExists).
-  static framestore::Result<std::unique_ptr<UnixListener>> Create(const UnixListenerOptions& options);
+  static framestore::Result<std::unique_ptr<UnixListener>> Create(
+      const UnixListenerOptions& options);
   ~UnixListener();
   UnixListener(const UnixListener&) = delete;
   UnixListener& operator=(const UnixListener&) = delete;

@@ -32,8 +32,9 @@ class EmulatedSlideChanger final : public GpioLines {
  public:
   // The mechanism wired as `config` says, carousel at config.initial_slide,
   // moving config.emulated_travel per position.
-  explicit EmulatedSlideChanger(const SlideControllerConfig& config,
-                                std::chrono::milliseconds min_pulse = std::chrono::milliseconds(10));
+  explicit EmulatedSlideChanger(
+      const SlideControllerConfig& config,
+      std::chrono::milliseconds min_pulse = std::chrono::milliseconds(10));
 
   Status RequestOutput(unsigned offset, int initial) override;
   Status RequestInput(unsigned offset) override;
@@ -47,14 +48,14 @@ class EmulatedSlideChanger final : public GpioLines {
   bool moving() const;
   int focus_steps() const;  // + farther
   bool lamp_lit() const;
-  int advances() const;     // complete advance pulses seen
+  int advances() const;  // complete advance pulses seen
   void SetFaults(const EmulatedSlideChangerFaults& faults);
 
  private:
   int Level(unsigned offset) const;  // physical level; mutex_ held
   int InPlaceLevel() const;          // mutex_ held
   bool Active(int level) const { return config_.active_low ? level == 0 : level == 1; }
-  void Settle() const;               // finishes a move whose time has come; mutex_ held
+  void Settle() const;  // finishes a move whose time has come; mutex_ held
 
   SlideControllerConfig config_;
   std::chrono::milliseconds min_pulse_;

@@ -40,12 +40,12 @@ struct SlideControllerConfig {
   unsigned lamp_line = 4;
   unsigned focus_in_line = 5;
   unsigned focus_out_line = 6;
-  bool active_low = false;  // every line: logical 1 is the low level
-  std::chrono::milliseconds pulse{50};           // advance pulse width
-  std::chrono::milliseconds settle{20};          // in_place must drop within this after a pulse
+  bool active_low = false;                         // every line: logical 1 is the low level
+  std::chrono::milliseconds pulse{50};             // advance pulse width
+  std::chrono::milliseconds settle{20};            // in_place must drop within this after a pulse
   std::chrono::milliseconds change_timeout{5000};  // per slide change
-  std::chrono::milliseconds focus_step{5};       // high and low time of one focus step
-  int initial_slide = 1;                         // at power-on, without select lines
+  std::chrono::milliseconds focus_step{5};         // high and low time of one focus step
+  int initial_slide = 1;                           // at power-on, without select lines
   // The emulated mechanism's travel time per position (slides.backend simulated).
   std::chrono::milliseconds emulated_travel{300};
 };
@@ -56,12 +56,12 @@ Status Validate(const SlideControllerConfig& config);
 
 // What the controller knows.
 struct SlideState {
-  int slide = 0;             // the slide last commanded (0: unknown)
-  bool in_place = false;     // the mechanism confirmed it
-  bool moving = false;       // a change is under way
+  int slide = 0;          // the slide last commanded (0: unknown)
+  bool in_place = false;  // the mechanism confirmed it
+  bool moving = false;    // a change is under way
   bool lamp_on = false;
-  int focus_position = 0;    // focus steps from start-up (+ farther)
-  std::string last_error;    // of the last command; empty when it succeeded
+  int focus_position = 0;  // focus steps from start-up (+ farther)
+  std::string last_error;  // of the last command; empty when it succeeded
 };
 
 class SlideController {

@@ -106,8 +106,8 @@ struct ProcessingRecord {
   ProcessingState state = ProcessingState::kPending;
   int attempts = 0;
   std::string last_error;
-  std::string replica;           // of the processing service that did it
-  std::string software_version;  // of that service
+  std::string replica;                       // of the processing service that did it
+  std::string software_version;              // of that service
   std::map<std::string, std::string> files;  // result file name -> hex SHA-256 (kDone)
   std::chrono::system_clock::time_point updated;
 };

@@ -1,6 +1,7 @@
 // The SQLite index of the capture store: one row per acknowledged capture in
 // `captures`, one row per frame file in `frames` and at most one processing
-// record per capture in `processing` (foreign keys, ON DELETE CASCADE). docs/capture-store.md lists the schema.
+// record per capture in `processing` (foreign keys, ON DELETE CASCADE). docs/capture-store.md lists
+// the schema.
 //
 // Durability: the database runs in WAL mode with synchronous=FULL, so a
 // successful Insert or Remove has synced the WAL before it returns.

@@ -31,7 +31,6 @@
 
 namespace bsls::store {
 
-
 // "<id>-<camera>.pgm".
 std::string FrameFileName(const CaptureId& id, framestore::Camera camera);
 

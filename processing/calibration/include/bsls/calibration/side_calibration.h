@@ -59,12 +59,12 @@
 #include <vector>
 
 #include "bsls/calibration/calibration_error.h"
-#include "bsls/common/cancellation.h"
 #include "bsls/calibration/camera_calibration.h"
 #include "bsls/calibration/manifest.h"
 #include "bsls/calibration/projector_calibration.h"
 #include "bsls/calibration/reference_cross.h"
 #include "bsls/calibration/target_detect.h"
+#include "bsls/common/cancellation.h"
 #include "bsls/decoder/decoder.h"
 #include "bsls/geometry/pinhole_model.h"
 #include "bsls/io/frame_file.h"
@@ -80,9 +80,9 @@ struct SideCalibrationParams {
   // chain: its junctions lie closer to the truth (docs/decoding.md, "Which
   // chain"), and the projector's model is fitted to them.
   decoder::DecodeParams decode = decoder::SkeletonChainParams();
-  StripeFitParams stripes;                  // step 3, both plane models
-  CrossParams cross;                        // step 4
-  ProjectorMatrixParams matrix;             // step 5
+  StripeFitParams stripes;       // step 3, both plane models
+  CrossParams cross;             // step 4
+  ProjectorMatrixParams matrix;  // step 5
   // The fewest usable views of each kind (listed, and left once the views
   // that give nothing are dropped) that still calibrate; docs/calibration.md,
   // "Views that fail", says why. Camera views: two planes at distinct z make

@@ -16,11 +16,10 @@
 #ifndef BSLS_EXTRACTION_RIDGE_POINTS_H_
 #define BSLS_EXTRACTION_RIDGE_POINTS_H_
 
+#include <opencv2/core.hpp>
 #include <span>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace bsls::extraction {
 
@@ -37,15 +36,16 @@ struct RidgeParams {
 };
 
 struct RidgePoint {
-  float x = 0;     // sub-pixel column of the peak (parabola through three pixels)
-  int y = 0;       // row
+  float x = 0;         // sub-pixel column of the peak (parabola through three pixels)
+  int y = 0;           // row
   int prominence = 0;  // grey levels: the smaller fall within half_window
 };
 
 // The ridge points of an image, row by row, each row's from left to right.
 struct RidgePoints {
   std::vector<RidgePoint> points;
-  std::vector<int> row_start;  // rows + 1 entries: row y holds points [row_start[y], row_start[y+1])
+  std::vector<int>
+      row_start;  // rows + 1 entries: row y holds points [row_start[y], row_start[y+1])
 
   // The points of row y (empty outside the image).
   std::span<const RidgePoint> Row(int y) const;

@@ -110,8 +110,8 @@ std::optional<double> RidgeCentreInColumn(const cv::Mat& image, int x, double ap
 // No positions, a position that is not finite or positions out of order
 // throw std::invalid_argument.
 std::vector<std::optional<double>> StripeCentresInRow(const cv::Mat& image, int y,
-                                                     std::span<const double> approximate_x,
-                                                     const StripeCentreParams& params = {});
+                                                      std::span<const double> approximate_x,
+                                                      const StripeCentreParams& params = {});
 
 }  // namespace bsls::extraction
 

@@ -17,7 +17,7 @@ namespace bsls::geometry {
 
 using Sample = std::pair<double, double>;  // (t, x)
 using Samples = std::vector<Sample>;
-using Quadratic = std::array<double, 3>;   // x = c[0] + c[1] t + c[2] t^2
+using Quadratic = std::array<double, 3>;  // x = c[0] + c[1] t + c[2] t^2
 
 // Least-squares line x = a + b t through the samples; false with fewer than
 // two or all at one t.

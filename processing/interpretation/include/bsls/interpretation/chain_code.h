@@ -7,11 +7,10 @@
 #define BSLS_INTERPRETATION_CHAIN_CODE_H_
 
 #include <array>
+#include <opencv2/core.hpp>
 #include <optional>
 #include <string_view>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace bsls::interpretation {
 

@@ -10,20 +10,19 @@
 #ifndef BSLS_INTERPRETATION_CORNER_EXTENSION_H_
 #define BSLS_INTERPRETATION_CORNER_EXTENSION_H_
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "bsls/interpretation/skeleton_graph.h"
 
 namespace bsls::interpretation {
 
 struct CornerParams {
-  int leg = 5;                   // px of each leg used to measure its direction
-  double leg_tolerance_deg = 40; // how far a leg may lean from vertical / horizontal
-  int stub = 3;                  // px added along the line beyond the corner (a shorter
-                                 // stub melts into the corner's pixel cluster)
+  int leg = 5;                    // px of each leg used to measure its direction
+  double leg_tolerance_deg = 40;  // how far a leg may lean from vertical / horizontal
+  int stub = 3;                   // px added along the line beyond the corner (a shorter
+                                  // stub melts into the corner's pixel cluster)
   // px: a segment whose far end is free (its partner line unseen) still makes
   // a corner when at least this long and the stripe mask shows the line going
   // on; shorter ones are hooks at line ends.

@@ -27,9 +27,9 @@ struct InterpretationParams {
   ReferenceLineParams reference;
   RepairParams repair;
   LabellingParams labelling;
-  int max_repair_rounds = 8;    // thesis 5.1.4.7: retrace after each correction
-  int min_component_pixels = 6; // smaller skeleton pieces are noise (thesis 4.4)
-  bool enable_repair = true;    // off: label what is there, seal nothing
+  int max_repair_rounds = 8;     // thesis 5.1.4.7: retrace after each correction
+  int min_component_pixels = 6;  // smaller skeleton pieces are noise (thesis 4.4)
+  bool enable_repair = true;     // off: label what is there, seal nothing
   // px of empty frame put around the skeleton while interpreting, so that a
   // corner cut by the image's edge can still be extended (at least the stub).
   int frame_margin = 4;
@@ -40,11 +40,11 @@ struct InterpretationParams {
 
 struct InterpretationResult {
   bool ok = false;
-  std::string error;         // why the frame could not be labelled (ok == false)
-  cv::Mat skeleton;          // the repaired skeleton
+  std::string error;  // why the frame could not be labelled (ok == false)
+  cv::Mat skeleton;   // the repaired skeleton
   ReferenceLine reference;
   std::vector<Repair> repairs;
-  std::vector<cv::Point> corners;  // degree-2 corners extended to junctions (5.2.3.3)
+  std::vector<cv::Point> corners;         // degree-2 corners extended to junctions (5.2.3.3)
   std::map<LoopClass, int> loop_classes;  // classes found before any repair
   std::vector<LoopRecord> boundary;       // boundary networks after repair
   Labelling labelling;

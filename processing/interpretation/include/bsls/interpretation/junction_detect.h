@@ -7,10 +7,9 @@
 #ifndef BSLS_INTERPRETATION_JUNCTION_DETECT_H_
 #define BSLS_INTERPRETATION_JUNCTION_DETECT_H_
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "bsls/pattern/brick_pattern.h"
 
@@ -53,8 +52,8 @@ struct JunctionDetection {
 
 // Thesis 5.2.3.1 stages 2-7 for one candidate pixel, for the brick slide of
 // `side` (whose segments leave direct junctions towards growing p).
-JunctionDetection DetectJunction(const cv::Mat& skeleton, cv::Point candidate,
-                                 pattern::Side side, const JunctionParams& params = {});
+JunctionDetection DetectJunction(const cv::Mat& skeleton, cv::Point candidate, pattern::Side side,
+                                 const JunctionParams& params = {});
 
 // The attribute a T-junction with a segment leaving towards image direction
 // `side_dx` (< 0 left, > 0 right) has on `side`.

@@ -19,9 +19,9 @@ namespace bsls::interpretation {
 struct NodeRole {
   // For junction nodes: the attribute; for ends and anchors: unset.
   std::optional<JunctionAttribute> attribute;
-  int up = -1;    // half-edge continuing the line upwards (smaller y), or -1
-  int down = -1;  // half-edge continuing the line downwards, or -1
-  int side = -1;  // half-edge of the segment, or -1
+  int up = -1;         // half-edge continuing the line upwards (smaller y), or -1
+  int down = -1;       // half-edge continuing the line downwards, or -1
+  int side = -1;       // half-edge of the segment, or -1
   cv::Point2d centre;  // junction centre point (JCP) or end pixel
 };
 

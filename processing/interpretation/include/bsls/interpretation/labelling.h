@@ -42,12 +42,12 @@ struct LabellingParams {
 };
 
 struct LabelledJunction {
-  int node = -1;          // skeleton-graph node, -1 when interpolated
-  cv::Point2d position;   // junction centre point, pixels
+  int node = -1;         // skeleton-graph node, -1 when interpolated
+  cv::Point2d position;  // junction centre point, pixels
   int p = 0;
-  int v = 0;              // slide row, relative (see above)
+  int v = 0;  // slide row, relative (see above)
   pattern::JunctionKind kind = pattern::JunctionKind::kDirect;
-  bool interpolated = false;  // placed from relative junctions, not seen
+  bool interpolated = false;       // placed from relative junctions, not seen
   std::vector<cv::Point> segment;  // skeleton pixels of its segment, from the junction on
 };
 

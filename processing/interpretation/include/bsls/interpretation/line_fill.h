@@ -3,9 +3,8 @@
 #ifndef BSLS_INTERPRETATION_LINE_FILL_H_
 #define BSLS_INTERPRETATION_LINE_FILL_H_
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 namespace bsls::interpretation {
 

@@ -21,15 +21,15 @@ namespace bsls::interpretation {
 
 // Table 5.5 and section 5.1.4.8.
 enum class LoopClass {
-  kComplete,              // six junctions (five on line 0), alternating kinds, no end point
-  kBoundary,              // the outside of a connected pattern (boundary network)
-  kOneDiscontinuity,      // n_e = 2 facing ends (5.1.4.4 a)
-  kDoubleDiscontinuity,   // n_e = 4, two facing pairs (5.1.4.4 b)
-  kMissingJunction,       // n_e = 3: a line gap and a segment end (5.1.4.5)
-  kTwoMissingJunctions,   // n_e = 4, two line gaps without segment ends (5.1.4.6)
-  kLargeArea,             // n_e > 4 (5.1.4.7)
-  kOverlap,               // crossing points or a broken junction order (5.1.4.8)
-  kIncomplete,            // closed but not a brick (e.g. a missing median junction)
+  kComplete,             // six junctions (five on line 0), alternating kinds, no end point
+  kBoundary,             // the outside of a connected pattern (boundary network)
+  kOneDiscontinuity,     // n_e = 2 facing ends (5.1.4.4 a)
+  kDoubleDiscontinuity,  // n_e = 4, two facing pairs (5.1.4.4 b)
+  kMissingJunction,      // n_e = 3: a line gap and a segment end (5.1.4.5)
+  kTwoMissingJunctions,  // n_e = 4, two line gaps without segment ends (5.1.4.6)
+  kLargeArea,            // n_e > 4 (5.1.4.7)
+  kOverlap,              // crossing points or a broken junction order (5.1.4.8)
+  kIncomplete,           // closed but not a brick (e.g. a missing median junction)
 };
 
 // Name of a class, e.g. "missing_junction".
@@ -40,7 +40,7 @@ struct LoopEvent {
   bool is_end = false;
   int node = -1;
   JunctionAttribute attribute = JunctionAttribute::kCross3;  // junction visits
-  EndDirection end = EndDirection::kTop;                      // end points
+  EndDirection end = EndDirection::kTop;                     // end points
   cv::Point2d position;
   int walk_index = 0;  // index of the half-edge arriving at the event
 };

@@ -8,24 +8,23 @@
 #ifndef BSLS_INTERPRETATION_REFERENCE_LINE_H_
 #define BSLS_INTERPRETATION_REFERENCE_LINE_H_
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 #include "bsls/pattern/brick_pattern.h"
 
 namespace bsls::interpretation {
 
 struct ReferenceLineParams {
-  int scan_area = 15;           // px: side of the square scan areas (thesis: 15x15)
-  double cone_slope = 0.6;      // scan area 2: |across| <= cone_slope * along + 1
-  int direction_memory = 8;     // px of trace used to estimate the running direction
-  int lookahead = 4;            // px followed to break ties between neighbours
-  double central_band = 0.6;    // fraction of the rows, centred, where the start is sought
-  int start_tolerance = 6;      // px: a start must lie this close to the moving line
-  int min_length = 30;          // px: a shorter trace is not line 0
+  int scan_area = 15;         // px: side of the square scan areas (thesis: 15x15)
+  double cone_slope = 0.6;    // scan area 2: |across| <= cone_slope * along + 1
+  int direction_memory = 8;   // px of trace used to estimate the running direction
+  int lookahead = 4;          // px followed to break ties between neighbours
+  double central_band = 0.6;  // fraction of the rows, centred, where the start is sought
+  int start_tolerance = 6;    // px: a start must lie this close to the moving line
+  int min_length = 30;        // px: a shorter trace is not line 0
 
   // True when the numbers are usable; otherwise says why.
   bool IsValid(std::string* error) const;

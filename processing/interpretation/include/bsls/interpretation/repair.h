@@ -18,8 +18,8 @@
 namespace bsls::interpretation {
 
 struct RepairParams {
-  double max_line_gap = 40.0;     // px: longest gap sealed on a line (TEP-BEP)
-  double max_segment_gap = 22.0;  // px: longest gap sealed on a segment (LEP-REP)
+  double max_line_gap = 40.0;       // px: longest gap sealed on a line (TEP-BEP)
+  double max_segment_gap = 22.0;    // px: longest gap sealed on a segment (LEP-REP)
   double max_segment_reach = 20.0;  // px: how far a segment end is extended to meet a line
   double max_line_reach = 8.0;      // px: how far a line end is extended to meet a segment
   // Largest sideways miss (px) of an end's extrapolated direction at its

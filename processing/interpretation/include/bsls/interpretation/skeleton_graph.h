@@ -16,10 +16,9 @@
 #ifndef BSLS_INTERPRETATION_SKELETON_GRAPH_H_
 #define BSLS_INTERPRETATION_SKELETON_GRAPH_H_
 
+#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace bsls::interpretation {
 

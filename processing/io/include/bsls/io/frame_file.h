@@ -4,12 +4,11 @@
 #define BSLS_IO_FRAME_FILE_H_
 
 #include <cstdint>
+#include <opencv2/core.hpp>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <opencv2/core.hpp>
 
 namespace bsls::io {
 

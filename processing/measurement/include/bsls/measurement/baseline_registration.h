@@ -28,14 +28,14 @@
 namespace bsls::measurement {
 
 struct BaselineParams {
-  bool register_rigidly = true;           // false: the two scans share one frame as they are
-  double max_pair_mm = 5.0;               // pairs further apart (plane distance) are ignored, > 0
-  double huber_mm = 0.3;                  // Huber threshold on the plane distance, > 0
-  int max_iterations = 50;                // Gauss-Newton steps, >= 1
-  double converged_rotation_deg = 1e-3;   // a step below this rotation ...
-  double converged_translation_mm = 1e-3; // ... and translation ends the iteration (> 0)
-  int max_points = 20000;                 // vertices used (evenly thinned), >= 100
-  int min_pairs = 100;                    // fewer pairs is an error, >= 6
+  bool register_rigidly = true;            // false: the two scans share one frame as they are
+  double max_pair_mm = 5.0;                // pairs further apart (plane distance) are ignored, > 0
+  double huber_mm = 0.3;                   // Huber threshold on the plane distance, > 0
+  int max_iterations = 50;                 // Gauss-Newton steps, >= 1
+  double converged_rotation_deg = 1e-3;    // a step below this rotation ...
+  double converged_translation_mm = 1e-3;  // ... and translation ends the iteration (> 0)
+  int max_points = 20000;                  // vertices used (evenly thinned), >= 100
+  int min_pairs = 100;                     // fewer pairs is an error, >= 6
   // Share of the lesion region's surface the baseline must lie under, (0, 1];
   // where it does not, the region's area and volume are not measured.
   double min_coverage = 0.8;

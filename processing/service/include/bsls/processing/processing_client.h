@@ -78,8 +78,7 @@ class ProcessingClient {
   WorkOutcome Measure(const v1::MeasureRequest& request, const ProgressCallback& progress = {});
   // Calibrate: the manifest, then every file in 1 MiB chunks; with retries.
   WorkOutcome Calibrate(const std::string& manifest_yaml, const std::vector<UploadFile>& files,
-                        const std::string& request_tag = "",
-                        const ProgressCallback& progress = {});
+                        const std::string& request_tag = "", const ProgressCallback& progress = {});
   // PutCalibration (no retry: it is quick; the caller decides).
   grpc::Status PutCalibration(const std::string& yaml, v1::CalibrationInfo* info);
   // GetServerInfo of whichever replica answers.

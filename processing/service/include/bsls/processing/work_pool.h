@@ -24,8 +24,8 @@ namespace bsls::processing {
 struct WorkPoolStats {
   int workers = 0;
   int queue = 0;
-  int busy = 0;     // holding a worker now
-  int waiting = 0;  // admitted, waiting for a worker
+  int busy = 0;                 // holding a worker now
+  int waiting = 0;              // admitted, waiting for a worker
   std::uint64_t completed = 0;  // tickets that held a worker and were released
   std::uint64_t rejected = 0;   // TryAdmit refusals
 };

@@ -1,6 +1,6 @@
 // Starting the product's executables from the tests: one fork/exec with the
-// child's stdout and stderr in a log file, and the child's end (ChildProcess), shared by the launchers of bslsd
-// (tests/daemon/daemon_process.h) and bsls-processd
+// child's stdout and stderr in a log file, and the child's end (ChildProcess), shared by the
+// launchers of bslsd (tests/daemon/daemon_process.h) and bsls-processd
 // (tests/processing/processd_process.h).
 #ifndef BSLS_TESTING_SPAWN_H_
 #define BSLS_TESTING_SPAWN_H_

@@ -6,9 +6,8 @@
 #ifndef BSLS_TESTING_SYNTHETIC_BRICK_H_
 #define BSLS_TESTING_SYNTHETIC_BRICK_H_
 
-#include <vector>
-
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "bsls/pattern/brick_pattern.h"
 
@@ -18,8 +17,8 @@ struct SyntheticBrickParams {
   pattern::Side side = pattern::Side::kLeft;
   cv::Size size{512, 512};
   pattern::PatternSpec spec{};
-  int visible_lines = 14;     // lines 0 .. visible_lines-1 are drawn
-  int first_row = -16;        // slide rows drawn
+  int visible_lines = 14;  // lines 0 .. visible_lines-1 are drawn
+  int first_row = -16;     // slide rows drawn
   int last_row = 16;
   double line_pitch = 15.0;   // px between neighbouring lines
   double row_spacing = 13.0;  // px between consecutive rows
