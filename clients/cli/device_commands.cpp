@@ -174,11 +174,10 @@ std::unique_ptr<v1::CaptureDaemon::Stub> Connect(const DeviceOptions& options) {
   return v1::CaptureDaemon::NewStub(OpenChannel(options.address));
 }
 
-}  // namespace
+using SharedOptions = std::shared_ptr<DeviceOptions>;
 
-void AddDeviceCommands(CLI::App& app) {
-  auto options = std::make_shared<DeviceOptions>();
-
+// bsls status: the daemon's device, slides and store.
+void AddStatusCommand(CLI::App& app, const SharedOptions& options) {
   CLI::App* status =
       AddDeviceCommand(app, "status", "the capture daemon's device, slides and store", *options);
   status->callback([options] {
@@ -187,7 +186,10 @@ void AddDeviceCommands(CLI::App& app) {
               "GetStatus", options->address);
     PrintStatus(reply, options->json);
   });
+}
 
+// bsls camera CAMERA: selects the camera of previews and one-side grabs.
+void AddCameraCommand(CLI::App& app, const SharedOptions& options) {
   auto camera = std::make_shared<std::string>();
   CLI::App* camera_command =
       AddDeviceCommand(app, "camera", "select the camera of previews and one-side grabs", *options);
@@ -202,7 +204,10 @@ void AddDeviceCommands(CLI::App& app) {
               "SelectCamera", options->address);
     PrintStatus(reply, options->json);
   });
+}
 
+// bsls gain GAIN: sets the cameras' manual gain.
+void AddGainCommand(CLI::App& app, const SharedOptions& options) {
   auto gain = std::make_shared<int>(0);
   CLI::App* gain_command = AddDeviceCommand(app, "gain", "set the cameras' manual gain", *options);
   gain_command->add_option("GAIN", *gain, "inside the range `bsls status` shows")->required();
@@ -214,12 +219,48 @@ void AddDeviceCommands(CLI::App& app) {
               "SetGain", options->address);
     PrintStatus(reply, options->json);
   });
+}
 
-  // bsls slide [SLIDE] [--focus STEPS] [--lamp on|off]: without arguments, the state.
-  struct SlideArgs {
-    std::string slide, lamp;
-    int focus = 0;
-  };
+struct SlideArgs {
+  std::string slide, lamp;
+  int focus = 0;
+};
+
+// Sets the lamp, the slide and the focus as asked, in that order; without
+// any, reads the slide state. Prints the state the last call returned.
+void RunSlide(const DeviceOptions& options, const SlideArgs& args) {
+  auto stub = Connect(options);
+  v1::SlideState state;
+  bool changed = false;
+  if (!args.lamp.empty()) {
+    v1::SetLampRequest request;
+    request.set_on(args.lamp == "on");
+    CheckCall(stub->SetLamp(CallContext(options.address).get(), request, &state), "SetLamp",
+              options.address);
+    changed = true;
+  }
+  if (!args.slide.empty()) {
+    v1::SetSlideRequest request;
+    request.set_slide(kSlides.at(args.slide));
+    CheckCall(stub->SetSlide(CallContext(options.address).get(), request, &state), "SetSlide",
+              options.address);
+    changed = true;
+  }
+  if (args.focus != 0) {
+    v1::SetFocusRequest request;
+    request.set_steps(args.focus);
+    CheckCall(stub->SetFocus(CallContext(options.address).get(), request, &state), "SetFocus",
+              options.address);
+    changed = true;
+  }
+  if (!changed)
+    CheckCall(stub->GetSlideState(CallContext(options.address).get(), {}, &state), "GetSlideState",
+              options.address);
+  std::cout << (options.json ? Json(state) : Describe(state)) << "\n";
+}
+
+// bsls slide [SLIDE] [--focus STEPS] [--lamp on|off]: without arguments, the state.
+void AddSlideCommand(CLI::App& app, const SharedOptions& options) {
   auto slide_args = std::make_shared<SlideArgs>();
   CLI::App* slide = AddDeviceCommand(
       app, "slide", "put a slide in place (reference|left|right or 1|2|3), focus, lamp", *options);
@@ -229,37 +270,12 @@ void AddDeviceCommands(CLI::App& app) {
       ->check(CLI::Range(-1000, 1000));
   slide->add_option("--lamp", slide_args->lamp, "switch the projector lamp")
       ->check(CLI::IsMember({"on", "off"}));
-  slide->callback([options, slide_args] {
-    auto stub = Connect(*options);
-    v1::SlideState state;
-    bool changed = false;
-    if (!slide_args->lamp.empty()) {
-      v1::SetLampRequest request;
-      request.set_on(slide_args->lamp == "on");
-      CheckCall(stub->SetLamp(CallContext(options->address).get(), request, &state), "SetLamp",
-                options->address);
-      changed = true;
-    }
-    if (!slide_args->slide.empty()) {
-      v1::SetSlideRequest request;
-      request.set_slide(kSlides.at(slide_args->slide));
-      CheckCall(stub->SetSlide(CallContext(options->address).get(), request, &state), "SetSlide",
-                options->address);
-      changed = true;
-    }
-    if (slide_args->focus != 0) {
-      v1::SetFocusRequest request;
-      request.set_steps(slide_args->focus);
-      CheckCall(stub->SetFocus(CallContext(options->address).get(), request, &state), "SetFocus",
-                options->address);
-      changed = true;
-    }
-    if (!changed)
-      CheckCall(stub->GetSlideState(CallContext(options->address).get(), {}, &state),
-                "GetSlideState", options->address);
-    std::cout << (options->json ? Json(state) : Describe(state)) << "\n";
-  });
+  slide->callback([options, slide_args] { RunSlide(*options, *slide_args); });
+}
 
+// bsls grab [--side S] [--session ID] [--patient REF] [-o DIR]: grabs and
+// prints the stored capture, writing its frames with -o.
+void AddGrabCommand(CLI::App& app, const SharedOptions& options) {
   struct GrabArgs {
     std::string side = "both", session, patient, out;
   };
@@ -284,15 +300,15 @@ void AddDeviceCommands(CLI::App& app) {
     if (!grab_args->out.empty()) files = WriteFrames(reply.capture(), grab_args->out);
     PrintCapture(reply.capture(), files, options->json);
   });
+}
 
-  // bsls captures list|get|delete
-  CLI::App* captures = app.add_subcommand("captures", "the daemon's stored captures");
-  captures->require_subcommand(1);
+// bsls captures list [--session ID] [--patient REF]: every page of them.
+void AddListCommand(CLI::App& captures, const SharedOptions& options) {
   struct ListArgs {
     std::string session, patient;
   };
   auto list_args = std::make_shared<ListArgs>();
-  CLI::App* list = AddDeviceCommand(*captures, "list", "stored captures, oldest first", *options);
+  CLI::App* list = AddDeviceCommand(captures, "list", "stored captures, oldest first", *options);
   list->add_option("--session", list_args->session, "only this session");
   list->add_option("--patient", list_args->patient, "only this patient reference");
   list->callback([options, list_args] {
@@ -309,12 +325,16 @@ void AddDeviceCommands(CLI::App& app) {
       request.set_page_token(reply.next_page_token());
     } while (!request.page_token().empty());
   });
+}
 
-  struct GetArgs {
-    std::string id, out;
-  };
+struct GetArgs {
+  std::string id, out;
+};
+
+// bsls captures get ID [-o DIR]: one capture, its frames written with -o.
+void AddGetCommand(CLI::App& captures, const SharedOptions& options) {
   auto get_args = std::make_shared<GetArgs>();
-  CLI::App* get = AddDeviceCommand(*captures, "get", "one capture; -o writes its frames", *options);
+  CLI::App* get = AddDeviceCommand(captures, "get", "one capture; -o writes its frames", *options);
   get->add_option("CAPTURE_ID", get_args->id, "32 hex digits")->required();
   get->add_option("-o,--out", get_args->out, "write the frames as PNG into this folder");
   get->callback([options, get_args] {
@@ -327,45 +347,54 @@ void AddDeviceCommands(CLI::App& app) {
     if (!get_args->out.empty()) files = WriteFrames(info, get_args->out);
     PrintCapture(info, files, options->json);
   });
+}
 
-  // bsls captures results ID -o DIR: the processing results kept with the capture.
+// Streams the capture's result files and writes them into args.out, naming
+// each file written; CommandError when the stream fails or is damaged.
+void FetchResults(const DeviceOptions& options, const GetArgs& args) {
+  v1::GetCaptureResultRequest request;
+  request.set_capture_id(args.id);
+  auto context = CallContext(options.address);
+  auto reader = Connect(options)->GetCaptureResult(context.get(), request);
+  rpc::ArtifactAssembler assembler;
+  v1::Artifact chunk;
+  std::string damage;
+  while (reader->Read(&chunk)) {
+    if (!damage.empty()) continue;
+    try {
+      assembler.Add(chunk);
+    } catch (const rpc::ArtifactError& e) {
+      damage = e.what();
+    }
+  }
+  CheckCall(reader->Finish(), "GetCaptureResult", options.address);
+  if (!damage.empty()) throw CommandError(kExitServiceFailed, "GetCaptureResult: " + damage);
+  MakeFolder(args.out);
+  for (const auto& [name, bytes] : assembler.files()) {
+    const std::string path = args.out + "/" + name;
+    io::WriteFileAtomically(path, bytes);
+    if (options.json)
+      std::cout << nlohmann::json{{"file", path}, {"bytes", bytes.size()}}.dump() << "\n";
+    else
+      std::cout << "wrote " << path << " (" << bytes.size() << " bytes)\n";
+  }
+}
+
+// bsls captures results ID -o DIR: the processing results kept with the capture.
+void AddResultsCommand(CLI::App& captures, const SharedOptions& options) {
   auto results_args = std::make_shared<GetArgs>();
   CLI::App* results = AddDeviceCommand(
-      *captures, "results", "the processing results kept with a capture (surface, reports, record)",
+      captures, "results", "the processing results kept with a capture (surface, reports, record)",
       *options);
   results->add_option("CAPTURE_ID", results_args->id, "32 hex digits")->required();
   results->add_option("-o,--out", results_args->out, "folder for the files")->required();
-  results->callback([options, results_args] {
-    v1::GetCaptureResultRequest request;
-    request.set_capture_id(results_args->id);
-    auto context = CallContext(options->address);
-    auto reader = Connect(*options)->GetCaptureResult(context.get(), request);
-    rpc::ArtifactAssembler assembler;
-    v1::Artifact chunk;
-    std::string damage;
-    while (reader->Read(&chunk)) {
-      if (!damage.empty()) continue;
-      try {
-        assembler.Add(chunk);
-      } catch (const rpc::ArtifactError& e) {
-        damage = e.what();
-      }
-    }
-    CheckCall(reader->Finish(), "GetCaptureResult", options->address);
-    if (!damage.empty()) throw CommandError(kExitServiceFailed, "GetCaptureResult: " + damage);
-    MakeFolder(results_args->out);
-    for (const auto& [name, bytes] : assembler.files()) {
-      const std::string path = results_args->out + "/" + name;
-      io::WriteFileAtomically(path, bytes);
-      if (options->json)
-        std::cout << nlohmann::json{{"file", path}, {"bytes", bytes.size()}}.dump() << "\n";
-      else
-        std::cout << "wrote " << path << " (" << bytes.size() << " bytes)\n";
-    }
-  });
+  results->callback([options, results_args] { FetchResults(*options, *results_args); });
+}
 
+// bsls captures delete ID: deletes one capture (admin).
+void AddDeleteCommand(CLI::App& captures, const SharedOptions& options) {
   auto delete_id = std::make_shared<std::string>();
-  CLI::App* remove = AddDeviceCommand(*captures, "delete", "delete one capture (admin)", *options);
+  CLI::App* remove = AddDeviceCommand(captures, "delete", "delete one capture (admin)", *options);
   remove->add_option("CAPTURE_ID", *delete_id, "32 hex digits")->required();
   remove->callback([options, delete_id] {
     v1::DeleteCaptureRequest request;
@@ -379,12 +408,67 @@ void AddDeviceCommands(CLI::App& app) {
     else
       std::cout << "{\"deleted\":\"" << *delete_id << "\"}\n";
   });
+}
 
-  struct PreviewArgs {
-    std::string camera, out;
-    int frames = 25;
-    bool show = false;
-  };
+struct PreviewArgs {
+  std::string camera, out;
+  int frames = 25;
+  bool show = false;
+};
+
+// Takes args.frames preview frames (fewer when the window is closed with q
+// or Esc), writing each with -o and showing it with --show; prints what it
+// took.
+void RunPreview(const DeviceOptions& options, const PreviewArgs& args) {
+  if (args.out.empty() && !args.show)
+    throw CommandError(kExitUsage, "preview: give -o DIR (write the frames) or --show");
+  if (args.show && std::getenv("DISPLAY") == nullptr && std::getenv("WAYLAND_DISPLAY") == nullptr)
+    throw CommandError(kExitUsage, "preview --show: no display (DISPLAY is not set); use -o DIR");
+  if (!args.out.empty()) MakeFolder(args.out);
+  v1::PreviewRequest request;
+  if (!args.camera.empty()) request.set_camera(kCameras.at(args.camera));
+  // The stream's deadline covers every frame asked for, at 25 Hz, plus the timeout.
+  ServiceAddress address = options.address;
+  address.timeout_s += args.frames / 25.0;
+  auto context = CallContext(address);
+  auto reader = Connect(options)->StreamPreview(context.get(), request);
+  v1::PreviewFrame message;
+  int taken = 0;
+  std::uint64_t dropped = 0;
+  const auto start = std::chrono::steady_clock::now();
+  while (taken < args.frames && reader->Read(&message)) {
+    const cv::Mat view = FrameImage(message.frame(), "preview");
+    if (!args.out.empty()) {
+      char name[32];
+      std::snprintf(name, sizeof name, "preview_%05d.png", taken);
+      io::WritePngAtomically((fs::path(args.out) / name).string(), view);
+    }
+    dropped += message.dropped();
+    ++taken;
+    if (args.show) {
+      cv::imshow("bsls preview", view);
+      const int key = cv::waitKey(1);
+      if (key == 'q' || key == 27) break;
+    }
+  }
+  context->TryCancel();
+  const grpc::Status finished = reader->Finish();
+  if (taken < args.frames) CheckCall(finished, "StreamPreview", options.address);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (options.json)
+    std::cout << "{\"frames\":" << taken << ",\"dropped\":" << dropped << ",\"seconds\":" << seconds
+              << "}\n";
+  else if (!args.out.empty())
+    std::cout << "wrote " << taken << " frames to " << args.out << " in " << seconds << " s ("
+              << dropped << " skipped while writing)\n";
+  else
+    std::cout << "showed " << taken << " frames in " << seconds << " s (" << dropped
+              << " skipped)\n";
+}
+
+// bsls preview [--camera C] [--frames N] [-o DIR] [--show]: live frames.
+void AddPreviewCommand(CLI::App& app, const SharedOptions& options) {
   auto preview_args = std::make_shared<PreviewArgs>();
   CLI::App* preview = AddDeviceCommand(
       app, "preview", "live frames of one camera, written as PNG files or shown in a window",
@@ -396,54 +480,28 @@ void AddDeviceCommands(CLI::App& app) {
   preview->add_option("-o,--out", preview_args->out, "folder for preview_NNNNN.png");
   preview->add_flag("--show", preview_args->show,
                     "show the frames in a window (positioning the patient); q or Esc ends");
-  preview->callback([options, preview_args] {
-    if (preview_args->out.empty() && !preview_args->show)
-      throw CommandError(kExitUsage, "preview: give -o DIR (write the frames) or --show");
-    if (preview_args->show && std::getenv("DISPLAY") == nullptr &&
-        std::getenv("WAYLAND_DISPLAY") == nullptr)
-      throw CommandError(kExitUsage, "preview --show: no display (DISPLAY is not set); use -o DIR");
-    if (!preview_args->out.empty()) MakeFolder(preview_args->out);
-    v1::PreviewRequest request;
-    if (!preview_args->camera.empty()) request.set_camera(kCameras.at(preview_args->camera));
-    // The stream's deadline covers every frame asked for, at 25 Hz, plus the timeout.
-    ServiceAddress address = options->address;
-    address.timeout_s += preview_args->frames / 25.0;
-    auto context = CallContext(address);
-    auto reader = Connect(*options)->StreamPreview(context.get(), request);
-    v1::PreviewFrame message;
-    int taken = 0;
-    std::uint64_t dropped = 0;
-    const auto start = std::chrono::steady_clock::now();
-    while (taken < preview_args->frames && reader->Read(&message)) {
-      const cv::Mat view = FrameImage(message.frame(), "preview");
-      if (!preview_args->out.empty()) {
-        char name[32];
-        std::snprintf(name, sizeof name, "preview_%05d.png", taken);
-        io::WritePngAtomically((fs::path(preview_args->out) / name).string(), view);
-      }
-      dropped += message.dropped();
-      ++taken;
-      if (preview_args->show) {
-        cv::imshow("bsls preview", view);
-        const int key = cv::waitKey(1);
-        if (key == 'q' || key == 27) break;
-      }
-    }
-    context->TryCancel();
-    const grpc::Status finished = reader->Finish();
-    if (taken < preview_args->frames) CheckCall(finished, "StreamPreview", options->address);
-    const double seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (options->json)
-      std::cout << "{\"frames\":" << taken << ",\"dropped\":" << dropped
-                << ",\"seconds\":" << seconds << "}\n";
-    else if (!preview_args->out.empty())
-      std::cout << "wrote " << taken << " frames to " << preview_args->out << " in " << seconds
-                << " s (" << dropped << " skipped while writing)\n";
-    else
-      std::cout << "showed " << taken << " frames in " << seconds << " s (" << dropped
-                << " skipped)\n";
-  });
+  preview->callback([options, preview_args] { RunPreview(*options, *preview_args); });
+}
+
+}  // namespace
+
+void AddDeviceCommands(CLI::App& app) {
+  auto options = std::make_shared<DeviceOptions>();
+  AddStatusCommand(app, options);
+  AddCameraCommand(app, options);
+  AddGainCommand(app, options);
+  AddSlideCommand(app, options);
+  AddGrabCommand(app, options);
+
+  // bsls captures list|get|results|delete
+  CLI::App* captures = app.add_subcommand("captures", "the daemon's stored captures");
+  captures->require_subcommand(1);
+  AddListCommand(*captures, options);
+  AddGetCommand(*captures, options);
+  AddResultsCommand(*captures, options);
+  AddDeleteCommand(*captures, options);
+
+  AddPreviewCommand(app, options);
 }
 
 }  // namespace bsls::cli

@@ -28,6 +28,125 @@ v1::Camera ToProto(framestore::Camera camera) {
   return static_cast<v1::Camera>(static_cast<int>(camera) + 1);
 }
 
+// The capture store of `config`, opened; its recovery report logged.
+// Recovery reports damaged acknowledged captures, never drops them.
+Result<std::unique_ptr<store::CaptureStore>> OpenStore(const Config& config) {
+  Result<std::unique_ptr<store::CaptureStore>> opened = store::CaptureStore::Open(config.store);
+  if (!opened.ok())
+    return Status(opened.status().code(), "capture store: " + opened.status().message());
+  const store::RecoveryReport& recovery = (*opened)->recovery_report();
+  spdlog::info("capture store {}: {} captures checked, {} damaged, {} leftovers removed",
+               config.store.root, recovery.captures_checked, recovery.problems.size(),
+               recovery.temp_files_removed + recovery.orphan_files_removed);
+  for (const store::CaptureProblem& problem : recovery.problems)
+    spdlog::error("capture {} is damaged: {}", problem.id, problem.status.message());
+  return opened;
+}
+
+// The device's callbacks: `tick` for the watchdog, and device lost, found
+// and camera changed logged and published on `events`.
+service::DeviceCallbacks DeviceEvents(service::EventHub* events, std::function<void()> tick) {
+  service::DeviceCallbacks callbacks;
+  callbacks.tick = std::move(tick);
+  callbacks.lost = [events](const std::string& reason) {
+    spdlog::error("framestore lost: {}", reason);
+    v1::Event event;
+    event.mutable_device_lost()->set_reason(reason);
+    events->Publish(std::move(event));
+  };
+  callbacks.found = [events](const std::string& device) {
+    spdlog::info("framestore found again: {}", device);
+    v1::Event event;
+    event.mutable_device_found()->set_device(device);
+    events->Publish(std::move(event));
+  };
+  callbacks.camera_changed = [events](framestore::Camera camera, int gain) {
+    v1::Event event;
+    event.mutable_camera_changed()->set_camera(ToProto(camera));
+    event.mutable_camera_changed()->set_gain(gain);
+    events->Publish(std::move(event));
+  };
+  return callbacks;
+}
+
+// The processing queue's options from config.processing, with the text of
+// each calibration file named there (checked to be of its side);
+// kInvalidArgument naming the key when one is not.
+Status ReadProcessingOptions(const Config& config, service::ProcessingQueueOptions* processing) {
+  const ProcessingConfig& p = config.processing;
+  processing->client.target = p.server;
+  processing->client.tls = {p.tls_ca,
+                            p.tls_certificate,
+                            p.tls_key,
+                            "processing.tls_ca",
+                            "processing.tls_certificate",
+                            "processing.tls_key"};
+  processing->client.timeout = std::chrono::milliseconds(p.timeout_ms);
+  processing->retry_initial = std::chrono::milliseconds(p.retry_initial_ms);
+  processing->retry_max = std::chrono::milliseconds(p.retry_max_ms);
+  processing->daemon_version = BSLS_VERSION;
+  for (const auto& [file, key, side, out] :
+       {std::tuple{p.calibration_left, "processing.calibration_left", pattern::Side::kLeft,
+                   &processing->left_calibration},
+        std::tuple{p.calibration_right, "processing.calibration_right", pattern::Side::kRight,
+                   &processing->right_calibration}}) {
+    if (file.empty()) continue;
+    try {
+      const calibration::CalibrationRecord record = calibration::LoadCalibration(file);
+      if (record.calibration.side != side)
+        return Status(ErrorCode::kInvalidArgument,
+                      std::string(key) + " " + file + ": is a calibration of the other side");
+      std::ifstream in(file, std::ios::binary);
+      out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    } catch (const calibration::CalibrationFileError& e) {
+      return Status(ErrorCode::kInvalidArgument, std::string(key) + ": " + e.what());
+    }
+  }
+  return Status();
+}
+
+// Starts the processing queue; kInvalidArgument when its TLS files or its
+// server address are unusable.
+Status StartProcessing(service::ProcessingQueue& queue) {
+  try {
+    queue.Start();
+  } catch (const rpc::TlsFileError& e) {
+    return Status(ErrorCode::kInvalidArgument, e.what());
+  } catch (const std::invalid_argument& e) {
+    return Status(ErrorCode::kInvalidArgument, std::string("processing.server: ") + e.what());
+  }
+  return Status();
+}
+
+// Sets `builder` up to serve `service` with config.listen's limits and, when
+// it names a TCP address, to listen there with mutual TLS (the port bound
+// written to `tcp_port` when the server starts); kInvalidArgument when the
+// TLS files are unusable.
+Status ConfigureServer(const Config& config, grpc::Service* service, int* tcp_port,
+                       grpc::ServerBuilder& builder) {
+  builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
+  builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
+  rpc::ApplyHttp2Limits(config.listen.http2, builder);
+  rpc::ReportMalformedRequests(builder);
+  grpc::ResourceQuota quota("bslsd");
+  quota.SetMaxThreads(64);
+  builder.SetResourceQuota(quota);
+  builder.RegisterService(service);
+  if (!config.listen.tcp.empty()) {
+    // Mutual TLS only: a client without a certificate signed by the CA fails the handshake.
+    std::shared_ptr<grpc::ServerCredentials> tls;
+    try {
+      tls = rpc::MutualTlsServerCredentials(
+          {config.listen.tls_client_ca, config.listen.tls_certificate, config.listen.tls_key,
+           "listen.tls_client_ca", "listen.tls_certificate", "listen.tls_key"});
+    } catch (const rpc::TlsFileError& e) {
+      return Status(ErrorCode::kInvalidArgument, e.what());
+    }
+    builder.AddListeningPort(config.listen.tcp, tls, tcp_port);
+  }
+  return Status();
+}
+
 }  // namespace
 
 Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& config) {
@@ -63,17 +182,9 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   if (!policy.ok()) return policy.status();
   d->policy_ = std::move(policy).value();
 
-  // The store: recovery reports damaged acknowledged captures, never drops them.
-  Result<std::unique_ptr<store::CaptureStore>> opened = store::CaptureStore::Open(config.store);
-  if (!opened.ok())
-    return Status(opened.status().code(), "capture store: " + opened.status().message());
+  Result<std::unique_ptr<store::CaptureStore>> opened = OpenStore(config);
+  if (!opened.ok()) return opened.status();
   d->store_ = std::move(opened).value();
-  const store::RecoveryReport& recovery = d->store_->recovery_report();
-  spdlog::info("capture store {}: {} captures checked, {} damaged, {} leftovers removed",
-               config.store.root, recovery.captures_checked, recovery.problems.size(),
-               recovery.temp_files_removed + recovery.orphan_files_removed);
-  for (const store::CaptureProblem& problem : recovery.problems)
-    spdlog::error("capture {} is damaged: {}", problem.id, problem.status.message());
 
   Result<std::unique_ptr<slides::SlideController>> slides = OpenSlides(config, &d->events_);
   if (!slides.ok()) return slides.status();
@@ -82,97 +193,26 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
       OpenFramestore(config, std::move(privileged), d->slides_.get());
   if (!framestore.ok()) return framestore.status();
   spdlog::info("framestore: {}", (*framestore)->capabilities().device);
+  d->device_ = std::make_unique<service::CaptureDevice>(std::move(framestore).value(),
+                                                        DeviceEvents(&d->events_, std::move(tick)));
 
-  service::EventHub* events = &d->events_;
-  service::DeviceCallbacks callbacks;
-  callbacks.tick = std::move(tick);
-  callbacks.lost = [events](const std::string& reason) {
-    spdlog::error("framestore lost: {}", reason);
-    v1::Event event;
-    event.mutable_device_lost()->set_reason(reason);
-    events->Publish(std::move(event));
-  };
-  callbacks.found = [events](const std::string& device) {
-    spdlog::info("framestore found again: {}", device);
-    v1::Event event;
-    event.mutable_device_found()->set_device(device);
-    events->Publish(std::move(event));
-  };
-  callbacks.camera_changed = [events](framestore::Camera camera, int gain) {
-    v1::Event event;
-    event.mutable_camera_changed()->set_camera(ToProto(camera));
-    event.mutable_camera_changed()->set_gain(gain);
-    events->Publish(std::move(event));
-  };
-  d->device_ =
-      std::make_unique<service::CaptureDevice>(std::move(framestore).value(), std::move(callbacks));
   // The processing queue: captures of earlier runs first, then every new grab.
   service::ProcessingQueueOptions processing;
-  const ProcessingConfig& p = config.processing;
-  processing.client.target = p.server;
-  processing.client.tls = {p.tls_ca,
-                           p.tls_certificate,
-                           p.tls_key,
-                           "processing.tls_ca",
-                           "processing.tls_certificate",
-                           "processing.tls_key"};
-  processing.client.timeout = std::chrono::milliseconds(p.timeout_ms);
-  processing.retry_initial = std::chrono::milliseconds(p.retry_initial_ms);
-  processing.retry_max = std::chrono::milliseconds(p.retry_max_ms);
-  processing.daemon_version = BSLS_VERSION;
-  for (const auto& [file, key, side, out] :
-       {std::tuple{p.calibration_left, "processing.calibration_left", pattern::Side::kLeft,
-                   &processing.left_calibration},
-        std::tuple{p.calibration_right, "processing.calibration_right", pattern::Side::kRight,
-                   &processing.right_calibration}}) {
-    if (file.empty()) continue;
-    try {
-      const calibration::CalibrationRecord record = calibration::LoadCalibration(file);
-      if (record.calibration.side != side)
-        return Status(ErrorCode::kInvalidArgument,
-                      std::string(key) + " " + file + ": is a calibration of the other side");
-      std::ifstream in(file, std::ios::binary);
-      out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    } catch (const calibration::CalibrationFileError& e) {
-      return Status(ErrorCode::kInvalidArgument, std::string(key) + ": " + e.what());
-    }
-  }
+  if (Status read = ReadProcessingOptions(config, &processing); !read.ok()) return read;
   d->processing_ =
       std::make_unique<service::ProcessingQueue>(d->store_.get(), &d->events_, processing);
-  try {
-    d->processing_->Start();
-  } catch (const rpc::TlsFileError& e) {
-    return Status(ErrorCode::kInvalidArgument, e.what());
-  } catch (const std::invalid_argument& e) {
-    return Status(ErrorCode::kInvalidArgument, std::string("processing.server: ") + e.what());
-  }
-  if (d->processing_->enabled()) spdlog::info("processing: every grab goes to {}", p.server);
+  if (Status started = StartProcessing(*d->processing_); !started.ok()) return started;
+  if (d->processing_->enabled())
+    spdlog::info("processing: every grab goes to {}", config.processing.server);
 
   d->service_ = std::make_unique<service::CaptureService>(
       d->device_.get(), d->store_.get(), d->slides_.get(), &d->events_, &d->peers_, &d->policy_,
       config.limits, BSLS_VERSION, d->processing_.get());
 
   grpc::ServerBuilder builder;
-  builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
-  builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
-  rpc::ApplyHttp2Limits(config.listen.http2, builder);
-  rpc::ReportMalformedRequests(builder);
-  grpc::ResourceQuota quota("bslsd");
-  quota.SetMaxThreads(64);
-  builder.SetResourceQuota(quota);
-  builder.RegisterService(d->service_.get());
-  if (!config.listen.tcp.empty()) {
-    // Mutual TLS only: a client without a certificate signed by the CA fails the handshake.
-    std::shared_ptr<grpc::ServerCredentials> tls;
-    try {
-      tls = rpc::MutualTlsServerCredentials(
-          {config.listen.tls_client_ca, config.listen.tls_certificate, config.listen.tls_key,
-           "listen.tls_client_ca", "listen.tls_certificate", "listen.tls_key"});
-    } catch (const rpc::TlsFileError& e) {
-      return Status(ErrorCode::kInvalidArgument, e.what());
-    }
-    builder.AddListeningPort(config.listen.tcp, tls, &d->tcp_port_);
-  }
+  if (Status configured = ConfigureServer(config, d->service_.get(), &d->tcp_port_, builder);
+      !configured.ok())
+    return configured;
   d->server_ = builder.BuildAndStart();
   if (!d->server_ || (!config.listen.tcp.empty() && d->tcp_port_ == 0))
     return Status(ErrorCode::kUnavailable,

@@ -220,14 +220,10 @@ Eigen::Vector3d Unit(const Reader& r, const Eigen::Vector3d& v, const std::strin
   return v;
 }
 
-}  // namespace
-
-std::string CalibrationToYaml(const SideCalibration& c, const std::string& software_version) {
-  YAML::Emitter out;
-  out << YAML::Comment(
-      "BSLS calibration of one side (thesis chapter 6). World mm (contracts section 3), camera "
-      "pixels, projector slide pitches d; rotations row-major, world -> device.");
-  out << YAML::BeginMap;
+// Writes the file's identity: format, versions, side, image size, manifest
+// hash, pattern and target.
+void WriteHeader(YAML::Emitter& out, const SideCalibration& c,
+                 const std::string& software_version) {
   KeyValue(out, "format", kCalibrationFormatName);
   KeyValue(out, "format_version", kCalibrationFormatVersion);
   KeyValue(out, "software_version", software_version);
@@ -248,8 +244,10 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
   KeyValue(out, "pitch_mm", c.target.pitch_mm);
   KeyValue(out, "square_mm", c.target.square_mm);
   out << YAML::EndMap;
+}
 
-  // Camera (thesis 6.1).
+// Writes the "camera" mapping: model, report and per-view residuals.
+void WriteCamera(YAML::Emitter& out, const SideCalibration& c) {
   const CameraCalibrationReport& cr = c.camera.report;
   out << YAML::Key << "camera" << YAML::Value << YAML::BeginMap;
   Intrinsics(out, c.camera.model.intrinsics());
@@ -283,8 +281,32 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
   }
   out << YAML::EndSeq;
   out << YAML::EndMap;
+}
 
-  // Projector (thesis 6.2).
+// Writes the "matrix" mapping of the projector: model, 3 x 4 matrix and fit.
+void WriteProjectorMatrix(YAML::Emitter& out, const ProjectorMatrixFit& m) {
+  out << YAML::Key << "matrix" << YAML::Value << YAML::BeginMap;
+  Intrinsics(out, m.model.intrinsics());
+  Pose(out, m.model.pose());
+  Eigen::Matrix<double, 12, 1> p;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) p(4 * i + j) = m.matrix(i, j);
+  Vec(out, "matrix", p);  // row-major 3 x 4, slide units
+  out << YAML::Key << "fit" << YAML::Value << YAML::Flow << YAML::BeginMap;
+  KeyValue(out, "points_used", m.report.points_used);
+  KeyValue(out, "points_dropped", m.report.points_dropped);
+  KeyValue(out, "rms_d", m.report.rms_d);
+  KeyValue(out, "max_d", m.report.max_d);
+  KeyValue(out, "residual_sigma_d", m.report.residual_sigma_d);
+  KeyValue(out, "iterations", m.report.iterations);
+  KeyValue(out, "converged", m.report.converged);
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+}
+
+// Writes the "projector" mapping: both plane models, the matrix when fitted,
+// and the pose.
+void WriteProjector(YAML::Emitter& out, const SideCalibration& c) {
   out << YAML::Key << "projector" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "parallel_plane" << YAML::Value << YAML::BeginMap;
   Vec(out, "normal", c.parallel.model.normal);
@@ -304,26 +326,7 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
   KeyValue(out, "axis_to_origin_mm", c.perspective.axis_to_origin_mm);
   StripeReport(out, c.perspective.report);
   out << YAML::EndMap;
-  if (c.projector_matrix) {
-    const ProjectorMatrixFit& m = *c.projector_matrix;
-    out << YAML::Key << "matrix" << YAML::Value << YAML::BeginMap;
-    Intrinsics(out, m.model.intrinsics());
-    Pose(out, m.model.pose());
-    Eigen::Matrix<double, 12, 1> p;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 4; ++j) p(4 * i + j) = m.matrix(i, j);
-    Vec(out, "matrix", p);  // row-major 3 x 4, slide units
-    out << YAML::Key << "fit" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    KeyValue(out, "points_used", m.report.points_used);
-    KeyValue(out, "points_dropped", m.report.points_dropped);
-    KeyValue(out, "rms_d", m.report.rms_d);
-    KeyValue(out, "max_d", m.report.max_d);
-    KeyValue(out, "residual_sigma_d", m.report.residual_sigma_d);
-    KeyValue(out, "iterations", m.report.iterations);
-    KeyValue(out, "converged", m.report.converged);
-    out << YAML::EndMap;
-    out << YAML::EndMap;
-  }
+  if (c.projector_matrix) WriteProjectorMatrix(out, *c.projector_matrix);
   const ProjectorPose& pp = c.projector;
   out << YAML::Key << "pose" << YAML::Value << YAML::BeginMap;
   Vec(out, "plane_centre_mm", pp.plane_centre_mm);
@@ -337,8 +340,10 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
     KeyValue(out, "camera_projector_angle_deg", *pp.camera_projector_angle_deg);
   out << YAML::EndMap;
   out << YAML::EndMap;
+}
 
-  // Slide rows (reference crosses) and the screens.
+// Writes the "reference" mapping: the ray when fitted and each cross.
+void WriteReference(YAML::Emitter& out, const SideCalibration& c) {
   out << YAML::Key << "reference" << YAML::Value << YAML::BeginMap;
   if (c.reference_ray) {
     out << YAML::Key << "ray" << YAML::Value << YAML::Flow << YAML::BeginMap;
@@ -358,6 +363,10 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
   }
   out << YAML::EndSeq;
   out << YAML::EndMap;
+}
+
+// Writes the "screens" list, one flow mapping per used screen view.
+void WriteScreens(YAML::Emitter& out, const SideCalibration& c) {
   out << YAML::Key << "screens" << YAML::Value << YAML::BeginSeq;
   for (const ScreenViewReport& v : c.screen_views) {
     out << YAML::Flow << YAML::BeginMap;
@@ -373,33 +382,29 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
     out << YAML::EndMap;
   }
   out << YAML::EndSeq;
-  // Listed views left out, so the file says what it was made from.
-  if (!c.dropped_views.empty()) {
-    out << YAML::Key << "dropped_views" << YAML::Value << YAML::BeginSeq;
-    for (const DroppedView& v : c.dropped_views) {
-      out << YAML::Flow << YAML::BeginMap;
-      KeyValue(out, "image", v.image.string());
-      KeyValue(out, "kind", std::string(ToString(v.kind)));
-      KeyValue(out, "index", v.index);
-      KeyValue(out, "z_mm", v.z_mm);
-      KeyValue(out, "reason", v.reason);
-      out << YAML::EndMap;
-    }
-    out << YAML::EndSeq;
-  }
-
-  out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
-  KeyValue(out, "stripe_centre_px", c.sigmas.stripe_centre_px);
-  KeyValue(out, "target_point_px", c.sigmas.target_point_px);
-  KeyValue(out, "plane_mm", c.sigmas.plane_mm);
-  out << YAML::EndMap;
-  out << YAML::EndMap;
-  if (!out.good()) throw std::logic_error("calibration YAML: " + out.GetLastError());
-  return std::string(out.c_str()) + "\n";
 }
 
-CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string& name) {
-  const Reader r(name);
+// Writes the "dropped_views" list; nothing when no view was dropped.
+void WriteDroppedViews(YAML::Emitter& out, const SideCalibration& c) {
+  if (c.dropped_views.empty()) return;
+  out << YAML::Key << "dropped_views" << YAML::Value << YAML::BeginSeq;
+  for (const DroppedView& v : c.dropped_views) {
+    out << YAML::Flow << YAML::BeginMap;
+    KeyValue(out, "image", v.image.string());
+    KeyValue(out, "kind", std::string(ToString(v.kind)));
+    KeyValue(out, "index", v.index);
+    KeyValue(out, "z_mm", v.z_mm);
+    KeyValue(out, "reason", v.reason);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq;
+}
+
+// ---------------------------------------------------------------- reading, by section
+
+// The root mapping, checked to be this format at the supported version; the
+// record's versions filled in.
+YAML::Node ReadRoot(const Reader& r, const std::string& text, CalibrationRecord* record) {
   YAML::Node root;
   try {
     root = io::LoadBoundedYaml(text);
@@ -410,14 +415,17 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
   const auto format = r.Get<std::string>(root, "format", "");
   if (format != kCalibrationFormatName)
     r.Fail("", "format is '" + format + "', expected '" + kCalibrationFormatName + "'");
-  CalibrationRecord record;
-  record.format_version = r.Get<int>(root, "format_version", "");
-  if (record.format_version != kCalibrationFormatVersion)
-    r.Fail("", "format_version " + std::to_string(record.format_version) +
+  record->format_version = r.Get<int>(root, "format_version", "");
+  if (record->format_version != kCalibrationFormatVersion)
+    r.Fail("", "format_version " + std::to_string(record->format_version) +
                    " is not supported (this software reads version " +
                    std::to_string(kCalibrationFormatVersion) + ")");
-  record.software_version = r.Get<std::string>(root, "software_version", "");
-  SideCalibration& c = record.calibration;
+  record->software_version = r.Get<std::string>(root, "software_version", "");
+  return root;
+}
+
+// Reads side, image size, manifest hash, pattern and target, each checked.
+void ReadHeader(const Reader& r, const YAML::Node& root, SideCalibration& c) {
   const auto side = pattern::ParseSide(r.Get<std::string>(root, "side", ""));
   if (!side) r.Fail("side", "must be left or right");
   c.side = *side;
@@ -438,14 +446,31 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
   c.target.pitch_mm = r.Get<double>(target, "pitch_mm", "target");
   c.target.square_mm = r.Get<double>(target, "square_mm", "target");
   if (!c.target.IsValid(&why)) r.Fail("target", why);
+}
 
-  // Camera.
-  const YAML::Node camera = r.Child(root, "camera", "");
-  c.camera.model =
-      geometry::PinholeModel(ReadIntrinsics(r, camera, "camera"), ReadPose(r, camera, "camera"));
+// Reads camera.report.sigmas, the parameter standard deviations.
+CameraParameterSigmas ReadCameraSigmas(const Reader& r, const YAML::Node& rep,
+                                       const std::string& rw) {
+  const std::string sw = rw + ".sigmas";
+  const YAML::Node s = r.Child(rep, "sigmas", rw);
+  CameraParameterSigmas sig;
+  sig.f_px = r.Get<double>(s, "f_px", sw);
+  sig.sx = r.Get<double>(s, "sx", sw);
+  sig.fx_px = r.Get<double>(s, "fx_px", sw);
+  sig.fy_px = r.Get<double>(s, "fy_px", sw);
+  sig.cx_px = r.Get<double>(s, "cx_px", sw);
+  sig.cy_px = r.Get<double>(s, "cy_px", sw);
+  sig.k1 = r.Get<double>(s, "k1", sw);
+  sig.k2 = r.Get<double>(s, "k2", sw);
+  sig.rotation_rad = r.Vector3(s, "rotation_rad", sw);
+  sig.translation_mm = r.Vector3(s, "translation_mm", sw);
+  return sig;
+}
+
+// Reads camera.report (without its per-view residuals).
+void ReadCameraReport(const Reader& r, const YAML::Node& camera, CameraCalibrationReport& cr) {
   const YAML::Node rep = r.Child(camera, "report", "camera");
   const std::string rw = "camera.report";
-  CameraCalibrationReport& cr = c.camera.report;
   cr.num_points = r.Get<int>(rep, "points", rw);
   cr.num_views = r.Get<int>(rep, "views", rw);
   cr.rms_px = r.Get<double>(rep, "rms_px", rw);
@@ -460,22 +485,17 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
   cr.initialisation = init == "tsai" ? CameraInitialisation::kTsai : CameraInitialisation::kDlt;
   cr.iterations = r.Get<int>(rep, "iterations", rw);
   cr.converged = r.Get<bool>(rep, "converged", rw);
-  if (rep["sigmas"]) {
-    const std::string sw = rw + ".sigmas";
-    const YAML::Node s = r.Child(rep, "sigmas", rw);
-    CameraParameterSigmas sig;
-    sig.f_px = r.Get<double>(s, "f_px", sw);
-    sig.sx = r.Get<double>(s, "sx", sw);
-    sig.fx_px = r.Get<double>(s, "fx_px", sw);
-    sig.fy_px = r.Get<double>(s, "fy_px", sw);
-    sig.cx_px = r.Get<double>(s, "cx_px", sw);
-    sig.cy_px = r.Get<double>(s, "cy_px", sw);
-    sig.k1 = r.Get<double>(s, "k1", sw);
-    sig.k2 = r.Get<double>(s, "k2", sw);
-    sig.rotation_rad = r.Vector3(s, "rotation_rad", sw);
-    sig.translation_mm = r.Vector3(s, "translation_mm", sw);
-    cr.sigmas = sig;
-  }
+  if (rep["sigmas"]) cr.sigmas = ReadCameraSigmas(r, rep, rw);
+}
+
+// Reads the "camera" mapping: model, report, and the views, whose residuals
+// also fill the report's per-view lists.
+void ReadCamera(const Reader& r, const YAML::Node& root, SideCalibration& c) {
+  const YAML::Node camera = r.Child(root, "camera", "");
+  c.camera.model =
+      geometry::PinholeModel(ReadIntrinsics(r, camera, "camera"), ReadPose(r, camera, "camera"));
+  CameraCalibrationReport& cr = c.camera.report;
+  ReadCameraReport(r, camera, cr);
   const YAML::Node views = r.Child(camera, "views", "camera", false);
   if (!views.IsSequence()) r.Fail("camera.views", "must be a list");
   for (size_t i = 0; i < views.size(); ++i) {
@@ -490,9 +510,10 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
     cr.view_rms_mm.push_back(v.rms_mm);
     c.camera_views.push_back(std::move(v));
   }
+}
 
-  // Projector.
-  const YAML::Node projector = r.Child(root, "projector", "");
+// Reads projector.parallel_plane and projector.perspective_plane.
+void ReadPlaneModels(const Reader& r, const YAML::Node& projector, SideCalibration& c) {
   {
     const std::string w = "projector.parallel_plane";
     const YAML::Node n = r.Child(projector, "parallel_plane", "projector");
@@ -518,41 +539,46 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
     c.perspective.axis_to_origin_mm = r.Get<double>(n, "axis_to_origin_mm", w);
     c.perspective.report = ReadStripeReport(r, n, w);
   }
-  if (projector["matrix"]) {
-    const std::string w = "projector.matrix";
-    const YAML::Node n = r.Child(projector, "matrix", "projector");
-    ProjectorMatrixFit m;
-    m.model = geometry::PinholeModel(ReadIntrinsics(r, n, w), ReadPose(r, n, w));
-    const Eigen::VectorXd p = r.Vector(n, "matrix", w, 12);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 4; ++j) m.matrix(i, j) = p(4 * i + j);
-    const std::string fw = w + ".fit";
-    const YAML::Node f = r.Child(n, "fit", w);
-    m.report.points_used = r.Get<int>(f, "points_used", fw);
-    m.report.points_dropped = r.Get<int>(f, "points_dropped", fw);
-    m.report.rms_d = r.Get<double>(f, "rms_d", fw);
-    m.report.max_d = r.Get<double>(f, "max_d", fw);
-    m.report.residual_sigma_d = r.Get<double>(f, "residual_sigma_d", fw);
-    m.report.iterations = r.Get<int>(f, "iterations", fw);
-    m.report.converged = r.Get<bool>(f, "converged", fw);
-    c.projector_matrix = m;
-  }
-  {
-    const std::string w = "projector.pose";
-    const YAML::Node n = r.Child(projector, "pose", "projector");
-    ProjectorPose& pp = c.projector;
-    pp.plane_centre_mm = r.Vector3(n, "plane_centre_mm", w);
-    pp.plane_axis = r.Vector3(n, "plane_axis", w);
-    pp.plane_centre_distance_mm = r.Get<double>(n, "plane_centre_distance_mm", w);
-    if (n["matrix_centre_mm"]) pp.matrix_centre_mm = r.Vector3(n, "matrix_centre_mm", w);
-    if (n["optical_axis"]) pp.optical_axis = r.Vector3(n, "optical_axis", w);
-    if (n["matrix_centre_distance_mm"])
-      pp.matrix_centre_distance_mm = r.Get<double>(n, "matrix_centre_distance_mm", w);
-    if (n["camera_projector_angle_deg"])
-      pp.camera_projector_angle_deg = r.Get<double>(n, "camera_projector_angle_deg", w);
-  }
+}
 
-  // Reference crosses and screens.
+// Reads projector.matrix: model, 3 x 4 matrix and fit.
+ProjectorMatrixFit ReadProjectorMatrix(const Reader& r, const YAML::Node& projector) {
+  const std::string w = "projector.matrix";
+  const YAML::Node n = r.Child(projector, "matrix", "projector");
+  ProjectorMatrixFit m;
+  m.model = geometry::PinholeModel(ReadIntrinsics(r, n, w), ReadPose(r, n, w));
+  const Eigen::VectorXd p = r.Vector(n, "matrix", w, 12);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 4; ++j) m.matrix(i, j) = p(4 * i + j);
+  const std::string fw = w + ".fit";
+  const YAML::Node f = r.Child(n, "fit", w);
+  m.report.points_used = r.Get<int>(f, "points_used", fw);
+  m.report.points_dropped = r.Get<int>(f, "points_dropped", fw);
+  m.report.rms_d = r.Get<double>(f, "rms_d", fw);
+  m.report.max_d = r.Get<double>(f, "max_d", fw);
+  m.report.residual_sigma_d = r.Get<double>(f, "residual_sigma_d", fw);
+  m.report.iterations = r.Get<int>(f, "iterations", fw);
+  m.report.converged = r.Get<bool>(f, "converged", fw);
+  return m;
+}
+
+// Reads projector.pose; its matrix-derived keys are optional.
+void ReadProjectorPose(const Reader& r, const YAML::Node& projector, ProjectorPose& pp) {
+  const std::string w = "projector.pose";
+  const YAML::Node n = r.Child(projector, "pose", "projector");
+  pp.plane_centre_mm = r.Vector3(n, "plane_centre_mm", w);
+  pp.plane_axis = r.Vector3(n, "plane_axis", w);
+  pp.plane_centre_distance_mm = r.Get<double>(n, "plane_centre_distance_mm", w);
+  if (n["matrix_centre_mm"]) pp.matrix_centre_mm = r.Vector3(n, "matrix_centre_mm", w);
+  if (n["optical_axis"]) pp.optical_axis = r.Vector3(n, "optical_axis", w);
+  if (n["matrix_centre_distance_mm"])
+    pp.matrix_centre_distance_mm = r.Get<double>(n, "matrix_centre_distance_mm", w);
+  if (n["camera_projector_angle_deg"])
+    pp.camera_projector_angle_deg = r.Get<double>(n, "camera_projector_angle_deg", w);
+}
+
+// Reads the "reference" mapping: the ray when present and each cross.
+void ReadReference(const Reader& r, const YAML::Node& root, SideCalibration& c) {
   const YAML::Node reference = r.Child(root, "reference", "");
   if (reference["ray"]) {
     const YAML::Node n = r.Child(reference, "ray", "reference");
@@ -573,6 +599,10 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
     v.ray_residual_mm = r.Get<double>(crosses[i], "ray_residual_mm", w);
     c.reference_views.push_back(std::move(v));
   }
+}
+
+// Reads the "screens" list; a q_offset, when present, must be even.
+void ReadScreens(const Reader& r, const YAML::Node& root, SideCalibration& c) {
   const YAML::Node screens = r.Child(root, "screens", "", false);
   if (!screens.IsSequence()) r.Fail("screens", "must be a list");
   for (size_t i = 0; i < screens.size(); ++i) {
@@ -592,30 +622,84 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
     if (screens[i]["matrix_rms_d"]) v.matrix_rms_d = r.Get<double>(screens[i], "matrix_rms_d", w);
     c.screen_views.push_back(std::move(v));
   }
-  if (root["dropped_views"]) {
-    const YAML::Node dropped = r.Child(root, "dropped_views", "", false);
-    if (!dropped.IsSequence()) r.Fail("dropped_views", "must be a list");
-    for (size_t i = 0; i < dropped.size(); ++i) {
-      const std::string w = "dropped_views[" + std::to_string(i) + "]";
-      DroppedView v;
-      v.image = r.Get<std::string>(dropped[i], "image", w);
-      const std::string kind = r.Get<std::string>(dropped[i], "kind", w);
-      if (kind == ToString(ViewKind::kCamera)) {
-        v.kind = ViewKind::kCamera;
-      } else if (kind == ToString(ViewKind::kScreen)) {
-        v.kind = ViewKind::kScreen;
-      } else if (kind == ToString(ViewKind::kReference)) {
-        v.kind = ViewKind::kReference;
-      } else {
-        r.Fail(w + ".kind", "must be camera, screen or reference, not \"" + kind + "\"");
-      }
-      v.index = r.Get<int>(dropped[i], "index", w);
-      if (v.index < 0) r.Fail(w + ".index", "must not be negative");
-      v.z_mm = r.Get<double>(dropped[i], "z_mm", w);
-      v.reason = r.Get<std::string>(dropped[i], "reason", w);
-      c.dropped_views.push_back(std::move(v));
+}
+
+// Reads the optional "dropped_views" list.
+void ReadDroppedViews(const Reader& r, const YAML::Node& root, SideCalibration& c) {
+  if (!root["dropped_views"]) return;
+  const YAML::Node dropped = r.Child(root, "dropped_views", "", false);
+  if (!dropped.IsSequence()) r.Fail("dropped_views", "must be a list");
+  for (size_t i = 0; i < dropped.size(); ++i) {
+    const std::string w = "dropped_views[" + std::to_string(i) + "]";
+    DroppedView v;
+    v.image = r.Get<std::string>(dropped[i], "image", w);
+    const std::string kind = r.Get<std::string>(dropped[i], "kind", w);
+    if (kind == ToString(ViewKind::kCamera)) {
+      v.kind = ViewKind::kCamera;
+    } else if (kind == ToString(ViewKind::kScreen)) {
+      v.kind = ViewKind::kScreen;
+    } else if (kind == ToString(ViewKind::kReference)) {
+      v.kind = ViewKind::kReference;
+    } else {
+      r.Fail(w + ".kind", "must be camera, screen or reference, not \"" + kind + "\"");
     }
+    v.index = r.Get<int>(dropped[i], "index", w);
+    if (v.index < 0) r.Fail(w + ".index", "must not be negative");
+    v.z_mm = r.Get<double>(dropped[i], "z_mm", w);
+    v.reason = r.Get<std::string>(dropped[i], "reason", w);
+    c.dropped_views.push_back(std::move(v));
   }
+}
+
+}  // namespace
+
+std::string CalibrationToYaml(const SideCalibration& c, const std::string& software_version) {
+  YAML::Emitter out;
+  out << YAML::Comment(
+      "BSLS calibration of one side (thesis chapter 6). World mm (contracts section 3), camera "
+      "pixels, projector slide pitches d; rotations row-major, world -> device.");
+  out << YAML::BeginMap;
+  WriteHeader(out, c, software_version);
+  // Camera (thesis 6.1).
+  WriteCamera(out, c);
+  // Projector (thesis 6.2).
+  WriteProjector(out, c);
+  // Slide rows (reference crosses) and the screens.
+  WriteReference(out, c);
+  WriteScreens(out, c);
+  // Listed views left out, so the file says what it was made from.
+  WriteDroppedViews(out, c);
+
+  out << YAML::Key << "uncertainty" << YAML::Value << YAML::BeginMap;
+  KeyValue(out, "stripe_centre_px", c.sigmas.stripe_centre_px);
+  KeyValue(out, "target_point_px", c.sigmas.target_point_px);
+  KeyValue(out, "plane_mm", c.sigmas.plane_mm);
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  if (!out.good()) throw std::logic_error("calibration YAML: " + out.GetLastError());
+  return std::string(out.c_str()) + "\n";
+}
+
+CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string& name) {
+  const Reader r(name);
+  CalibrationRecord record;
+  const YAML::Node root = ReadRoot(r, text, &record);
+  SideCalibration& c = record.calibration;
+  ReadHeader(r, root, c);
+
+  // Camera.
+  ReadCamera(r, root, c);
+
+  // Projector.
+  const YAML::Node projector = r.Child(root, "projector", "");
+  ReadPlaneModels(r, projector, c);
+  if (projector["matrix"]) c.projector_matrix = ReadProjectorMatrix(r, projector);
+  ReadProjectorPose(r, projector, c.projector);
+
+  // Reference crosses and screens.
+  ReadReference(r, root, c);
+  ReadScreens(r, root, c);
+  ReadDroppedViews(r, root, c);
 
   const YAML::Node u = r.Child(root, "uncertainty", "");
   c.sigmas.stripe_centre_px = r.Get<double>(u, "stripe_centre_px", "uncertainty");

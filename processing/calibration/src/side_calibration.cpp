@@ -193,6 +193,434 @@ double WorstOffRay(const std::vector<Eigen::Vector3d>& points) {
   return worst;
 }
 
+// One run of CalibrateSide: the manifest and params it reads, the calibration
+// it fills, and the views announced so far. Each public step is one stage of
+// thesis chapter 6; CalibrateSide calls them in their numbered order.
+class SideCalibrationRun {
+ public:
+  SideCalibrationRun(const Manifest& manifest, const SideCalibrationParams& params,
+                     const CalibrationProgress& progress, const Cancellation& cancel)
+      : manifest_(manifest),
+        params_(params),
+        progress_(progress),
+        cancel_(cancel),
+        file_(manifest.path.string()),
+        total_views_(static_cast<double>(manifest.camera_views.size() +
+                                         manifest.screen_views.size() +
+                                         manifest.reference_views.size())) {}
+
+  // Throws unless the params, the manifest's target and pattern and its view
+  // lists are fit to calibrate from.
+  void CheckInputs() const;
+  // 1. Thesis 6.1: camera model and camera view reports.
+  void CalibrateCameraViews();
+  // 2. Thesis 6.2: stripe points of the screen views; the decode of each used
+  // screen view, in the order of out().screen_views.
+  std::vector<decoder::DecodeResult> DecodeScreenViews();
+  // 3. Thesis 6.2.1 and 6.2.2: both light-plane models and per-view plane RMS.
+  void FitStripePlanes();
+  // 4. Slide 1: the reference ray (when crosses are listed) and each screen
+  // view's q offset.
+  void FixSlideRows(const std::vector<decoder::DecodeResult>& decoded);
+  // 5. Thesis eq. 2.16: the projector matrix, when crosses are listed.
+  void FitMatrix(const std::vector<decoder::DecodeResult>& decoded);
+
+  SideCalibration& out() { return out_; }
+
+ private:
+  void BeginView(const std::string& name);
+  cv::Mat Load(const ManifestView& view, const std::string& name) {
+    return LoadView(view, name, params_.images, &width_, &height_);
+  }
+  void Drop(const ManifestView& view, ViewKind kind, size_t index, const std::string& reason);
+  void Require(ViewKind kind, size_t used, size_t listed, int minimum) const;
+  [[noreturn]] void Rethrow(const CalibrationError& e) const;
+  std::optional<ScreenViewReport> ScreenStripePoints(const ManifestView& view, size_t index,
+                                                     const decoder::DecodeResult& result,
+                                                     std::vector<StripePoint>* points, double* sum2,
+                                                     double* dof);
+  void FindCrosses();
+  void RejectOffRayCrosses();
+  void SetQOffsets(const std::vector<decoder::DecodeResult>& decoded);
+  std::vector<size_t> CollectJunctionPoints(const std::vector<decoder::DecodeResult>& decoded);
+
+  const Manifest& manifest_;
+  const SideCalibrationParams& params_;
+  const CalibrationProgress& progress_;
+  const Cancellation& cancel_;
+  const std::string file_;
+  const double total_views_;
+  int views_begun_ = 0;
+  int width_ = 0, height_ = 0;
+  std::vector<size_t> view_begin_;   // first stripe point of each used screen view, then the end
+  std::vector<size_t> cross_index_;  // manifest index of each used cross view
+  SideCalibration out_;
+};
+
+void SideCalibrationRun::CheckInputs() const {
+  std::string why;
+  if (!params_.IsValid(&why))
+    Throw(CalibrationErrorReason::kInvalidParams, "calibration: parameters: " + why);
+  if (!manifest_.target.IsValid(&why))
+    Throw(CalibrationErrorReason::kInvalidInput, "calibration: " + file_ + ": " + why);
+  if (!manifest_.pattern.IsValid(&why))
+    Throw(CalibrationErrorReason::kInvalidInput, "calibration: " + file_ + ": pattern: " + why);
+  CheckManifest(manifest_, params_);
+}
+
+// Every view is announced before it is read; the caller may stop there.
+void SideCalibrationRun::BeginView(const std::string& name) {
+  cancel_.ThrowIfRequested(name);
+  if (progress_ && !progress_(name, views_begun_ / total_views_))
+    Throw(CalibrationErrorReason::kCancelled, "calibration: stopped before " + name);
+  ++views_begun_;
+}
+
+// A view that gives nothing is left out with its reason; a kind with fewer
+// usable views than its minimum refuses the calibration, naming the views
+// it lost and why.
+void SideCalibrationRun::Drop(const ManifestView& view, ViewKind kind, size_t index,
+                              const std::string& reason) {
+  out_.dropped_views.push_back({view.image, kind, static_cast<int>(index), view.z_mm, reason});
+}
+
+void SideCalibrationRun::Require(ViewKind kind, size_t used, size_t listed, int minimum) const {
+  if (static_cast<int>(used) >= minimum) return;
+  std::string text = "calibration: " + file_ + ": " + std::to_string(used) + " of " +
+                     std::to_string(listed) + " " + std::string(ToString(kind)) +
+                     " views usable, at least " + std::to_string(minimum) + " are needed (" +
+                     WhyMinimum(kind) + "); dropped:";
+  std::string separator = " ";
+  for (const DroppedView& d : out_.dropped_views) {
+    if (d.kind != kind) continue;
+    text += separator + ViewName(d.image, d.kind, d.index, d.z_mm) + ": " + d.reason;
+    separator = "; ";
+  }
+  Throw(CalibrationErrorReason::kNotFound, text);
+}
+
+// A stage's CalibrationError again, its message prefixed with the manifest.
+void SideCalibrationRun::Rethrow(const CalibrationError& e) const {
+  Throw(e.reason(), "calibration: " + file_ + ": " + e.what());
+}
+
+// 1. Thesis 6.1: target squares' centres of gravity in every camera view,
+// then Tsai's two-stage calibration on the views whose grid was found.
+void SideCalibrationRun::CalibrateCameraViews() {
+  std::vector<TargetView> views;
+  for (size_t i = 0; i < manifest_.camera_views.size(); ++i) {
+    const ManifestView& view = manifest_.camera_views[i];
+    const std::string name = ViewName(view, ViewKind::kCamera, i);
+    BeginView(name);
+    const cv::Mat grey = Load(view, name);
+    const TargetDetection detection = DetectTarget(grey, manifest_.target, params_.target);
+    if (!detection.ok) {
+      Drop(view, ViewKind::kCamera, i, "target not found: " + detection.error);
+      continue;
+    }
+    TargetView target_view;
+    for (const TargetSquare& square : detection.squares) {
+      TargetPoint point;
+      point.world_mm = manifest_.target.SquareCentre(square.row, square.col, view.z_mm);
+      point.image_px = {square.centre.x, square.centre.y};
+      target_view.points.push_back(point);
+    }
+    views.push_back(std::move(target_view));
+    CameraViewReport report;
+    report.image = view.image;
+    report.z_mm = view.z_mm;
+    report.max_grid_residual = detection.max_grid_residual;
+    out_.camera_views.push_back(report);
+  }
+  Require(ViewKind::kCamera, views.size(), manifest_.camera_views.size(), params_.min_camera_views);
+  out_.width = width_;
+  out_.height = height_;
+  try {
+    out_.camera = CalibrateCamera(views, width_, height_, params_.camera);
+  } catch (const CalibrationError& e) {
+    Rethrow(e);
+  }
+  if (!out_.camera.report.converged)
+    Throw(CalibrationErrorReason::kNotConverged,
+          "calibration: " + file_ + ": camera calibration did not converge in " +
+              std::to_string(out_.camera.report.iterations) + " iterations (RMS " +
+              Number(out_.camera.report.rms_px) + " px)");
+  for (size_t i = 0; i < out_.camera_views.size(); ++i) {
+    out_.camera_views[i].rms_px = out_.camera.report.view_rms_px[i];
+    out_.camera_views[i].rms_mm = out_.camera.report.view_rms_mm[i];
+  }
+  out_.sigmas.target_point_px = out_.camera.report.residual_sigma_px;
+}
+
+// The report of one decoded screen view, its line-centre samples
+// back-projected onto its screen appended to `points` and its centre scatter
+// to `sum2` and `dof`; nothing (the view dropped) when no sample lands.
+std::optional<ScreenViewReport> SideCalibrationRun::ScreenStripePoints(
+    const ManifestView& view, size_t index, const decoder::DecodeResult& result,
+    std::vector<StripePoint>* points, double* sum2, double* dof) {
+  const geometry::PinholeModel& camera = out_.camera.model;
+  ScreenViewReport report;
+  report.image = view.image;
+  report.z_mm = view.z_mm;
+  report.lines = static_cast<int>(result.lines.size());
+  report.junctions = static_cast<int>(result.junctions.size());
+  for (const decoder::DecodedLine& line : result.lines) {
+    AccumulateCentreScatter(line.points, params_.centre_fit_degree, params_.min_centre_run, sum2,
+                            dof);
+    for (size_t k = 0; k < line.points.size(); k += params_.stripe_sample_step) {
+      const Eigen::Vector2d image(line.points[k].x, line.points[k].y);
+      const auto world = internal::IntersectZPlane(camera.BackProject(image), view.z_mm);
+      if (world) points->push_back({*world, line.p});
+    }
+  }
+  if (points->empty()) {
+    Drop(view, ViewKind::kScreen, index,
+         "no decoded line-centre sample back-projects onto the screen (" +
+             std::to_string(report.lines) + " lines decoded)");
+    return std::nullopt;
+  }
+  report.stripe_points = static_cast<int>(points->size());
+  return report;
+}
+
+// 2. Thesis 6.2: decode every screen view; back-project each labelled
+// line-centre sample onto its screen.
+std::vector<decoder::DecodeResult> SideCalibrationRun::DecodeScreenViews() {
+  decoder::DecodeParams decode = params_.decode;
+  decode.spec = manifest_.pattern;
+  std::vector<decoder::DecodeResult> decoded;  // one per used screen view
+  double centre_sum2 = 0.0, centre_dof = 0.0;
+  for (size_t i = 0; i < manifest_.screen_views.size(); ++i) {
+    const ManifestView& view = manifest_.screen_views[i];
+    const std::string name = ViewName(view, ViewKind::kScreen, i);
+    BeginView(name);
+    const cv::Mat grey = Load(view, name);
+    decoder::DecodeResult result = decoder::Decode(grey, manifest_.side, decode, cancel_);
+    if (!result.ok) {
+      Drop(view, ViewKind::kScreen, i, "the brick pattern could not be decoded: " + result.error);
+      continue;
+    }
+    std::vector<StripePoint> points;
+    double sum2 = 0.0, dof = 0.0;
+    const std::optional<ScreenViewReport> report =
+        ScreenStripePoints(view, i, result, &points, &sum2, &dof);
+    if (!report) continue;
+    centre_sum2 += sum2;
+    centre_dof += dof;
+    view_begin_.push_back(out_.diagnostics.stripe_points.size());
+    out_.diagnostics.stripe_points.insert(out_.diagnostics.stripe_points.end(), points.begin(),
+                                          points.end());
+    out_.screen_views.push_back(*report);
+    decoded.push_back(std::move(result));
+  }
+  Require(ViewKind::kScreen, out_.screen_views.size(), manifest_.screen_views.size(),
+          params_.min_screen_views);
+  view_begin_.push_back(out_.diagnostics.stripe_points.size());
+  out_.sigmas.stripe_centre_px = centre_dof > 0.0 ? std::sqrt(centre_sum2 / centre_dof) : 0.0;
+  return decoded;
+}
+
+// 3. Thesis 6.2.1 and 6.2.2, each with its two-pass outlier rejection.
+void SideCalibrationRun::FitStripePlanes() {
+  try {
+    out_.parallel = FitParallelPlaneModel(out_.diagnostics.stripe_points, params_.stripes);
+    out_.perspective = FitPerspectivePlaneModel(out_.diagnostics.stripe_points, params_.stripes);
+  } catch (const CalibrationError& e) {
+    Rethrow(e);
+  }
+  out_.sigmas.plane_mm = out_.perspective.report.rms_mm;
+  for (size_t i = 0; i < out_.screen_views.size(); ++i) {
+    double sum2 = 0.0;
+    int count = 0;
+    for (size_t k = view_begin_[i]; k < view_begin_[i + 1]; ++k) {
+      if (!out_.perspective.report.inlier[k]) continue;
+      const StripePoint& point = out_.diagnostics.stripe_points[k];
+      const double d =
+          out_.perspective.model.PlaneOfLine(point.line).SignedDistance(point.world_mm);
+      sum2 += d * d;
+      ++count;
+    }
+    out_.screen_views[i].plane_rms_mm = count > 0 ? std::sqrt(sum2 / count) : 0.0;
+  }
+}
+
+// The centre of the cross in every reference view, on its screen; views
+// whose cross is not found or whose centre misses the screen dropped.
+void SideCalibrationRun::FindCrosses() {
+  const geometry::PinholeModel& camera = out_.camera.model;
+  for (size_t i = 0; i < manifest_.reference_views.size(); ++i) {
+    const ManifestView& view = manifest_.reference_views[i];
+    const std::string name = ViewName(view, ViewKind::kReference, i);
+    BeginView(name);
+    const cv::Mat grey = Load(view, name);
+    std::string cross_why;
+    const auto cross = FindReferenceCross(grey, params_.cross, &cross_why);
+    if (!cross) {
+      Drop(view, ViewKind::kReference, i, "reference cross not found: " + cross_why);
+      continue;
+    }
+    ReferenceViewReport report;
+    report.image = view.image;
+    report.z_mm = view.z_mm;
+    report.centre_px = {cross->centre.x, cross->centre.y};
+    const auto world = internal::IntersectZPlane(camera.BackProject(report.centre_px), view.z_mm);
+    if (!world) {
+      Drop(view, ViewKind::kReference, i, "the camera ray of the cross centre misses the screen");
+      continue;
+    }
+    report.world_mm = *world;
+    out_.reference_views.push_back(report);
+    cross_index_.push_back(i);
+  }
+}
+
+// Drops crosses off the line through the others until the rest lie on one
+// within params.max_reference_ray_residual_mm; throws when that cannot be
+// told.
+void SideCalibrationRun::RejectOffRayCrosses() {
+  // A centre off the line through the others is a misread cross or a wrong
+  // z. It can be told from the rest only when at least three others remain
+  // to agree on a line; it is the one whose removal leaves them on one.
+  const double limit = params_.max_reference_ray_residual_mm;
+  for (;;) {
+    std::vector<ReferenceViewReport>& crosses = out_.reference_views;
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& r : crosses) centres.push_back(r.world_mm);
+    if (crosses.size() < 3 || WorstOffRay(centres) <= limit) break;
+    // Each cross against the line through the others.
+    std::vector<double> off(crosses.size()), rest(crosses.size());
+    for (size_t k = 0; k < crosses.size(); ++k) {
+      const std::vector<Eigen::Vector3d> others = AllBut(crosses, k);
+      off[k] = DistanceToLine(FitRay(others), crosses[k].world_mm);
+      rest[k] = WorstOffRay(others);
+    }
+    const size_t worst = std::max_element(off.begin(), off.end()) - off.begin();
+    const size_t best = std::min_element(rest.begin(), rest.end()) - rest.begin();
+    const std::string off_text = "the cross centre lies " + Number(off[best]) +
+                                 " mm off the line through the other cross centres (limit " +
+                                 Number(limit) + " mm): a misread cross or a wrong z_mm";
+    if (crosses.size() < 4 || rest[best] > limit) {
+      const size_t named = crosses.size() < 4 ? worst : best;
+      Throw(CalibrationErrorReason::kInvalidInput,
+            "calibration: " +
+                ViewName(manifest_.reference_views[cross_index_[named]], ViewKind::kReference,
+                         cross_index_[named]) +
+                ": the cross centre lies " + Number(off[named]) +
+                " mm off the line through the other cross centres (limit " + Number(limit) +
+                " mm): a misread cross or a wrong z_mm; with " + std::to_string(crosses.size()) +
+                " crosses, " +
+                (crosses.size() < 4 ? "fewer than three others cannot tell which is wrong"
+                                    : "no three of them agree on a line"));
+    }
+    Drop(manifest_.reference_views[cross_index_[best]], ViewKind::kReference, cross_index_[best],
+         off_text);
+    crosses.erase(crosses.begin() + static_cast<std::ptrdiff_t>(best));
+    cross_index_.erase(cross_index_.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+}
+
+// The q offset of each screen view: the image of slide point (0, 0) on its
+// plane, where the reference ray meets it.
+void SideCalibrationRun::SetQOffsets(const std::vector<decoder::DecodeResult>& decoded) {
+  const geometry::PinholeModel& camera = out_.camera.model;
+  for (size_t i = 0; i < out_.screen_views.size() && out_.reference_ray; ++i) {
+    ScreenViewReport& report = out_.screen_views[i];
+    const std::optional<Eigen::Vector3d> origin = out_.reference_ray->AtZ(report.z_mm);
+    if (!origin) continue;
+    const auto image = camera.Project(*origin);
+    if (!image) continue;
+    const decoder::DecodedJunction* nearest = nullptr;
+    double best = params_.max_origin_junction_px;
+    for (const decoder::DecodedJunction& j : decoded[i].junctions) {
+      if (j.p != 0) continue;
+      const double d = std::hypot(j.position.x - image->x(), j.position.y - image->y());
+      if (d <= best) {
+        best = d;
+        nearest = &j;
+      }
+    }
+    // Line-0 junctions sit on even rows only, so the offset is even.
+    if (nearest) report.q_offset = -nearest->q;
+  }
+}
+
+// 4. Slide 1: the cross centre is slide point (0, 0) = brick line 0, row 0.
+void SideCalibrationRun::FixSlideRows(const std::vector<decoder::DecodeResult>& decoded) {
+  FindCrosses();
+  if (!manifest_.reference_views.empty()) {
+    Require(ViewKind::kReference, out_.reference_views.size(), manifest_.reference_views.size(),
+            params_.min_reference_views);
+    RejectOffRayCrosses();
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& r : out_.reference_views) centres.push_back(r.world_mm);
+    out_.reference_ray = FitRay(centres);
+    for (ReferenceViewReport& r : out_.reference_views)
+      r.ray_residual_mm = DistanceToLine(*out_.reference_ray, r.world_mm);
+  }
+  SetQOffsets(decoded);
+}
+
+// The junctions of the screen views with a q offset, on their screens, with
+// their absolute slide points, appended to diagnostics.junction_points;
+// returns the first junction point of each used screen view, then the end.
+std::vector<size_t> SideCalibrationRun::CollectJunctionPoints(
+    const std::vector<decoder::DecodeResult>& decoded) {
+  const geometry::PinholeModel& camera = out_.camera.model;
+  std::vector<size_t> junction_begin;  // first junction point of each used screen view
+  for (size_t i = 0; i < out_.screen_views.size(); ++i) {
+    ScreenViewReport& report = out_.screen_views[i];
+    junction_begin.push_back(out_.diagnostics.junction_points.size());
+    if (!report.q_offset) continue;
+    for (const decoder::DecodedJunction& j : decoded[i].junctions) {
+      if (j.interpolated && !params_.use_interpolated_junctions) continue;
+      const auto world =
+          internal::IntersectZPlane(camera.BackProject({j.position.x, j.position.y}), report.z_mm);
+      if (!world) continue;
+      out_.diagnostics.junction_points.push_back(
+          {*world, SlideOfJunction(manifest_.side, j.p, j.q + *report.q_offset)});
+      ++report.matrix_junctions;
+    }
+  }
+  junction_begin.push_back(out_.diagnostics.junction_points.size());
+  return junction_begin;
+}
+
+// 5. Thesis eq. 2.16: the projector matrix from the junctions of the views
+// whose rows are absolute (decoder::DecodeParams::q_offset added, as the
+// decoder would).
+void SideCalibrationRun::FitMatrix(const std::vector<decoder::DecodeResult>& decoded) {
+  const std::vector<size_t> junction_begin = CollectJunctionPoints(decoded);
+  if (manifest_.reference_views.empty()) return;
+  if (out_.diagnostics.junction_points.empty())
+    Throw(CalibrationErrorReason::kNotFound,
+          "calibration: " + file_ + ": no screen view's line-0 junction lies within " +
+              Number(params_.max_origin_junction_px) +
+              " px of the reference ray's image: the slide rows cannot be fixed");
+  try {
+    out_.projector_matrix = FitProjectorMatrix(out_.diagnostics.junction_points, params_.matrix);
+  } catch (const CalibrationError& e) {
+    Rethrow(e);
+  }
+  if (!out_.projector_matrix->report.converged)
+    Throw(CalibrationErrorReason::kNotConverged,
+          "calibration: " + file_ + ": projector matrix did not converge in " +
+              std::to_string(out_.projector_matrix->report.iterations) + " iterations");
+  const ProjectorMatrixFit& matrix = *out_.projector_matrix;
+  for (size_t i = 0; i < out_.screen_views.size(); ++i) {
+    double sum2 = 0.0;
+    int count = 0;
+    for (size_t k = junction_begin[i]; k < junction_begin[i + 1]; ++k) {
+      if (!matrix.report.inlier[k]) continue;
+      const JunctionPoint& j = out_.diagnostics.junction_points[k];
+      const auto slide = matrix.model.Project(j.world_mm);
+      if (!slide) continue;
+      sum2 += (*slide - j.slide_st).squaredNorm();
+      ++count;
+    }
+    if (count > 0) out_.screen_views[i].matrix_rms_d = std::sqrt(sum2 / count);
+  }
+}
+
 }  // namespace
 
 bool SideCalibrationParams::IsValid(std::string* error) const {
@@ -261,329 +689,36 @@ ProjectorPose PoseOfProjector(const PerspectivePlaneFit& perspective,
 SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationParams& params,
                               const CalibrationProgress& progress, const Cancellation& cancel) {
   const auto start = Clock::now();
-  const double total_views =
-      static_cast<double>(manifest.camera_views.size() + manifest.screen_views.size() +
-                          manifest.reference_views.size());
-  int views_begun = 0;
-  // Every view is announced before it is read; the caller may stop there.
-  auto begin_view = [&](const std::string& name) {
-    cancel.ThrowIfRequested(name);
-    if (progress && !progress(name, views_begun / total_views))
-      Throw(CalibrationErrorReason::kCancelled, "calibration: stopped before " + name);
-    ++views_begun;
-  };
-  const std::string file = manifest.path.string();
-  std::string why;
-  if (!params.IsValid(&why))
-    Throw(CalibrationErrorReason::kInvalidParams, "calibration: parameters: " + why);
-  if (!manifest.target.IsValid(&why))
-    Throw(CalibrationErrorReason::kInvalidInput, "calibration: " + file + ": " + why);
-  if (!manifest.pattern.IsValid(&why))
-    Throw(CalibrationErrorReason::kInvalidInput, "calibration: " + file + ": pattern: " + why);
-  CheckManifest(manifest, params);
+  SideCalibrationRun run(manifest, params, progress, cancel);
+  run.CheckInputs();
 
-  SideCalibration out;
+  SideCalibration& out = run.out();
   out.side = manifest.side;
   out.manifest_sha256 = manifest.sha256;
   out.pattern = manifest.pattern;
   out.target = manifest.target;
-  int width = 0, height = 0;
 
-  // A view that gives nothing is left out with its reason; a kind with fewer
-  // usable views than its minimum refuses the calibration, naming the views
-  // it lost and why.
-  auto drop = [&](const ManifestView& view, ViewKind kind, size_t index,
-                  const std::string& reason) {
-    out.dropped_views.push_back({view.image, kind, static_cast<int>(index), view.z_mm, reason});
-  };
-  auto require = [&](ViewKind kind, size_t used, size_t listed, int minimum) {
-    if (static_cast<int>(used) >= minimum) return;
-    std::string text = "calibration: " + file + ": " + std::to_string(used) + " of " +
-                       std::to_string(listed) + " " + std::string(ToString(kind)) +
-                       " views usable, at least " + std::to_string(minimum) + " are needed (" +
-                       WhyMinimum(kind) + "); dropped:";
-    std::string separator = " ";
-    for (const DroppedView& d : out.dropped_views) {
-      if (d.kind != kind) continue;
-      text += separator + ViewName(d.image, d.kind, d.index, d.z_mm) + ": " + d.reason;
-      separator = "; ";
-    }
-    Throw(CalibrationErrorReason::kNotFound, text);
-  };
-
-  // 1. Thesis 6.1: target squares' centres of gravity in every camera view,
-  // then Tsai's two-stage calibration on the views whose grid was found.
+  // 1. Thesis 6.1: camera.
   auto t = Clock::now();
-  std::vector<TargetView> views;
-  for (size_t i = 0; i < manifest.camera_views.size(); ++i) {
-    const ManifestView& view = manifest.camera_views[i];
-    const std::string name = ViewName(view, ViewKind::kCamera, i);
-    begin_view(name);
-    const cv::Mat grey = LoadView(view, name, params.images, &width, &height);
-    const TargetDetection detection = DetectTarget(grey, manifest.target, params.target);
-    if (!detection.ok) {
-      drop(view, ViewKind::kCamera, i, "target not found: " + detection.error);
-      continue;
-    }
-    TargetView target_view;
-    for (const TargetSquare& square : detection.squares) {
-      TargetPoint point;
-      point.world_mm = manifest.target.SquareCentre(square.row, square.col, view.z_mm);
-      point.image_px = {square.centre.x, square.centre.y};
-      target_view.points.push_back(point);
-    }
-    views.push_back(std::move(target_view));
-    CameraViewReport report;
-    report.image = view.image;
-    report.z_mm = view.z_mm;
-    report.max_grid_residual = detection.max_grid_residual;
-    out.camera_views.push_back(report);
-  }
-  require(ViewKind::kCamera, views.size(), manifest.camera_views.size(), params.min_camera_views);
-  out.width = width;
-  out.height = height;
-  try {
-    out.camera = CalibrateCamera(views, width, height, params.camera);
-  } catch (const CalibrationError& e) {
-    Throw(e.reason(), "calibration: " + file + ": " + e.what());
-  }
-  if (!out.camera.report.converged)
-    Throw(CalibrationErrorReason::kNotConverged,
-          "calibration: " + file + ": camera calibration did not converge in " +
-              std::to_string(out.camera.report.iterations) + " iterations (RMS " +
-              Number(out.camera.report.rms_px) + " px)");
-  for (size_t i = 0; i < out.camera_views.size(); ++i) {
-    out.camera_views[i].rms_px = out.camera.report.view_rms_px[i];
-    out.camera_views[i].rms_mm = out.camera.report.view_rms_mm[i];
-  }
-  out.sigmas.target_point_px = out.camera.report.residual_sigma_px;
+  run.CalibrateCameraViews();
   out.diagnostics.times.camera_ms = MsSince(t);
   const geometry::PinholeModel& camera = out.camera.model;
 
-  // 2. Thesis 6.2: decode every screen view; back-project each labelled
-  // line-centre sample onto its screen.
+  // 2. Thesis 6.2: stripe points of the screen views.
   t = Clock::now();
-  decoder::DecodeParams decode = params.decode;
-  decode.spec = manifest.pattern;
-  std::vector<decoder::DecodeResult> decoded;  // one per used screen view
-  std::vector<size_t> view_begin;              // first stripe point of each used screen view
-  double centre_sum2 = 0.0, centre_dof = 0.0;
-  for (size_t i = 0; i < manifest.screen_views.size(); ++i) {
-    const ManifestView& view = manifest.screen_views[i];
-    const std::string name = ViewName(view, ViewKind::kScreen, i);
-    begin_view(name);
-    const cv::Mat grey = LoadView(view, name, params.images, &width, &height);
-    decoder::DecodeResult result = decoder::Decode(grey, manifest.side, decode, cancel);
-    if (!result.ok) {
-      drop(view, ViewKind::kScreen, i, "the brick pattern could not be decoded: " + result.error);
-      continue;
-    }
-    ScreenViewReport report;
-    report.image = view.image;
-    report.z_mm = view.z_mm;
-    report.lines = static_cast<int>(result.lines.size());
-    report.junctions = static_cast<int>(result.junctions.size());
-    std::vector<StripePoint> points;
-    double sum2 = 0.0, dof = 0.0;
-    for (const decoder::DecodedLine& line : result.lines) {
-      AccumulateCentreScatter(line.points, params.centre_fit_degree, params.min_centre_run, &sum2,
-                              &dof);
-      for (size_t k = 0; k < line.points.size(); k += params.stripe_sample_step) {
-        const Eigen::Vector2d image(line.points[k].x, line.points[k].y);
-        const auto world = internal::IntersectZPlane(camera.BackProject(image), view.z_mm);
-        if (world) points.push_back({*world, line.p});
-      }
-    }
-    if (points.empty()) {
-      drop(view, ViewKind::kScreen, i,
-           "no decoded line-centre sample back-projects onto the screen (" +
-               std::to_string(report.lines) + " lines decoded)");
-      continue;
-    }
-    centre_sum2 += sum2;
-    centre_dof += dof;
-    report.stripe_points = static_cast<int>(points.size());
-    view_begin.push_back(out.diagnostics.stripe_points.size());
-    out.diagnostics.stripe_points.insert(out.diagnostics.stripe_points.end(), points.begin(),
-                                         points.end());
-    out.screen_views.push_back(report);
-    decoded.push_back(std::move(result));
-  }
-  require(ViewKind::kScreen, out.screen_views.size(), manifest.screen_views.size(),
-          params.min_screen_views);
-  view_begin.push_back(out.diagnostics.stripe_points.size());
-  out.sigmas.stripe_centre_px = centre_dof > 0.0 ? std::sqrt(centre_sum2 / centre_dof) : 0.0;
+  const std::vector<decoder::DecodeResult> decoded = run.DecodeScreenViews();
   out.diagnostics.times.stripes_ms = MsSince(t);
 
-  // 3. Thesis 6.2.1 and 6.2.2, each with its two-pass outlier rejection.
+  // 3. Thesis 6.2.1 and 6.2.2: the light planes.
   t = Clock::now();
-  try {
-    out.parallel = FitParallelPlaneModel(out.diagnostics.stripe_points, params.stripes);
-    out.perspective = FitPerspectivePlaneModel(out.diagnostics.stripe_points, params.stripes);
-  } catch (const CalibrationError& e) {
-    Throw(e.reason(), "calibration: " + file + ": " + e.what());
-  }
-  out.sigmas.plane_mm = out.perspective.report.rms_mm;
-  for (size_t i = 0; i < out.screen_views.size(); ++i) {
-    double sum2 = 0.0;
-    int count = 0;
-    for (size_t k = view_begin[i]; k < view_begin[i + 1]; ++k) {
-      if (!out.perspective.report.inlier[k]) continue;
-      const StripePoint& point = out.diagnostics.stripe_points[k];
-      const double d = out.perspective.model.PlaneOfLine(point.line).SignedDistance(point.world_mm);
-      sum2 += d * d;
-      ++count;
-    }
-    out.screen_views[i].plane_rms_mm = count > 0 ? std::sqrt(sum2 / count) : 0.0;
-  }
+  run.FitStripePlanes();
   out.diagnostics.times.planes_ms = MsSince(t);
 
-  // 4. Slide 1: the cross centre is slide point (0, 0) = brick line 0, row 0.
+  // 4. and 5.: slide rows from the reference crosses, then the projector
+  // matrix (thesis eq. 2.16).
   t = Clock::now();
-  std::vector<size_t> cross_index;  // manifest index of each used cross view
-  for (size_t i = 0; i < manifest.reference_views.size(); ++i) {
-    const ManifestView& view = manifest.reference_views[i];
-    const std::string name = ViewName(view, ViewKind::kReference, i);
-    begin_view(name);
-    const cv::Mat grey = LoadView(view, name, params.images, &width, &height);
-    std::string cross_why;
-    const auto cross = FindReferenceCross(grey, params.cross, &cross_why);
-    if (!cross) {
-      drop(view, ViewKind::kReference, i, "reference cross not found: " + cross_why);
-      continue;
-    }
-    ReferenceViewReport report;
-    report.image = view.image;
-    report.z_mm = view.z_mm;
-    report.centre_px = {cross->centre.x, cross->centre.y};
-    const auto world = internal::IntersectZPlane(camera.BackProject(report.centre_px), view.z_mm);
-    if (!world) {
-      drop(view, ViewKind::kReference, i, "the camera ray of the cross centre misses the screen");
-      continue;
-    }
-    report.world_mm = *world;
-    out.reference_views.push_back(report);
-    cross_index.push_back(i);
-  }
-  if (!manifest.reference_views.empty()) {
-    require(ViewKind::kReference, out.reference_views.size(), manifest.reference_views.size(),
-            params.min_reference_views);
-    // A centre off the line through the others is a misread cross or a wrong
-    // z. It can be told from the rest only when at least three others remain
-    // to agree on a line; it is the one whose removal leaves them on one.
-    const double limit = params.max_reference_ray_residual_mm;
-    for (;;) {
-      std::vector<ReferenceViewReport>& crosses = out.reference_views;
-      std::vector<Eigen::Vector3d> centres;
-      for (const auto& r : crosses) centres.push_back(r.world_mm);
-      if (crosses.size() < 3 || WorstOffRay(centres) <= limit) break;
-      // Each cross against the line through the others.
-      std::vector<double> off(crosses.size()), rest(crosses.size());
-      for (size_t k = 0; k < crosses.size(); ++k) {
-        const std::vector<Eigen::Vector3d> others = AllBut(crosses, k);
-        off[k] = DistanceToLine(FitRay(others), crosses[k].world_mm);
-        rest[k] = WorstOffRay(others);
-      }
-      const size_t worst = std::max_element(off.begin(), off.end()) - off.begin();
-      const size_t best = std::min_element(rest.begin(), rest.end()) - rest.begin();
-      const std::string off_text = "the cross centre lies " + Number(off[best]) +
-                                   " mm off the line through the other cross centres (limit " +
-                                   Number(limit) + " mm): a misread cross or a wrong z_mm";
-      if (crosses.size() < 4 || rest[best] > limit) {
-        const size_t named = crosses.size() < 4 ? worst : best;
-        Throw(CalibrationErrorReason::kInvalidInput,
-              "calibration: " +
-                  ViewName(manifest.reference_views[cross_index[named]], ViewKind::kReference,
-                           cross_index[named]) +
-                  ": the cross centre lies " + Number(off[named]) +
-                  " mm off the line through the other cross centres (limit " + Number(limit) +
-                  " mm): a misread cross or a wrong z_mm; with " + std::to_string(crosses.size()) +
-                  " crosses, " +
-                  (crosses.size() < 4 ? "fewer than three others cannot tell which is wrong"
-                                      : "no three of them agree on a line"));
-      }
-      drop(manifest.reference_views[cross_index[best]], ViewKind::kReference, cross_index[best],
-           off_text);
-      crosses.erase(crosses.begin() + static_cast<std::ptrdiff_t>(best));
-      cross_index.erase(cross_index.begin() + static_cast<std::ptrdiff_t>(best));
-    }
-    std::vector<Eigen::Vector3d> centres;
-    for (const auto& r : out.reference_views) centres.push_back(r.world_mm);
-    out.reference_ray = FitRay(centres);
-    for (ReferenceViewReport& r : out.reference_views)
-      r.ray_residual_mm = DistanceToLine(*out.reference_ray, r.world_mm);
-  }
-  // The q offset of each screen view: the image of slide point (0, 0) on its
-  // plane, where the reference ray meets it.
-  for (size_t i = 0; i < out.screen_views.size() && out.reference_ray; ++i) {
-    ScreenViewReport& report = out.screen_views[i];
-    const std::optional<Eigen::Vector3d> origin = out.reference_ray->AtZ(report.z_mm);
-    if (!origin) continue;
-    const auto image = camera.Project(*origin);
-    if (!image) continue;
-    const decoder::DecodedJunction* nearest = nullptr;
-    double best = params.max_origin_junction_px;
-    for (const decoder::DecodedJunction& j : decoded[i].junctions) {
-      if (j.p != 0) continue;
-      const double d = std::hypot(j.position.x - image->x(), j.position.y - image->y());
-      if (d <= best) {
-        best = d;
-        nearest = &j;
-      }
-    }
-    // Line-0 junctions sit on even rows only, so the offset is even.
-    if (nearest) report.q_offset = -nearest->q;
-  }
-
-  // 5. Thesis eq. 2.16: the projector matrix from the junctions of the views
-  // whose rows are absolute (decoder::DecodeParams::q_offset added, as the
-  // decoder would).
-  std::vector<size_t> junction_begin;  // first junction point of each used screen view
-  for (size_t i = 0; i < out.screen_views.size(); ++i) {
-    ScreenViewReport& report = out.screen_views[i];
-    junction_begin.push_back(out.diagnostics.junction_points.size());
-    if (!report.q_offset) continue;
-    for (const decoder::DecodedJunction& j : decoded[i].junctions) {
-      if (j.interpolated && !params.use_interpolated_junctions) continue;
-      const auto world =
-          internal::IntersectZPlane(camera.BackProject({j.position.x, j.position.y}), report.z_mm);
-      if (!world) continue;
-      out.diagnostics.junction_points.push_back(
-          {*world, SlideOfJunction(manifest.side, j.p, j.q + *report.q_offset)});
-      ++report.matrix_junctions;
-    }
-  }
-  junction_begin.push_back(out.diagnostics.junction_points.size());
-  if (!manifest.reference_views.empty()) {
-    if (out.diagnostics.junction_points.empty())
-      Throw(CalibrationErrorReason::kNotFound,
-            "calibration: " + file + ": no screen view's line-0 junction lies within " +
-                Number(params.max_origin_junction_px) +
-                " px of the reference ray's image: the slide rows cannot be fixed");
-    try {
-      out.projector_matrix = FitProjectorMatrix(out.diagnostics.junction_points, params.matrix);
-    } catch (const CalibrationError& e) {
-      Throw(e.reason(), "calibration: " + file + ": " + e.what());
-    }
-    if (!out.projector_matrix->report.converged)
-      Throw(CalibrationErrorReason::kNotConverged,
-            "calibration: " + file + ": projector matrix did not converge in " +
-                std::to_string(out.projector_matrix->report.iterations) + " iterations");
-    const ProjectorMatrixFit& matrix = *out.projector_matrix;
-    for (size_t i = 0; i < out.screen_views.size(); ++i) {
-      double sum2 = 0.0;
-      int count = 0;
-      for (size_t k = junction_begin[i]; k < junction_begin[i + 1]; ++k) {
-        if (!matrix.report.inlier[k]) continue;
-        const JunctionPoint& j = out.diagnostics.junction_points[k];
-        const auto slide = matrix.model.Project(j.world_mm);
-        if (!slide) continue;
-        sum2 += (*slide - j.slide_st).squaredNorm();
-        ++count;
-      }
-      if (count > 0) out.screen_views[i].matrix_rms_d = std::sqrt(sum2 / count);
-    }
-  }
+  run.FixSlideRows(decoded);
+  run.FitMatrix(decoded);
   std::stable_sort(out.dropped_views.begin(), out.dropped_views.end(),
                    [](const DroppedView& a, const DroppedView& b) {
                      return std::tie(a.kind, a.index) < std::tie(b.kind, b.index);
@@ -591,7 +726,7 @@ SideCalibration CalibrateSide(const Manifest& manifest, const SideCalibrationPar
   out.projector = PoseOfProjector(out.perspective, out.projector_matrix, camera);
   out.diagnostics.times.reference_ms = MsSince(t);
   out.diagnostics.times.total_ms = MsSince(start);
-  return out;
+  return std::move(out);
 }
 
 bool SharesWorldFrame(const SideCalibration& left, const SideCalibration& right, std::string* why,

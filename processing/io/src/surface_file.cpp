@@ -196,6 +196,241 @@ bool IsIndexList(const std::string& name) {
   return name == "vertex_indices" || name == "vertex_index";
 }
 
+// The error for a header that cannot be read as a surface's.
+InputError HeaderError(const std::string& name, const std::string& why) {
+  return InputError(name + ": not a usable PLY file: " + why);
+}
+
+// One header "property" line's property; throws on a malformed one.
+Property ParseProperty(const std::vector<std::string>& w, std::string_view line,
+                       const std::string& name) {
+  Property p;
+  if (w.size() == 5 && w[1] == "list") {
+    const auto count = ParseType(w[2]), item = ParseType(w[3]);
+    if (!count || !item || *count == Type::kFloat32 || *count == Type::kFloat64)
+      throw HeaderError(name, "bad list property '" + std::string(line) + "'");
+    p = {w[4], *item, true, *count};
+  } else if (w.size() == 3) {
+    const auto type = ParseType(w[1]);
+    if (!type) throw HeaderError(name, "unknown type '" + w[1] + "'");
+    p = {w[2], *type, false, Type::kUint8};
+  } else {
+    throw HeaderError(name, "bad property line '" + std::string(line) + "'");
+  }
+  return p;
+}
+
+// A PLY header: the body's format, its elements in file order, and where
+// the body starts in the file.
+struct PlyHeader {
+  Format format = Format::kAscii;
+  std::vector<Element> elements;
+  std::size_t body_start = 0;
+};
+
+// Reads the header up to and including its end_header line; throws
+// InputError naming the file on anything it cannot use.
+PlyHeader ReadPlyHeader(std::string_view bytes, const std::string& name) {
+  std::size_t pos = 0;
+  auto line = NextLine(bytes, &pos);
+  if (!line || *line != "ply") throw HeaderError(name, "it does not start with 'ply'");
+  std::optional<Format> format;
+  PlyHeader header;
+  std::vector<Element>& elements = header.elements;
+  bool ended = false;
+  while (!ended) {
+    // A header is a few hundred bytes; one of megabytes is not a surface's.
+    if (pos > kMaxPlyHeaderBytes)
+      throw HeaderError(name, "the header runs past " + std::to_string(kMaxPlyHeaderBytes >> 10) +
+                                  " KiB without an end_header line");
+    line = NextLine(bytes, &pos);
+    if (!line) throw HeaderError(name, "the header has no end_header line");
+    const std::vector<std::string> w = Words(*line);
+    if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+    if (w[0] == "end_header") {
+      ended = true;
+    } else if (w[0] == "format") {
+      if (w.size() != 3 || w[2] != "1.0") throw HeaderError(name, "bad format line");
+      if (w[1] == "ascii")
+        format = Format::kAscii;
+      else if (w[1] == "binary_little_endian")
+        format = Format::kLittle;
+      else if (w[1] == "binary_big_endian")
+        format = Format::kBig;
+      else
+        throw HeaderError(name, "unknown format '" + w[1] + "'");
+    } else if (w[0] == "element") {
+      if (w.size() != 3) throw HeaderError(name, "bad element line '" + std::string(*line) + "'");
+      Element e;
+      e.name = w[1];
+      const auto r = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
+      if (r.ec != std::errc() || r.ptr != w[2].data() + w[2].size())
+        throw HeaderError(name, "bad count in '" + std::string(*line) + "'");
+      elements.push_back(e);
+    } else if (w[0] == "property") {
+      if (elements.empty()) throw HeaderError(name, "a property before any element");
+      elements.back().properties.push_back(ParseProperty(w, *line, name));
+    } else {
+      throw HeaderError(name, "unknown header line '" + std::string(*line) + "'");
+    }
+  }
+  if (!format) throw HeaderError(name, "no format line");
+  header.format = *format;
+  header.body_start = pos;
+  return header;
+}
+
+// Reads one list property's items and throws them away.
+void SkipList(BodyReader& body, const Property& p, const std::string& what) {
+  const double n = body.Read(p.count_type, what);
+  if (n < 0) body.Fail("negative list length in " + what);
+  for (double i = 0; i < n; ++i) body.Read(p.type, what);
+}
+
+// Where each vertex property the mesh keeps sits in a vertex's values; -1
+// for one the file does not have.
+struct VertexColumns {
+  int x = -1, y = -1, z = -1, nx = -1, ny = -1, nz = -1, sigma = -1, line = -1, flags = -1;
+};
+
+VertexColumns FindVertexColumns(const Element& e) {
+  VertexColumns c;
+  for (std::size_t k = 0; k < e.properties.size(); ++k) {
+    const Property& p = e.properties[k];
+    if (p.is_list) continue;
+    const int index = static_cast<int>(k);
+    if (p.name == "x")
+      c.x = index;
+    else if (p.name == "y")
+      c.y = index;
+    else if (p.name == "z")
+      c.z = index;
+    else if (p.name == "nx")
+      c.nx = index;
+    else if (p.name == "ny")
+      c.ny = index;
+    else if (p.name == "nz")
+      c.nz = index;
+    else if (p.name == "uncertainty_mm")
+      c.sigma = index;
+    else if (p.name == "line")
+      c.line = index;
+    else if (p.name == "flags")
+      c.flags = index;
+  }
+  return c;
+}
+
+// Stores vertex v's values in the mesh; a value its type cannot hold fails
+// the body.
+void StoreVertex(const std::vector<double>& values, const VertexColumns& c, bool normals,
+                 std::uint64_t v, const std::string& what, BodyReader& body,
+                 geometry::SurfaceMesh& mesh) {
+  mesh.positions[v] = {values[c.x], values[c.y], values[c.z]};
+  if (!mesh.positions[v].allFinite()) body.Fail("non-finite position in " + what);
+  if (normals) mesh.normals[v] = {values[c.nx], values[c.ny], values[c.nz]};
+  // Values the types below cannot hold are input errors, never casts.
+  if (c.sigma >= 0) {
+    const double sigma = values[c.sigma];
+    if (!(sigma >= 0.0 && sigma <= std::numeric_limits<float>::max()))
+      body.Fail("uncertainty_mm is not a finite value >= 0 in " + what);
+    mesh.uncertainty_mm[v] = static_cast<float>(sigma);
+  }
+  if (c.line >= 0) {
+    const double p = values[c.line];
+    if (!(p >= std::numeric_limits<std::int32_t>::min() &&
+          p <= std::numeric_limits<std::int32_t>::max()) ||
+        p != std::floor(p))
+      body.Fail("line is not a 32-bit integer in " + what);
+    mesh.line[v] = static_cast<std::int32_t>(p);
+  }
+  if (c.flags >= 0) {
+    const double flags = values[c.flags];
+    if (!(flags >= 0.0 && flags <= 255.0) || flags != std::floor(flags))
+      body.Fail("flags is not a byte in " + what);
+    mesh.flags[v] = static_cast<std::uint8_t>(flags);
+  }
+}
+
+// Reads the vertex element into the mesh's per-vertex arrays; needs x, y, z.
+void ReadVertices(const Element& e, BodyReader& body, const std::string& name,
+                  geometry::SurfaceMesh& mesh) {
+  const VertexColumns c = FindVertexColumns(e);
+  if (c.x < 0 || c.y < 0 || c.z < 0)
+    throw InputError(name + ": not a usable PLY file: the vertices have no x, y, z");
+  const bool normals = c.nx >= 0 && c.ny >= 0 && c.nz >= 0;
+  mesh.positions.resize(e.count);
+  if (normals) mesh.normals.resize(e.count);
+  if (c.sigma >= 0) mesh.uncertainty_mm.resize(e.count);
+  if (c.line >= 0) mesh.line.resize(e.count);
+  if (c.flags >= 0) mesh.flags.resize(e.count);
+  std::vector<double> values(e.properties.size());
+  for (std::uint64_t v = 0; v < e.count; ++v) {
+    const std::string what = "vertex " + std::to_string(v) + " of " + std::to_string(e.count);
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const Property& p = e.properties[k];
+      if (p.is_list) {  // an unknown list on a vertex: skipped
+        SkipList(body, p, what);
+      } else {
+        values[k] = body.Read(p.type, what);
+      }
+    }
+    StoreVertex(values, c, normals, v, what, body, mesh);
+  }
+}
+
+// Reads the face element, each polygon of its index list appended to the
+// mesh's triangles as a fan.
+void ReadFaces(const Element& e, BodyReader& body, const std::string& name,
+               geometry::SurfaceMesh& mesh) {
+  int index_list = -1;
+  for (std::size_t k = 0; k < e.properties.size(); ++k)
+    if (e.properties[k].is_list && IsIndexList(e.properties[k].name))
+      index_list = static_cast<int>(k);
+  if (index_list < 0)
+    throw InputError(name + ": not a usable PLY file: the faces have no vertex_indices");
+  mesh.faces.reserve(e.count);
+  std::vector<int> polygon;
+  for (std::uint64_t f = 0; f < e.count; ++f) {
+    const std::string what = "face " + std::to_string(f) + " of " + std::to_string(e.count);
+    for (std::size_t k = 0; k < e.properties.size(); ++k) {
+      const Property& p = e.properties[k];
+      if (!p.is_list) {
+        body.Read(p.type, what);
+        continue;
+      }
+      const double n = body.Read(p.count_type, what);
+      if (n < 0 || n != std::floor(n)) body.Fail("bad list length in " + what);
+      polygon.clear();
+      for (double i = 0; i < n; ++i) {
+        const double index = body.Read(p.type, what);
+        if (static_cast<int>(k) == index_list) {
+          if (index < 0 || index != std::floor(index) || index > 2147483647.0)
+            body.Fail("bad vertex index in " + what);
+          polygon.push_back(static_cast<int>(index));
+        }
+      }
+      if (static_cast<int>(k) != index_list) continue;
+      if (polygon.size() < 3) body.Fail(what + " has fewer than 3 vertices");
+      for (std::size_t i = 1; i + 1 < polygon.size(); ++i)  // a fan
+        mesh.faces.emplace_back(polygon[0], polygon[i], polygon[i + 1]);
+    }
+  }
+}
+
+// Reads an element we do not use and throws its values away.
+void SkipElement(const Element& e, BodyReader& body) {
+  for (std::uint64_t i = 0; i < e.count; ++i)
+    for (const Property& p : e.properties) {
+      const std::string what = e.name + " " + std::to_string(i);
+      if (p.is_list) {
+        SkipList(body, p, what);
+      } else {
+        body.Read(p.type, what);
+      }
+    }
+}
+
 }  // namespace
 
 std::string EncodePly(const geometry::SurfaceMesh& mesh, PlyEncoding encoding) {
@@ -319,76 +554,17 @@ void WriteSurface(const std::string& path, const geometry::SurfaceMesh& mesh,
 }
 
 geometry::SurfaceMesh DecodePly(std::string_view bytes, const std::string& name) {
-  std::size_t pos = 0;
-  const auto header_error = [&name](const std::string& why) {
-    return InputError(name + ": not a usable PLY file: " + why);
-  };
-  auto line = NextLine(bytes, &pos);
-  if (!line || *line != "ply") throw header_error("it does not start with 'ply'");
-  std::optional<Format> format;
-  std::vector<Element> elements;
-  bool ended = false;
-  while (!ended) {
-    // A header is a few hundred bytes; one of megabytes is not a surface's.
-    if (pos > kMaxPlyHeaderBytes)
-      throw header_error("the header runs past " + std::to_string(kMaxPlyHeaderBytes >> 10) +
-                         " KiB without an end_header line");
-    line = NextLine(bytes, &pos);
-    if (!line) throw header_error("the header has no end_header line");
-    const std::vector<std::string> w = Words(*line);
-    if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
-    if (w[0] == "end_header") {
-      ended = true;
-    } else if (w[0] == "format") {
-      if (w.size() != 3 || w[2] != "1.0") throw header_error("bad format line");
-      if (w[1] == "ascii")
-        format = Format::kAscii;
-      else if (w[1] == "binary_little_endian")
-        format = Format::kLittle;
-      else if (w[1] == "binary_big_endian")
-        format = Format::kBig;
-      else
-        throw header_error("unknown format '" + w[1] + "'");
-    } else if (w[0] == "element") {
-      if (w.size() != 3) throw header_error("bad element line '" + std::string(*line) + "'");
-      Element e;
-      e.name = w[1];
-      const auto r = std::from_chars(w[2].data(), w[2].data() + w[2].size(), e.count);
-      if (r.ec != std::errc() || r.ptr != w[2].data() + w[2].size())
-        throw header_error("bad count in '" + std::string(*line) + "'");
-      elements.push_back(e);
-    } else if (w[0] == "property") {
-      if (elements.empty()) throw header_error("a property before any element");
-      Property p;
-      if (w.size() == 5 && w[1] == "list") {
-        const auto count = ParseType(w[2]), item = ParseType(w[3]);
-        if (!count || !item || *count == Type::kFloat32 || *count == Type::kFloat64)
-          throw header_error("bad list property '" + std::string(*line) + "'");
-        p = {w[4], *item, true, *count};
-      } else if (w.size() == 3) {
-        const auto type = ParseType(w[1]);
-        if (!type) throw header_error("unknown type '" + w[1] + "'");
-        p = {w[2], *type, false, Type::kUint8};
-      } else {
-        throw header_error("bad property line '" + std::string(*line) + "'");
-      }
-      elements.back().properties.push_back(p);
-    } else {
-      throw header_error("unknown header line '" + std::string(*line) + "'");
-    }
-  }
-  if (!format) throw header_error("no format line");
-
-  BodyReader body(bytes.substr(pos), *format, name);
+  const PlyHeader header = ReadPlyHeader(bytes, name);
+  BodyReader body(bytes.substr(header.body_start), header.format, name);
   geometry::SurfaceMesh mesh;
   bool seen_vertex = false;
-  for (const Element& e : elements) {
+  for (const Element& e : header.elements) {
     // Every item takes at least one byte (binary) or two characters (ASCII):
     // a count the rest of the file cannot hold is refused before allocating.
     std::size_t min_item = 0;
     for (const Property& p : e.properties)
       min_item += p.is_list ? SizeOf(p.count_type) : SizeOf(p.type);
-    if (*format == Format::kAscii) min_item = 2 * e.properties.size();
+    if (header.format == Format::kAscii) min_item = 2 * e.properties.size();
     if (min_item > 0 && e.count > body.remaining() / min_item)
       throw InputError(name + ": truncated PLY: " + std::to_string(e.count) + " " + e.name +
                        " items do not fit in the rest of the file");
@@ -396,129 +572,17 @@ geometry::SurfaceMesh DecodePly(std::string_view bytes, const std::string& name)
     // to read, and no loop as long as the count.
     if (e.properties.empty()) {
       if (e.name == "vertex" || e.name == "face")
-        throw header_error("element " + e.name + " has no properties");
+        throw HeaderError(name, "element " + e.name + " has no properties");
       continue;
     }
     if (e.name == "vertex") {
       if (seen_vertex) body.Fail("two vertex elements");
       seen_vertex = true;
-      int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, isig = -1, iline = -1,
-          iflags = -1;
-      for (std::size_t k = 0; k < e.properties.size(); ++k) {
-        const Property& p = e.properties[k];
-        if (p.is_list) continue;
-        const int index = static_cast<int>(k);
-        if (p.name == "x")
-          ix = index;
-        else if (p.name == "y")
-          iy = index;
-        else if (p.name == "z")
-          iz = index;
-        else if (p.name == "nx")
-          inx = index;
-        else if (p.name == "ny")
-          iny = index;
-        else if (p.name == "nz")
-          inz = index;
-        else if (p.name == "uncertainty_mm")
-          isig = index;
-        else if (p.name == "line")
-          iline = index;
-        else if (p.name == "flags")
-          iflags = index;
-      }
-      if (ix < 0 || iy < 0 || iz < 0)
-        throw InputError(name + ": not a usable PLY file: the vertices have no x, y, z");
-      const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
-      mesh.positions.resize(e.count);
-      if (normals) mesh.normals.resize(e.count);
-      if (isig >= 0) mesh.uncertainty_mm.resize(e.count);
-      if (iline >= 0) mesh.line.resize(e.count);
-      if (iflags >= 0) mesh.flags.resize(e.count);
-      std::vector<double> values(e.properties.size());
-      for (std::uint64_t v = 0; v < e.count; ++v) {
-        const std::string what = "vertex " + std::to_string(v) + " of " + std::to_string(e.count);
-        for (std::size_t k = 0; k < e.properties.size(); ++k) {
-          const Property& p = e.properties[k];
-          if (p.is_list) {  // an unknown list on a vertex: skipped
-            const double n = body.Read(p.count_type, what);
-            if (n < 0) body.Fail("negative list length in " + what);
-            for (double i = 0; i < n; ++i) body.Read(p.type, what);
-          } else {
-            values[k] = body.Read(p.type, what);
-          }
-        }
-        mesh.positions[v] = {values[ix], values[iy], values[iz]};
-        if (!mesh.positions[v].allFinite()) body.Fail("non-finite position in " + what);
-        if (normals) mesh.normals[v] = {values[inx], values[iny], values[inz]};
-        // Values the types below cannot hold are input errors, never casts.
-        if (isig >= 0) {
-          const double sigma = values[isig];
-          if (!(sigma >= 0.0 && sigma <= std::numeric_limits<float>::max()))
-            body.Fail("uncertainty_mm is not a finite value >= 0 in " + what);
-          mesh.uncertainty_mm[v] = static_cast<float>(sigma);
-        }
-        if (iline >= 0) {
-          const double p = values[iline];
-          if (!(p >= std::numeric_limits<std::int32_t>::min() &&
-                p <= std::numeric_limits<std::int32_t>::max()) ||
-              p != std::floor(p))
-            body.Fail("line is not a 32-bit integer in " + what);
-          mesh.line[v] = static_cast<std::int32_t>(p);
-        }
-        if (iflags >= 0) {
-          const double flags = values[iflags];
-          if (!(flags >= 0.0 && flags <= 255.0) || flags != std::floor(flags))
-            body.Fail("flags is not a byte in " + what);
-          mesh.flags[v] = static_cast<std::uint8_t>(flags);
-        }
-      }
+      ReadVertices(e, body, name, mesh);
     } else if (e.name == "face") {
-      int index_list = -1;
-      for (std::size_t k = 0; k < e.properties.size(); ++k)
-        if (e.properties[k].is_list && IsIndexList(e.properties[k].name))
-          index_list = static_cast<int>(k);
-      if (index_list < 0)
-        throw InputError(name + ": not a usable PLY file: the faces have no vertex_indices");
-      mesh.faces.reserve(e.count);
-      std::vector<int> polygon;
-      for (std::uint64_t f = 0; f < e.count; ++f) {
-        const std::string what = "face " + std::to_string(f) + " of " + std::to_string(e.count);
-        for (std::size_t k = 0; k < e.properties.size(); ++k) {
-          const Property& p = e.properties[k];
-          if (!p.is_list) {
-            body.Read(p.type, what);
-            continue;
-          }
-          const double n = body.Read(p.count_type, what);
-          if (n < 0 || n != std::floor(n)) body.Fail("bad list length in " + what);
-          polygon.clear();
-          for (double i = 0; i < n; ++i) {
-            const double index = body.Read(p.type, what);
-            if (static_cast<int>(k) == index_list) {
-              if (index < 0 || index != std::floor(index) || index > 2147483647.0)
-                body.Fail("bad vertex index in " + what);
-              polygon.push_back(static_cast<int>(index));
-            }
-          }
-          if (static_cast<int>(k) != index_list) continue;
-          if (polygon.size() < 3) body.Fail(what + " has fewer than 3 vertices");
-          for (std::size_t i = 1; i + 1 < polygon.size(); ++i)  // a fan
-            mesh.faces.emplace_back(polygon[0], polygon[i], polygon[i + 1]);
-        }
-      }
+      ReadFaces(e, body, name, mesh);
     } else {  // an element we do not use: skipped
-      for (std::uint64_t i = 0; i < e.count; ++i)
-        for (const Property& p : e.properties) {
-          const std::string what = e.name + " " + std::to_string(i);
-          if (p.is_list) {
-            const double n = body.Read(p.count_type, what);
-            if (n < 0) body.Fail("negative list length in " + what);
-            for (double k = 0; k < n; ++k) body.Read(p.type, what);
-          } else {
-            body.Read(p.type, what);
-          }
-        }
+      SkipElement(e, body);
     }
   }
   if (!seen_vertex) throw InputError(name + ": not a usable PLY file: no vertex element");

@@ -130,6 +130,180 @@ std::vector<double> AnchoredBridge(const std::map<int, double>& x_of_row, int ro
   return xs;
 }
 
+// Throws unless the params are valid and the decode succeeded, is of the
+// triangulator's side and has at least one labelled line sample.
+void CheckInputs(const decoder::DecodeResult& decode, const Triangulator& triangulator,
+                 const ReconstructionParams& params) {
+  std::string why;
+  if (!params.IsValid(&why)) throw std::invalid_argument(why);
+  if (!decode.ok) throw ReconstructionError("reconstruction: the decode failed: " + decode.error);
+  const pattern::Side side = triangulator.model().side;
+  if (decode.side != side)
+    throw ReconstructionError("reconstruction: the decode is of the " +
+                              std::string(pattern::ToString(decode.side)) +
+                              " side, the model of the " + std::string(pattern::ToString(side)));
+  const bool any_sample = std::any_of(decode.lines.begin(), decode.lines.end(),
+                                      [](const auto& l) { return !l.points.empty(); });
+  if (!any_sample)
+    throw ReconstructionError("reconstruction: the decode has no labelled line samples");
+}
+
+// A line's centres that met its light plane: their vertices, and the image
+// column of each, by index and by row.
+struct MeasuredLine {
+  std::vector<LineVertex> vertices;
+  std::vector<double> x;
+  std::map<int, double> x_of_row;
+};
+
+// Measured samples: each centre of line p triangulated; those missing the
+// plane counted in r.dropped_samples.
+MeasuredLine TriangulateCentres(int p, const std::vector<Centre>& centres,
+                                const Triangulator& triangulator, ReconstructionReport& r) {
+  MeasuredLine m;
+  for (const Centre& c : centres) {
+    const auto point = triangulator.LineSample(p, {c.x, double(c.row)}, c.sigma_px);
+    if (!point) {
+      ++r.dropped_samples;
+      continue;
+    }
+    m.vertices.push_back({c.row, point->position, float(point->sigma_mm), c.flags});
+    m.x.push_back(c.x);
+    m.x_of_row[c.row] = c.x;
+  }
+  return m;
+}
+
+// Thesis Appendix B: the image columns x(row) of the rows missing between
+// measured vertices i and i + 1 of line p, by a cubic B-spline through the
+// centres x(row) at uniform knots: the gap's two ends and, where the line
+// has them, one more knot a gap-length beyond each end; pinned at the line's
+// junctions (AnchoredBridge) for a gap too long for the spline alone. Empty
+// when the gap is not bridged. `step` is the line's median step (mm).
+std::vector<double> GapColumns(const MeasuredLine& m, std::size_t i, int p,
+                               const std::multimap<int, cv::Point2d>& junctions_of,
+                               const ReconstructionParams& params, double step) {
+  const std::vector<LineVertex>& measured = m.vertices;
+  const MeshParams& mesh_params = params.mesh;
+  const int row0 = measured[i].row, row1 = measured[i + 1].row;
+  const int missing = row1 - row0 - 1;
+  if (missing < 1) return {};
+  // The line's junctions inside the gap, clear of its ends.
+  std::vector<cv::Point2d> inside;
+  if (missing > params.max_bridge_rows) {
+    if (missing > params.max_anchored_bridge_rows) return {};
+    const auto [from, to] = junctions_of.equal_range(p);
+    for (auto it = from; it != to; ++it)
+      if (it->second.y > row0 + 0.5 && it->second.y < row1 - 0.5) inside.push_back(it->second);
+    if (inside.empty()) return {};
+    std::sort(inside.begin(), inside.end(),
+              [](const cv::Point2d& a, const cv::Point2d& b) { return a.y < b.y; });
+  }
+  const int h = missing + 1;  // knot spacing, rows
+  // A jump in depth across the gap is an occlusion, not a break: no bridge.
+  const double jump = (measured[i + 1].position - measured[i].position).norm();
+  if (jump > std::max(mesh_params.min_along_jump_mm, mesh_params.max_along_ratio * step * h))
+    return {};
+  if (!inside.empty())
+    return AnchoredBridge(m.x_of_row, row0, row1, inside, params.max_anchor_offset_px);
+  std::vector<double> knots;
+  int first_knot_row = row0;
+  if (const auto it = m.x_of_row.find(row0 - h); it != m.x_of_row.end()) {
+    knots.push_back(it->second);
+    first_knot_row = row0 - h;
+  }
+  knots.push_back(m.x[i]);
+  knots.push_back(m.x[i + 1]);
+  if (const auto it = m.x_of_row.find(row1 + h); it != m.x_of_row.end())
+    knots.push_back(it->second);
+  const std::optional<CubicBSpline> spline = CubicBSpline::Interpolate(knots);
+  if (!spline) return {};
+  std::vector<double> xs;
+  for (int row = row0 + 1; row < row1; ++row)
+    xs.push_back((*spline)(double(row - first_knot_row) / h));
+  return xs;
+}
+
+// Line p's measured vertices with the bridged ones of each short gap
+// between them, in row order; bridged samples counted in r.
+std::vector<LineVertex> BridgeGaps(int p, const MeasuredLine& m,
+                                   const std::multimap<int, cv::Point2d>& junctions_of,
+                                   const Triangulator& triangulator,
+                                   const ReconstructionParams& params, ReconstructionReport& r) {
+  const std::vector<LineVertex>& measured = m.vertices;
+  const UncertaintyParams& u = triangulator.model().uncertainty;
+  std::vector<double> steps;
+  for (std::size_t i = 0; i + 1 < measured.size(); ++i)
+    if (measured[i + 1].row == measured[i].row + 1)
+      steps.push_back((measured[i + 1].position - measured[i].position).norm());
+  const double step = Median(steps);
+  std::vector<LineVertex> vertices;
+  for (std::size_t i = 0; i < measured.size(); ++i) {
+    vertices.push_back(measured[i]);
+    if (i + 1 == measured.size()) break;
+    const std::vector<double> xs = GapColumns(m, i, p, junctions_of, params, step);
+    if (xs.empty()) continue;
+    const int row0 = measured[i].row, row1 = measured[i + 1].row;
+    const double sigma = std::hypot(u.stripe_centre_sigma_px, params.bridge_sigma_px);
+    for (int row = row0 + 1; row < row1; ++row) {
+      const double x = xs[static_cast<size_t>(row - row0 - 1)];
+      const auto point = triangulator.LineSample(p, {x, double(row)}, sigma);
+      if (!point) continue;
+      vertices.push_back({row, point->position, float(point->sigma_mm), geometry::kVertexBridged});
+      ++r.bridged_samples;
+    }
+  }
+  return vertices;
+}
+
+// Appends `vertices` to line p of `by_p`. A line listed twice by the
+// decoder: its samples merge, first kept per row.
+void MergeLine(int p, const std::vector<LineVertex>& vertices,
+               std::map<int, TriangulatedLine>& by_p) {
+  TriangulatedLine& out = by_p[p];
+  out.p = p;
+  out.vertices.insert(out.vertices.end(), vertices.begin(), vertices.end());
+  std::stable_sort(out.vertices.begin(), out.vertices.end(),
+                   [](const LineVertex& a, const LineVertex& b) { return a.row < b.row; });
+  out.vertices.erase(std::unique(out.vertices.begin(), out.vertices.end(),
+                                 [](const auto& a, const auto& b) { return a.row == b.row; }),
+                     out.vertices.end());
+}
+
+// Appends a vertex for every decoded junction that triangulates, its normal
+// from the line vertex on its row (else towards the camera); counted in r.
+void AddJunctions(const decoder::DecodeResult& decode, const Triangulator& triangulator,
+                  const std::vector<TriangulatedLine>& lines, geometry::SurfaceMesh& mesh,
+                  ReconstructionReport& r) {
+  // Vertex of (p, row) for the junctions' normals.
+  std::map<std::pair<int, int>, int> vertex_of;
+  int index = 0;
+  for (const TriangulatedLine& line : lines)
+    for (const LineVertex& v : line.vertices) vertex_of[{line.p, v.row}] = index++;
+  for (const decoder::DecodedJunction& j : decode.junctions) {
+    const Eigen::Vector2d image(j.position.x, j.position.y);
+    if (!image.allFinite()) {
+      ++r.dropped_junctions;
+      continue;
+    }
+    const auto point = triangulator.Junction(j.p, j.q, image, decode.q_absolute);
+    if (!point) {
+      ++r.dropped_junctions;
+      continue;
+    }
+    mesh.positions.push_back(point->position);
+    mesh.uncertainty_mm.push_back(float(point->sigma_mm));
+    mesh.line.push_back(j.p);
+    mesh.flags.push_back(geometry::kVertexJunction);
+    const auto near = vertex_of.find({j.p, static_cast<int>(std::lround(image.y()))});
+    Eigen::Vector3d normal = (triangulator.CameraCentre() - point->position).normalized();
+    if (near != vertex_of.end()) normal = mesh.normals[near->second];
+    mesh.normals.push_back(normal);
+    ++r.junctions;
+    if (triangulator.HasProjector() && decode.q_absolute) ++r.junctions_by_projector;
+  }
+}
+
 }  // namespace
 
 bool ReconstructionParams::IsValid(std::string* error) const {
@@ -157,18 +331,7 @@ geometry::SurfaceMesh Reconstruct(const decoder::DecodeResult& decode,
                                   const ReconstructionParams& params,
                                   ReconstructionReport* report) {
   const auto start = std::chrono::steady_clock::now();
-  std::string why;
-  if (!params.IsValid(&why)) throw std::invalid_argument(why);
-  if (!decode.ok) throw ReconstructionError("reconstruction: the decode failed: " + decode.error);
-  const pattern::Side side = triangulator.model().side;
-  if (decode.side != side)
-    throw ReconstructionError("reconstruction: the decode is of the " +
-                              std::string(pattern::ToString(decode.side)) +
-                              " side, the model of the " + std::string(pattern::ToString(side)));
-  const bool any_sample = std::any_of(decode.lines.begin(), decode.lines.end(),
-                                      [](const auto& l) { return !l.points.empty(); });
-  if (!any_sample)
-    throw ReconstructionError("reconstruction: the decode has no labelled line samples");
+  CheckInputs(decode, triangulator, params);
 
   ReconstructionReport r;
   const UncertaintyParams& u = triangulator.model().uncertainty;
@@ -182,94 +345,10 @@ geometry::SurfaceMesh Reconstruct(const decoder::DecodeResult& decode,
     std::vector<Centre> centres = CentresOf(line, u.stripe_centre_sigma_px);
     if (centres.empty()) continue;
     if (params.smooth_lines) r.smoothed_samples += SmoothCentres(&centres);
-
-    // Measured samples.
-    std::vector<LineVertex> measured;
-    std::vector<double> measured_x;
-    std::map<int, double> x_of_row;
-    for (const Centre& c : centres) {
-      const auto point = triangulator.LineSample(line.p, {c.x, double(c.row)}, c.sigma_px);
-      if (!point) {
-        ++r.dropped_samples;
-        continue;
-      }
-      measured.push_back({c.row, point->position, float(point->sigma_mm), c.flags});
-      measured_x.push_back(c.x);
-      x_of_row[c.row] = c.x;
-    }
-    r.measured_samples += static_cast<int>(measured.size());
-    if (measured.empty()) continue;
-
-    // Thesis Appendix B: bridge short gaps by a cubic B-spline through the
-    // centres x(row) at uniform knots: the gap's two ends and, where the line
-    // has them, one more knot a gap-length beyond each end.
-    std::vector<double> steps;
-    for (std::size_t i = 0; i + 1 < measured.size(); ++i)
-      if (measured[i + 1].row == measured[i].row + 1)
-        steps.push_back((measured[i + 1].position - measured[i].position).norm());
-    const double step = Median(steps);
-    std::vector<LineVertex> vertices;
-    for (std::size_t i = 0; i < measured.size(); ++i) {
-      vertices.push_back(measured[i]);
-      if (i + 1 == measured.size()) break;
-      const int row0 = measured[i].row, row1 = measured[i + 1].row;
-      const int missing = row1 - row0 - 1;
-      if (missing < 1) continue;
-      // The line's junctions inside the gap, clear of its ends.
-      std::vector<cv::Point2d> inside;
-      if (missing > params.max_bridge_rows) {
-        if (missing > params.max_anchored_bridge_rows) continue;
-        const auto [from, to] = junctions_of.equal_range(line.p);
-        for (auto it = from; it != to; ++it)
-          if (it->second.y > row0 + 0.5 && it->second.y < row1 - 0.5) inside.push_back(it->second);
-        if (inside.empty()) continue;
-        std::sort(inside.begin(), inside.end(),
-                  [](const cv::Point2d& a, const cv::Point2d& b) { return a.y < b.y; });
-      }
-      const int h = missing + 1;  // knot spacing, rows
-      // A jump in depth across the gap is an occlusion, not a break: no bridge.
-      const double jump = (measured[i + 1].position - measured[i].position).norm();
-      if (jump > std::max(mesh_params.min_along_jump_mm, mesh_params.max_along_ratio * step * h))
-        continue;
-      std::vector<double> xs;
-      if (!inside.empty()) {
-        xs = AnchoredBridge(x_of_row, row0, row1, inside, params.max_anchor_offset_px);
-        if (xs.empty()) continue;
-      } else {
-        std::vector<double> knots;
-        int first_knot_row = row0;
-        if (const auto it = x_of_row.find(row0 - h); it != x_of_row.end()) {
-          knots.push_back(it->second);
-          first_knot_row = row0 - h;
-        }
-        knots.push_back(measured_x[i]);
-        knots.push_back(measured_x[i + 1]);
-        if (const auto it = x_of_row.find(row1 + h); it != x_of_row.end())
-          knots.push_back(it->second);
-        const std::optional<CubicBSpline> spline = CubicBSpline::Interpolate(knots);
-        if (!spline) continue;
-        for (int row = row0 + 1; row < row1; ++row)
-          xs.push_back((*spline)(double(row - first_knot_row) / h));
-      }
-      const double sigma = std::hypot(u.stripe_centre_sigma_px, params.bridge_sigma_px);
-      for (int row = row0 + 1; row < row1; ++row) {
-        const double x = xs[static_cast<size_t>(row - row0 - 1)];
-        const auto point = triangulator.LineSample(line.p, {x, double(row)}, sigma);
-        if (!point) continue;
-        vertices.push_back(
-            {row, point->position, float(point->sigma_mm), geometry::kVertexBridged});
-        ++r.bridged_samples;
-      }
-    }
-    TriangulatedLine& out = by_p[line.p];
-    out.p = line.p;
-    // A line listed twice by the decoder: its samples merge, first kept per row.
-    out.vertices.insert(out.vertices.end(), vertices.begin(), vertices.end());
-    std::stable_sort(out.vertices.begin(), out.vertices.end(),
-                     [](const LineVertex& a, const LineVertex& b) { return a.row < b.row; });
-    out.vertices.erase(std::unique(out.vertices.begin(), out.vertices.end(),
-                                   [](const auto& a, const auto& b) { return a.row == b.row; }),
-                       out.vertices.end());
+    const MeasuredLine measured = TriangulateCentres(line.p, centres, triangulator, r);
+    r.measured_samples += static_cast<int>(measured.vertices.size());
+    if (measured.vertices.empty()) continue;
+    MergeLine(line.p, BridgeGaps(line.p, measured, junctions_of, triangulator, params, r), by_p);
   }
   if (r.measured_samples == 0)
     throw ReconstructionError("reconstruction: none of the " + std::to_string(r.dropped_samples) +
@@ -281,36 +360,7 @@ geometry::SurfaceMesh Reconstruct(const decoder::DecodeResult& decode,
   MeshReport mesh_report;
   geometry::SurfaceMesh mesh =
       BuildSurfaceMesh(lines, triangulator.CameraCentre(), mesh_params, &mesh_report);
-
-  if (params.include_junctions) {
-    // Vertex of (p, row) for the junctions' normals.
-    std::map<std::pair<int, int>, int> vertex_of;
-    int index = 0;
-    for (const TriangulatedLine& line : lines)
-      for (const LineVertex& v : line.vertices) vertex_of[{line.p, v.row}] = index++;
-    for (const decoder::DecodedJunction& j : decode.junctions) {
-      const Eigen::Vector2d image(j.position.x, j.position.y);
-      if (!image.allFinite()) {
-        ++r.dropped_junctions;
-        continue;
-      }
-      const auto point = triangulator.Junction(j.p, j.q, image, decode.q_absolute);
-      if (!point) {
-        ++r.dropped_junctions;
-        continue;
-      }
-      mesh.positions.push_back(point->position);
-      mesh.uncertainty_mm.push_back(float(point->sigma_mm));
-      mesh.line.push_back(j.p);
-      mesh.flags.push_back(geometry::kVertexJunction);
-      const auto near = vertex_of.find({j.p, static_cast<int>(std::lround(image.y()))});
-      Eigen::Vector3d normal = (triangulator.CameraCentre() - point->position).normalized();
-      if (near != vertex_of.end()) normal = mesh.normals[near->second];
-      mesh.normals.push_back(normal);
-      ++r.junctions;
-      if (triangulator.HasProjector() && decode.q_absolute) ++r.junctions_by_projector;
-    }
-  }
+  if (params.include_junctions) AddJunctions(decode, triangulator, lines, mesh, r);
 
   r.vertices = static_cast<int>(mesh.VertexCount());
   r.triangles = mesh_report.triangles;

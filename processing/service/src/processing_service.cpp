@@ -277,6 +277,131 @@ void ConfineManifestImages(const std::string& yaml) {
   visit(root);
 }
 
+// OK when the first message of a Calibrate upload is a manifest within the
+// limits; else the status that refuses it.
+Status CheckManifestMessage(const v1::CalibrateRequest& first, std::size_t max_manifest_bytes) {
+  if (first.part_case() != v1::CalibrateRequest::kManifest)
+    return Status(StatusCode::INVALID_ARGUMENT,
+                  "Calibrate: the first message must be the manifest");
+  if (first.manifest().yaml().size() > max_manifest_bytes)
+    return Status(StatusCode::INVALID_ARGUMENT,
+                  "manifest.yaml: " + std::to_string(first.manifest().yaml().size()) +
+                      " bytes, at most " + std::to_string(max_manifest_bytes));
+  if (first.manifest().request_tag().size() > kMaxTagBytes)
+    return Status(StatusCode::INVALID_ARGUMENT, "manifest.request_tag: at most 256 bytes");
+  return Status::OK;
+}
+
+// The upload: every file in order, chunk by chunk, within the limits,
+// written under `folder`; refused (INVALID_ARGUMENT naming the file, INTERNAL
+// when the scratch folder fails) otherwise.
+void ReceiveUploadFiles(grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream,
+                        const fs::path& folder, const ProcessingServiceOptions& options,
+                        const session::WorkObserver& observer) {
+  std::map<fs::path, std::uint64_t> sizes;  // bytes received so far, by file
+  std::map<fs::path, bool> complete;
+  std::uint64_t total = 0;
+  std::optional<fs::path> open_path;
+  std::ofstream out;
+  v1::CalibrateRequest part;
+  while (stream->Read(&part)) {
+    observer.CheckCancelled("the upload's end");
+    if (part.part_case() != v1::CalibrateRequest::kFile)
+      Refuse(StatusCode::INVALID_ARGUMENT, "Calibrate: a second manifest in the upload");
+    const v1::FileChunk& chunk = part.file();
+    const fs::path path = UploadPath(chunk.path());
+    const std::string name = "file " + chunk.path();
+    if (chunk.data().size() > kMaxChunkBytes)
+      Refuse(StatusCode::INVALID_ARGUMENT, name + ": a chunk above 4 MiB");
+    if (complete.count(path)) Refuse(StatusCode::INVALID_ARGUMENT, name + ": sent twice");
+    if (open_path != path) {
+      if (open_path)
+        Refuse(StatusCode::INVALID_ARGUMENT,
+               name + ": begun before file " + open_path->string() + " was complete");
+      if (static_cast<int>(complete.size()) >= options.max_upload_files)
+        Refuse(StatusCode::INVALID_ARGUMENT,
+               name + ": more than " + std::to_string(options.max_upload_files) + " files");
+      // A path whose folder is an uploaded file, or a file named like an
+      // uploaded folder, cannot be made: the upload contradicts itself.
+      std::error_code ec;
+      fs::create_directories(folder / path.parent_path(), ec);
+      if (!ec) out.open(folder / path, std::ios::binary | std::ios::trunc);
+      if (ec || !out)
+        Refuse(StatusCode::INVALID_ARGUMENT,
+               name + ": clashes with another uploaded path (a file and a folder of one name)");
+      open_path = path;
+    }
+    if (chunk.offset() != sizes[path])
+      Refuse(StatusCode::INVALID_ARGUMENT, name + ": a chunk at offset " +
+                                               std::to_string(chunk.offset()) + " after " +
+                                               std::to_string(sizes[path]) + " bytes");
+    total += chunk.data().size();
+    if (total > options.max_upload_bytes)
+      Refuse(StatusCode::INVALID_ARGUMENT, "Calibrate: the upload exceeds " +
+                                               std::to_string(options.max_upload_bytes) + " bytes");
+    out.write(chunk.data().data(), static_cast<std::streamsize>(chunk.data().size()));
+    sizes[path] += chunk.data().size();
+    if (chunk.last()) {
+      out.close();
+      if (!out) Refuse(StatusCode::INTERNAL, name + ": cannot be written to the scratch folder");
+      complete[path] = true;
+      open_path.reset();
+    }
+  }
+  if (open_path)
+    Refuse(StatusCode::INVALID_ARGUMENT,
+           "file " + open_path->string() + ": the upload ended before its last chunk");
+}
+
+// `text` without any occurrence of `prefix` (the scratch folder's path):
+// paths in errors are the client's, not the scratch folder's.
+std::string WithoutPrefix(std::string text, const std::string& prefix) {
+  for (size_t at; (at = text.find(prefix)) != std::string::npos;) text.erase(at, prefix.size());
+  return text;
+}
+
+// The manifest uploaded into `folder` (its text `yaml`), read; refused
+// (INVALID_ARGUMENT) when it is malformed or names a file outside the upload.
+calibration::Manifest LoadUploadedManifest(const fs::path& folder, const std::string& yaml,
+                                           const std::string& prefix) {
+  // Image paths are checked before the manifest is read: reading it asks
+  // whether each image exists, which must not be asked of the server's disk.
+  ConfineManifestImages(yaml);
+  calibration::Manifest manifest;
+  try {
+    manifest = calibration::LoadManifest(folder / "manifest.yaml");
+  } catch (const calibration::ManifestError& e) {
+    Refuse(StatusCode::INVALID_ARGUMENT, WithoutPrefix(e.what(), prefix));
+  }
+  // The manifest may only name files of the upload.
+  const fs::path root = fs::weakly_canonical(folder);
+  for (const auto* views :
+       {&manifest.camera_views, &manifest.screen_views, &manifest.reference_views})
+    for (const calibration::ManifestView& view : *views) {
+      const fs::path image = fs::weakly_canonical(view.image);
+      const auto [end, _] = std::mismatch(root.begin(), root.end(), image.begin(), image.end());
+      if (end != root.end())
+        Refuse(StatusCode::INVALID_ARGUMENT,
+               "manifest: image " + WithoutPrefix(view.image.string(), prefix) +
+                   " is not one of the uploaded files (paths must stay inside the manifest's "
+                   "folder)");
+    }
+  return manifest;
+}
+
+// Image paths as the client named them (relative to the manifest), so an
+// upload gives the same file, and the same id, on every replica.
+void UseClientPaths(calibration::SideCalibration& result, const fs::path& folder,
+                    const std::string& prefix) {
+  for (auto& v : result.camera_views) v.image = fs::relative(v.image, folder);
+  for (auto& v : result.screen_views) v.image = fs::relative(v.image, folder);
+  for (auto& v : result.reference_views) v.image = fs::relative(v.image, folder);
+  for (auto& v : result.dropped_views) {
+    v.image = fs::relative(v.image, folder);
+    v.reason = WithoutPrefix(v.reason, prefix);
+  }
+}
+
 }  // namespace
 
 std::shared_ptr<const CachedCalibration> ProcessingService::ResolveCalibration(
@@ -578,15 +703,8 @@ Status ProcessingService::Calibrate(
   v1::CalibrateRequest first;
   if (!stream->Read(&first))
     return Status(StatusCode::INVALID_ARGUMENT, "Calibrate: the upload ended before the manifest");
-  if (first.part_case() != v1::CalibrateRequest::kManifest)
-    return Status(StatusCode::INVALID_ARGUMENT,
-                  "Calibrate: the first message must be the manifest");
-  if (first.manifest().yaml().size() > options_.max_manifest_bytes)
-    return Status(StatusCode::INVALID_ARGUMENT,
-                  "manifest.yaml: " + std::to_string(first.manifest().yaml().size()) +
-                      " bytes, at most " + std::to_string(options_.max_manifest_bytes));
-  if (first.manifest().request_tag().size() > kMaxTagBytes)
-    return Status(StatusCode::INVALID_ARGUMENT, "manifest.request_tag: at most 256 bytes");
+  if (Status refused = CheckManifestMessage(first, options_.max_manifest_bytes); !refused.ok())
+    return refused;
 
   // The upload is taken while the call holds a queue place, before a worker.
   std::optional<ScratchFolder> scratch;
@@ -598,93 +716,15 @@ Status ProcessingService::Calibrate(
       if (!manifest.flush())
         Refuse(StatusCode::INTERNAL, "cannot write the manifest to " + folder.path().string());
     }
-    // The upload: every file in order, chunk by chunk, within the limits.
     w.observer.Report("upload", 0.0);
-    std::map<fs::path, std::uint64_t> sizes;  // bytes received so far, by file
-    std::map<fs::path, bool> complete;
-    std::uint64_t total = 0;
-    std::optional<fs::path> open_path;
-    std::ofstream out;
-    v1::CalibrateRequest part;
-    while (stream->Read(&part)) {
-      w.observer.CheckCancelled("the upload's end");
-      if (part.part_case() != v1::CalibrateRequest::kFile)
-        Refuse(StatusCode::INVALID_ARGUMENT, "Calibrate: a second manifest in the upload");
-      const v1::FileChunk& chunk = part.file();
-      const fs::path path = UploadPath(chunk.path());
-      const std::string name = "file " + chunk.path();
-      if (chunk.data().size() > kMaxChunkBytes)
-        Refuse(StatusCode::INVALID_ARGUMENT, name + ": a chunk above 4 MiB");
-      if (complete.count(path)) Refuse(StatusCode::INVALID_ARGUMENT, name + ": sent twice");
-      if (open_path != path) {
-        if (open_path)
-          Refuse(StatusCode::INVALID_ARGUMENT,
-                 name + ": begun before file " + open_path->string() + " was complete");
-        if (static_cast<int>(complete.size()) >= options_.max_upload_files)
-          Refuse(StatusCode::INVALID_ARGUMENT,
-                 name + ": more than " + std::to_string(options_.max_upload_files) + " files");
-        // A path whose folder is an uploaded file, or a file named like an
-        // uploaded folder, cannot be made: the upload contradicts itself.
-        std::error_code ec;
-        fs::create_directories(folder.path() / path.parent_path(), ec);
-        if (!ec) out.open(folder.path() / path, std::ios::binary | std::ios::trunc);
-        if (ec || !out)
-          Refuse(StatusCode::INVALID_ARGUMENT,
-                 name + ": clashes with another uploaded path (a file and a folder of one name)");
-        open_path = path;
-      }
-      if (chunk.offset() != sizes[path])
-        Refuse(StatusCode::INVALID_ARGUMENT, name + ": a chunk at offset " +
-                                                 std::to_string(chunk.offset()) + " after " +
-                                                 std::to_string(sizes[path]) + " bytes");
-      total += chunk.data().size();
-      if (total > options_.max_upload_bytes)
-        Refuse(StatusCode::INVALID_ARGUMENT, "Calibrate: the upload exceeds " +
-                                                 std::to_string(options_.max_upload_bytes) +
-                                                 " bytes");
-      out.write(chunk.data().data(), static_cast<std::streamsize>(chunk.data().size()));
-      sizes[path] += chunk.data().size();
-      if (chunk.last()) {
-        out.close();
-        if (!out) Refuse(StatusCode::INTERNAL, name + ": cannot be written to the scratch folder");
-        complete[path] = true;
-        open_path.reset();
-      }
-    }
-    if (open_path)
-      Refuse(StatusCode::INVALID_ARGUMENT,
-             "file " + open_path->string() + ": the upload ended before its last chunk");
+    ReceiveUploadFiles(stream, folder.path(), options_, w.observer);
   };
   return RunWork(context, "Calibrate", emit, upload, [&](Work& w) {
     const ScratchFolder& folder = *scratch;
     // Paths in errors are the client's, not the scratch folder's.
     const std::string prefix = folder.path().string() + "/";
-    auto strip = [&prefix](std::string text) {
-      for (size_t at; (at = text.find(prefix)) != std::string::npos;) text.erase(at, prefix.size());
-      return text;
-    };
-    // Image paths are checked before the manifest is read: reading it asks
-    // whether each image exists, which must not be asked of the server's disk.
-    ConfineManifestImages(first.manifest().yaml());
-    calibration::Manifest manifest;
-    try {
-      manifest = calibration::LoadManifest(folder.path() / "manifest.yaml");
-    } catch (const calibration::ManifestError& e) {
-      Refuse(StatusCode::INVALID_ARGUMENT, strip(e.what()));
-    }
-    // The manifest may only name files of the upload.
-    const fs::path root = fs::weakly_canonical(folder.path());
-    for (const auto* views :
-         {&manifest.camera_views, &manifest.screen_views, &manifest.reference_views})
-      for (const calibration::ManifestView& view : *views) {
-        const fs::path image = fs::weakly_canonical(view.image);
-        const auto [end, _] = std::mismatch(root.begin(), root.end(), image.begin(), image.end());
-        if (end != root.end())
-          Refuse(StatusCode::INVALID_ARGUMENT,
-                 "manifest: image " + strip(view.image.string()) +
-                     " is not one of the uploaded files (paths must stay inside the manifest's "
-                     "folder)");
-      }
+    const calibration::Manifest manifest =
+        LoadUploadedManifest(folder.path(), first.manifest().yaml(), prefix);
     calibration::SideCalibration result;
     calibration::SideCalibrationParams params;
     params.images.max_pixels = options_.max_frame_pixels;  // images are frames: the same budget
@@ -699,17 +739,9 @@ Status ProcessingService::Calibrate(
           w.observer.cancellation());
     } catch (const calibration::CalibrationError& e) {
       if (e.reason() == calibration::CalibrationErrorReason::kCancelled) throw;
-      throw calibration::CalibrationError(e.reason(), strip(e.what()));
+      throw calibration::CalibrationError(e.reason(), WithoutPrefix(e.what(), prefix));
     }
-    // Image paths as the client named them (relative to the manifest), so an
-    // upload gives the same file, and the same id, on every replica.
-    for (auto& v : result.camera_views) v.image = fs::relative(v.image, folder.path());
-    for (auto& v : result.screen_views) v.image = fs::relative(v.image, folder.path());
-    for (auto& v : result.reference_views) v.image = fs::relative(v.image, folder.path());
-    for (auto& v : result.dropped_views) {
-      v.image = fs::relative(v.image, folder.path());
-      v.reason = strip(v.reason);
-    }
+    UseClientPaths(result, folder.path(), prefix);
     const std::string yaml = calibration::CalibrationToYaml(result, options_.software_version);
     const auto cached = calibrations_.Put(yaml, "the new calibration");
     nlohmann::json report = calibration::CalibrationReport(result);
