@@ -614,6 +614,141 @@ DecodeParams ScaledForBinning(const DecodeParams& params, int n) {
   return out;
 }
 
+// The skeleton chain's features at its working resolution.
+struct WorkingFeatures {
+  int n = 1;        // the frame binned n x n
+  cv::Rect region;  // the part of the frame binned: the pattern's columns
+  extraction::ExtractionResult features;
+};
+
+// The working resolution: the frame binned so that its stripe pitch is
+// near the one the pixel-sized parameters are tuned for, cropped to the
+// pattern's columns, and its features extracted. Sets result's pitch
+// (measured unless params.binning fixes the binning), binning, region and
+// extraction time.
+WorkingFeatures ExtractWorkingFeatures(const cv::Mat& grey, const DecodeParams& params,
+                                       const Cancellation& cancel, DecodeResult* result) {
+  const auto t = Clock::now();
+  if (params.binning == 0)
+    result->pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
+  cancel.ThrowIfRequested("the stripe pitch");
+  WorkingFeatures out;
+  out.n = internal::BinningFor(result->pitch, params.tuned_pitch, params);
+  result->binning = out.n;
+  // The columns beside the lit pattern hold nothing to find.
+  out.region =
+      internal::PatternColumns(grey, out.n, params.region_rise, params.region_margin * out.n);
+  result->region = out.region;
+  cv::Mat working = internal::BinFrame(grey(out.region), out.n);
+  if (!working.isContinuous()) working = working.clone();
+  cancel.ThrowIfRequested("the pattern's columns");
+  out.features = extraction::ExtractFeatures(working, params.extraction, cancel);
+  result->times.extraction_ms = MsSince(t);
+  return out;
+}
+
+// The interpretation of the working features, mapped to the full frame.
+// Where a second core is free, the sub-pixel centres of the skeleton's
+// runs are measured on it into *ahead meanwhile (centres_ahead.h); that
+// stops when the interpretation ends, however that ends. Sets result's
+// interpretation time and centres measured ahead.
+interpretation::InterpretationResult InterpretMeasuringAhead(
+    const cv::Mat& grey, pattern::Side side, const WorkingFeatures& working,
+    const DecodeParams& params, const DecodeParams& subpixel, const Cancellation& cancel,
+    internal::CentresAhead* ahead, DecodeResult* result) {
+  std::atomic<bool> stop_ahead{false};
+  std::future<void> measuring;
+  struct StopAndWait {
+    std::atomic<bool>& stop;
+    std::future<void>& done;
+    ~StopAndWait() {
+      stop = true;
+      if (done.valid()) done.wait();
+    }
+  } stop_and_wait{stop_ahead, measuring};
+  if (params.measure_ahead && working.n == 1 && cv::getNumThreads() > 1)
+    measuring = std::async(std::launch::async, [&] {
+      *ahead = internal::CentresAhead(working.features.skeleton, working.region.tl());
+      result->centres_measured_ahead = ahead->Measure(grey, subpixel.centre, stop_ahead);
+    });
+
+  const auto t = Clock::now();
+  interpretation::InterpretationResult interp =
+      interpretation::Interpret(working.features.skeleton, side, params.spec, params.interpretation,
+                                working.features.mask, cancel);
+  internal::MapToFullFrame(working.n, working.region.tl(), grey.size(), &interp);
+  stop_ahead = true;
+  if (measuring.valid()) measuring.get();
+  result->times.interpretation_ms = MsSince(t);
+  return interp;
+}
+
+// Every labelled line's sub-pixel centres, by p, with an empty entry for
+// each junction's p that has no line. Lines are measured independently of
+// each other: in parallel (cv::parallel_for_, OpenCV's thread pool).
+std::map<int, LineCentres> MeasureLines(const cv::Mat& grey,
+                                        const interpretation::InterpretationResult& interp,
+                                        const internal::CentresAhead& ahead,
+                                        const DecodeParams& subpixel, int n) {
+  const auto& lines = interp.labelling.lines;
+  std::vector<LinePixels> pixels(lines.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) pixels[i] = PrepareLine(lines[i]);
+  });
+  const CrowdedRows crowded = MeasureCrowdedRows(grey, lines, pixels, subpixel, n);
+  std::vector<LineCentres> measured(lines.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i)
+      measured[i] =
+          MeasureLine(grey, interp.skeleton, lines[i].p, pixels[i], crowded, ahead, subpixel, n);
+  });
+  std::map<int, LineCentres> centres;
+  for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);
+  for (const auto& j : interp.labelling.junctions) centres.try_emplace(j.p);  // read-only below
+  return centres;
+}
+
+// Junctions: where the line's centre meets its segment's centre, one
+// decoded junction per labelled one into result->junctions (q offset by
+// q_offset). A segment is seen from both its junctions over nearly the
+// same columns: the columns are gathered first and each is measured once;
+// junctions are placed in parallel.
+void PlaceJunctions(const cv::Mat& grey,
+                    const std::vector<interpretation::LabelledJunction>& junctions,
+                    const std::map<int, LineCentres>& centres, const internal::CentresAhead& ahead,
+                    const DecodeParams& subpixel, int n, int q_offset, DecodeResult* result) {
+  std::vector<JunctionPlan> plans(junctions.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i)
+      plans[i] = PlanJunction(centres.at(junctions[i].p), junctions[i], subpixel, n);
+  });
+  ColumnCentres columns;
+  for (const JunctionPlan& plan : plans)
+    for (const cv::Point& c : plan.columns) columns.keys.emplace_back(c.x, c.y);
+  std::sort(columns.keys.begin(), columns.keys.end());
+  columns.keys.erase(std::unique(columns.keys.begin(), columns.keys.end()), columns.keys.end());
+  columns.centres.resize(columns.keys.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const auto [x, y] = columns.keys[i];
+      columns.centres[i] = ahead.InColumn(grey, x, y, subpixel.centre);
+    }
+  });
+  result->junctions.resize(junctions.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const interpretation::LabelledJunction& j = junctions[i];
+      DecodedJunction& d = result->junctions[i];
+      d.p = j.p;
+      d.q = j.v + q_offset;
+      d.kind = j.kind;
+      d.interpolated = j.interpolated;
+      d.position = j.position;
+      if (auto refined = RefineJunction(plans[i], columns, j, subpixel, n)) d.position = *refined;
+    }
+  });
+}
+
 }  // namespace
 
 bool TrackChainParams::IsValid(std::string* error) const {
@@ -716,54 +851,13 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     return result;
   }
 
-  // The working resolution: the frame binned so that its stripe pitch is
-  // near the one the pixel-sized parameters are tuned for.
-  auto t = Clock::now();
-  if (params.binning == 0)
-    result.pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
-  cancel.ThrowIfRequested("the stripe pitch");
-  const int n = internal::BinningFor(result.pitch, params.tuned_pitch, params);
-  result.binning = n;
-  // The columns beside the lit pattern hold nothing to find.
-  const cv::Rect region =
-      internal::PatternColumns(grey, n, params.region_rise, params.region_margin * n);
-  result.region = region;
-  cv::Mat working = internal::BinFrame(grey(region), n);
-  if (!working.isContinuous()) working = working.clone();
-  cancel.ThrowIfRequested("the pattern's columns");
-  const extraction::ExtractionResult features =
-      extraction::ExtractFeatures(working, params.extraction, cancel);
-  result.times.extraction_ms = MsSince(t);
+  const WorkingFeatures working = ExtractWorkingFeatures(grey, params, cancel, &result);
   cancel.ThrowIfRequested("the feature extraction");
 
-  // Where a second core is free, the sub-pixel centres of the skeleton's
-  // runs are measured on it while this one interprets (centres_ahead.h).
-  // It stops when the interpretation ends, however that ends.
-  const DecodeParams subpixel = ScaledForBinning(params, n);
+  const DecodeParams subpixel = ScaledForBinning(params, working.n);
   internal::CentresAhead ahead;
-  std::atomic<bool> stop_ahead{false};
-  std::future<void> measuring;
-  struct StopAndWait {
-    std::atomic<bool>& stop;
-    std::future<void>& done;
-    ~StopAndWait() {
-      stop = true;
-      if (done.valid()) done.wait();
-    }
-  } stop_and_wait{stop_ahead, measuring};
-  if (params.measure_ahead && n == 1 && cv::getNumThreads() > 1)
-    measuring = std::async(std::launch::async, [&] {
-      ahead = internal::CentresAhead(features.skeleton, region.tl());
-      result.centres_measured_ahead = ahead.Measure(grey, subpixel.centre, stop_ahead);
-    });
-
-  t = Clock::now();
-  interpretation::InterpretationResult interp = interpretation::Interpret(
-      features.skeleton, side, params.spec, params.interpretation, features.mask, cancel);
-  internal::MapToFullFrame(n, region.tl(), grey.size(), &interp);
-  stop_ahead = true;
-  if (measuring.valid()) measuring.get();
-  result.times.interpretation_ms = MsSince(t);
+  const interpretation::InterpretationResult interp =
+      InterpretMeasuringAhead(grey, side, working, params, subpixel, cancel, &ahead, &result);
   result.skeleton = interp.skeleton;
   result.repairs = static_cast<int>(interp.repairs.size());
   result.loop_classes = interp.loop_classes;
@@ -775,61 +869,10 @@ DecodeResult Decode(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   }
   cancel.ThrowIfRequested("the interpretation");
 
-  t = Clock::now();
-  const int q_offset = params.q_offset.value_or(0);
-  // Lines, then junctions, are measured independently of each other: in
-  // parallel (cv::parallel_for_, OpenCV's thread pool).
-  const auto& lines = interp.labelling.lines;
-  std::vector<LinePixels> pixels(lines.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) pixels[i] = PrepareLine(lines[i]);
-  });
-  const CrowdedRows crowded = MeasureCrowdedRows(grey, lines, pixels, subpixel, n);
-  std::vector<LineCentres> measured(lines.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(lines.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i)
-      measured[i] =
-          MeasureLine(grey, interp.skeleton, lines[i].p, pixels[i], crowded, ahead, subpixel, n);
-  });
-  std::map<int, LineCentres> centres;
-  for (size_t i = 0; i < lines.size(); ++i) centres[lines[i].p] = std::move(measured[i]);
-  for (const auto& j : interp.labelling.junctions) centres.try_emplace(j.p);  // read-only below
-
-  // Junctions: where the line's centre meets its segment's centre. A segment
-  // is seen from both its junctions over nearly the same columns: the
-  // columns are gathered first and each is measured once.
-  const auto& junctions = interp.labelling.junctions;
-  std::vector<JunctionPlan> plans(junctions.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i)
-      plans[i] = PlanJunction(centres.at(junctions[i].p), junctions[i], subpixel, n);
-  });
-  ColumnCentres columns;
-  for (const JunctionPlan& plan : plans)
-    for (const cv::Point& c : plan.columns) columns.keys.emplace_back(c.x, c.y);
-  std::sort(columns.keys.begin(), columns.keys.end());
-  columns.keys.erase(std::unique(columns.keys.begin(), columns.keys.end()), columns.keys.end());
-  columns.centres.resize(columns.keys.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
-      const auto [x, y] = columns.keys[i];
-      columns.centres[i] = ahead.InColumn(grey, x, y, subpixel.centre);
-    }
-  });
-  result.junctions.resize(junctions.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
-      const interpretation::LabelledJunction& j = junctions[i];
-      DecodedJunction& d = result.junctions[i];
-      d.p = j.p;
-      d.q = j.v + q_offset;
-      d.kind = j.kind;
-      d.interpolated = j.interpolated;
-      d.position = j.position;
-      if (auto refined = RefineJunction(plans[i], columns, j, subpixel, n)) d.position = *refined;
-    }
-  });
-
+  const auto t = Clock::now();
+  std::map<int, LineCentres> centres = MeasureLines(grey, interp, ahead, subpixel, working.n);
+  PlaceJunctions(grey, interp.labelling.junctions, centres, ahead, subpixel, working.n,
+                 params.q_offset.value_or(0), &result);
   // Lines: their decoded points (MeasureLine).
   for (const interpretation::LabelledLine& line : interp.labelling.lines) {
     DecodedLine out;

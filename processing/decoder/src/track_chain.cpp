@@ -298,14 +298,23 @@ std::vector<cv::Point2d> RowsOfFullFrame(const std::vector<cv::Point2d>& working
   return out;
 }
 
-}  // namespace
+// The track chain's working frame and the ridge points found on it.
+struct WorkingRidges {
+  cv::Mat working;     // the frame resampled (WorkingFactor)
+  WorkingScale scale;  // its pixels to the full frame's
+  extraction::RidgePoints rows;
+  extraction::RidgePoints columns;
+};
 
-void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
-                    const Cancellation& cancel, DecodeResult* result) {
+// The working resolution: the frame resampled so that its stripes lie
+// about as far apart as the pixel sizes are tuned for, smoothed, and its
+// ridge points along rows and columns found, into *out. Sets result's
+// pitch, scale, binning, region and extraction time; false (with
+// result->error) where the frame shows no stripe pattern.
+bool FindWorkingRidges(const cv::Mat& grey, const DecodeParams& params, const Cancellation& cancel,
+                       DecodeResult* result, WorkingRidges* out) {
   const TrackChainParams& tp = params.track_chain;
-  auto t = Clock::now();
-  // The working resolution: the frame resampled so that its stripes lie
-  // about as far apart as the pixel sizes are tuned for.
+  const auto t = Clock::now();
   if (params.binning == 0) {
     result->pitch = extraction::MeasureStripePitch(grey, params.pitch).value_or(0.0);
     // Without a regular spacing of stripes there is no pattern to label
@@ -314,57 +323,40 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     if (result->pitch == 0.0) {
       result->error =
           "no stripe pattern: the frame's central rows show no regular spacing of stripes";
-      return;
+      return false;
     }
   }
   cancel.ThrowIfRequested("the stripe pitch");
   const double factor = WorkingFactor(result->pitch, params);
-  cv::Mat working;
-  const WorkingScale scale = ResampleFrame(grey, factor, &working);
+  out->scale = ResampleFrame(grey, factor, &out->working);
   result->scale = factor;
   result->binning = std::max(1, static_cast<int>(std::lround(factor)));
   result->region = cv::Rect(0, 0, grey.cols, grey.rows);
   cv::Mat smoothed;
-  cv::GaussianBlur(working, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
+  cv::GaussianBlur(out->working, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
                    cv::BORDER_REPLICATE);
   cancel.ThrowIfRequested("the smoothing");
-  extraction::RidgePoints rows = extraction::FindRidgePoints(smoothed, tp.ridge);
+  out->rows = extraction::FindRidgePoints(smoothed, tp.ridge);
   cancel.ThrowIfRequested("the ridges along rows");
-  extraction::RidgePoints columns = extraction::FindColumnRidgePoints(smoothed, tp.ridge);
+  out->columns = extraction::FindColumnRidgePoints(smoothed, tp.ridge);
   cancel.ThrowIfRequested("the ridges along columns");
   result->times.extraction_ms = MsSince(t);
+  return true;
+}
 
-  t = Clock::now();
-  const interpretation::TrackNetwork net = interpretation::BuildTrackNetwork(
-      std::move(rows), std::move(columns), side, tp.tracks, cancel);
-  const interpretation::TrackLabels labels =
-      interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
-  result->times.interpretation_ms = MsSince(t);
-  result->label_conflicts = labels.conflicts;
-  // The tracks' ridge points, as the skeleton chain's repaired skeleton.
-  result->skeleton = DrawTracks(net, scale, grey.size());
-  if (!labels.ok) {
-    result->error = labels.error;
-    return;
-  }
-  cancel.ThrowIfRequested("the labelling");
-
-  t = Clock::now();
-  // Centres of every labelled line track, in parallel.
+// The labelled line tracks (those with a p), in index order.
+std::vector<int> LabelledTracks(const interpretation::TrackLabels& labels) {
   std::vector<int> labelled;
-  for (size_t i = 0; i < net.lines.size(); ++i)
+  for (size_t i = 0; i < labels.line_p.size(); ++i)
     if (labels.line_p[i] >= 0) labelled.push_back(static_cast<int>(i));
-  std::vector<TrackCentres> centres(net.lines.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(labelled.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
-      centres[labelled[i]] = MeasureTrack(working, net, labelled[i], params);
-      KeepRowsOfItsLine(net, labels, labelled[i], &centres[labelled[i]]);
-    }
-  });
+  return labelled;
+}
 
-  // Junctions: one per label; where two claim one, the one on a track of
-  // its own p (then the first) keeps it.
-  const int q_offset = params.q_offset.value_or(0);
+// Junctions: one per label; where two claim one, the one on a track of
+// its own p (then the first) keeps it. Returns the keepers by label, and
+// adds the others to *conflicts.
+std::vector<int> JunctionPerLabel(const interpretation::TrackNetwork& net,
+                                  const interpretation::TrackLabels& labels, int* conflicts) {
   std::vector<std::tuple<int, int, int>> claims;  // (p, v, junction), in junction order
   for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
     if (labels.p[j] != interpretation::kUnlabelled)
@@ -380,41 +372,41 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
          ++k)
       if (!on_own_line(keeper) && on_own_line(std::get<2>(claims[k])))
         keeper = std::get<2>(claims[k]);
-    result->label_conflicts += static_cast<int>(k - i) - 1;
+    *conflicts += static_cast<int>(k - i) - 1;
     placed.push_back(keeper);
     i = k;
   }
-  result->junctions.resize(placed.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(placed.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
-      const int j = placed[i];
-      DecodedJunction& d = result->junctions[i];
-      d.p = labels.p[j];
-      d.q = labels.v[j] + q_offset;
-      d.kind = net.junctions[j].kind;
-      d.position =
-          scale.ToFull(PlaceJunction(working, net, j, centres[net.junctions[j].line], params));
-    }
-  });
+  return placed;
+}
 
-  // Junctions seen whose label could not be proven: reported at their ridge
-  // points, not placed.
+// Junctions seen whose label could not be proven: reported at their ridge
+// points (full frame), not placed, ordered by y.
+std::vector<UnlabelledJunction> UnlabelledJunctions(const interpretation::TrackNetwork& net,
+                                                    const interpretation::TrackLabels& labels,
+                                                    const WorkingScale& scale) {
+  std::vector<UnlabelledJunction> out;
   for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
     if (labels.p[j] == interpretation::kUnlabelled)
-      result->unlabelled.push_back(
-          {scale.ToFull(net.junctions[j].position), net.junctions[j].kind});
-  std::sort(result->unlabelled.begin(), result->unlabelled.end(),
-            [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
-              return a.position.y < b.position.y;
-            });
+      out.push_back({scale.ToFull(net.junctions[j].position), net.junctions[j].kind});
+  std::sort(out.begin(), out.end(), [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
+    return a.position.y < b.position.y;
+  });
+  return out;
+}
 
-  // Lines: the centres of all tracks of one p, one per row (the first
-  // labelled track's where two hold one row).
+// Lines: the centres of all tracks of one p, one per row of the working
+// frame (`rows` of them; the first labelled track's where two hold one
+// row), in the full frame.
+std::vector<DecodedLine> DecodedLines(const std::vector<int>& labelled,
+                                      const interpretation::TrackLabels& labels,
+                                      const std::vector<TrackCentres>& centres, int rows,
+                                      const WorkingScale& scale) {
+  std::vector<DecodedLine> lines;
   int max_p = -1;
   for (int i : labelled) max_p = std::max(max_p, labels.line_p[i]);
   std::vector<double> row_x;
   for (int p = 0; p <= max_p; ++p) {
-    row_x.assign(working.rows, NAN);
+    row_x.assign(rows, NAN);
     bool any = false;
     for (int i : labelled) {
       if (labels.line_p[i] != p) continue;
@@ -428,12 +420,68 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       }
     }
     if (!any) continue;
-    DecodedLine& line = result->lines.emplace_back(DecodedLine{p, {}});
-    for (int y = 0; y < working.rows; ++y)
+    DecodedLine& line = lines.emplace_back(DecodedLine{p, {}});
+    for (int y = 0; y < rows; ++y)
       if (!std::isnan(row_x[y])) line.points.emplace_back(row_x[y], y);
   }
   if (!scale.IsIdentity())
-    for (DecodedLine& line : result->lines) line.points = RowsOfFullFrame(line.points, scale);
+    for (DecodedLine& line : lines) line.points = RowsOfFullFrame(line.points, scale);
+  return lines;
+}
+
+}  // namespace
+
+void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
+                    const Cancellation& cancel, DecodeResult* result) {
+  const TrackChainParams& tp = params.track_chain;
+  WorkingRidges ridges;
+  if (!FindWorkingRidges(grey, params, cancel, result, &ridges)) return;
+  const cv::Mat& working = ridges.working;
+  const WorkingScale& scale = ridges.scale;
+
+  auto t = Clock::now();
+  const interpretation::TrackNetwork net = interpretation::BuildTrackNetwork(
+      std::move(ridges.rows), std::move(ridges.columns), side, tp.tracks, cancel);
+  const interpretation::TrackLabels labels =
+      interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
+  result->times.interpretation_ms = MsSince(t);
+  result->label_conflicts = labels.conflicts;
+  // The tracks' ridge points, as the skeleton chain's repaired skeleton.
+  result->skeleton = DrawTracks(net, scale, grey.size());
+  if (!labels.ok) {
+    result->error = labels.error;
+    return;
+  }
+  cancel.ThrowIfRequested("the labelling");
+
+  t = Clock::now();
+  // Centres of every labelled line track, in parallel.
+  const std::vector<int> labelled = LabelledTracks(labels);
+  std::vector<TrackCentres> centres(net.lines.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(labelled.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      centres[labelled[i]] = MeasureTrack(working, net, labelled[i], params);
+      KeepRowsOfItsLine(net, labels, labelled[i], &centres[labelled[i]]);
+    }
+  });
+
+  // Junctions, placed in parallel.
+  const int q_offset = params.q_offset.value_or(0);
+  const std::vector<int> placed = JunctionPerLabel(net, labels, &result->label_conflicts);
+  result->junctions.resize(placed.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(placed.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const int j = placed[i];
+      DecodedJunction& d = result->junctions[i];
+      d.p = labels.p[j];
+      d.q = labels.v[j] + q_offset;
+      d.kind = net.junctions[j].kind;
+      d.position =
+          scale.ToFull(PlaceJunction(working, net, j, centres[net.junctions[j].line], params));
+    }
+  });
+  result->unlabelled = UnlabelledJunctions(net, labels, scale);
+  result->lines = DecodedLines(labelled, labels, centres, working.rows, scale);
   result->times.subpixel_ms = MsSince(t);
   result->ok = true;
 }

@@ -414,91 +414,124 @@ std::optional<StripeMeasurement> MeasureProfile(std::span<const double> profile,
   return StripeMeasurement{x, width, contrast, sigma};
 }
 
-// Thesis 5.1.4.8 (lines that crowd or overlap in the image), measured
-// rather than skipped: the stripes near `approximate` (profile indices,
-// ascending) as one pixel-integrated Gaussian each (area, centre, sigma) on
-// a linear ground, fitted jointly by Levenberg-Marquardt, so that each
-// one's light does not pull the others' centres. A stripe's centre is kept
-// where its fitted height is at least min_contrast, its FWHM at most
-// max_width, it lies within search_radius + 0.5 of its approximate position
-// and more than 1 px from its neighbours in the fit.
-std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
-                                                     std::span<const double> approximate,
-                                                     const StripeCentreParams& params) {
-  const int n = static_cast<int>(v.size());
-  const int k = static_cast<int>(approximate.size());
-  const int m = 2 + 3 * k;
-  std::vector<std::optional<double>> out(static_cast<size_t>(k));
-  if (n < m + 2) return out;
-  const double mid = 0.5 * (n - 1);
-  const double ground = *std::min_element(v.begin(), v.end());
-  Eigen::VectorXd theta(m);  // b0, b1, then (area, centre, sigma) per stripe
-  theta[0] = ground;
-  theta[1] = 0.0;
-  const double sigma0 = params.min_sigma;
-  const double area_per_height = std::sqrt(2.0 * std::numbers::pi) * sigma0;
-  for (int j = 0; j < k; ++j) {
-    const int at =
-        std::clamp(static_cast<int>(std::lround(approximate[static_cast<size_t>(j)])), 0, n - 1);
-    theta[2 + 3 * j] = std::max(1.0, v[static_cast<size_t>(at)] - ground) * area_per_height;
-    theta[3 + 3 * j] = approximate[static_cast<size_t>(j)];
-    theta[4 + 3 * j] = sigma0;
+// The model FitCrowdedProfile fits to a profile v of n samples: a linear
+// ground theta[0] + theta[1] (i - mid) and, per stripe j of k, a
+// pixel-integrated Gaussian of area, centre and sigma theta[2 + 3 j],
+// theta[3 + 3 j], theta[4 + 3 j] (profile indices).
+class CrowdedModel {
+ public:
+  CrowdedModel(std::span<const double> v, int k, const StripeCentreParams& params)
+      : v_(v),
+        n_(static_cast<int>(v.size())),
+        k_(k),
+        m_(2 + 3 * k),
+        mid_(0.5 * (n_ - 1)),
+        ground_(*std::min_element(v.begin(), v.end())),
+        highest_(*std::max_element(v.begin(), v.end())),
+        max_sigma_(params.max_width / 2.3548),
+        cdf_(static_cast<size_t>(n_ + 1)),
+        pdf_(cdf_.size()),
+        u_(cdf_.size()) {}
+
+  int Parameters() const { return m_; }
+  int Stripes() const { return k_; }
+
+  // The starting point: a flat ground at the profile's lowest value, each
+  // stripe min_sigma wide at its approximate position, as high as the
+  // profile there stands above the ground (at least 1).
+  Eigen::VectorXd Start(std::span<const double> approximate,
+                        const StripeCentreParams& params) const {
+    Eigen::VectorXd theta(m_);  // b0, b1, then (area, centre, sigma) per stripe
+    theta[0] = ground_;
+    theta[1] = 0.0;
+    const double sigma0 = params.min_sigma;
+    const double area_per_height = std::sqrt(2.0 * std::numbers::pi) * sigma0;
+    for (int j = 0; j < k_; ++j) {
+      const int at =
+          std::clamp(static_cast<int>(std::lround(approximate[static_cast<size_t>(j)])), 0, n_ - 1);
+      theta[2 + 3 * j] = std::max(1.0, v_[static_cast<size_t>(at)] - ground_) * area_per_height;
+      theta[3 + 3 * j] = approximate[static_cast<size_t>(j)];
+      theta[4 + 3 * j] = sigma0;
+    }
+    return theta;
   }
-  constexpr double kInvSqrt2Pi = 0.3989422804014327;
-  // Per stripe, the normal CDF and density at the n + 1 pixel edges
-  // (edge e between samples e - 1 and e), each shared by two samples.
-  std::vector<double> cdf(static_cast<size_t>(n + 1)), pdf(cdf.size()), u(cdf.size());
-  auto residuals = [&](const Eigen::VectorXd& t, Eigen::VectorXd* r, Eigen::MatrixXd* jac) {
+
+  // The residuals (model minus profile) at t into r, and their Jacobian
+  // into jac unless it is null.
+  void Residuals(const Eigen::VectorXd& t, Eigen::VectorXd* r, Eigen::MatrixXd* jac) {
+    constexpr double kInvSqrt2Pi = 0.3989422804014327;
+    const int n = n_, m = m_;
     r->resize(n);
     if (jac) jac->resize(n, m);
-    for (int i = 0; i < n; ++i) (*r)[i] = t[0] + t[1] * (i - mid) - v[static_cast<size_t>(i)];
+    for (int i = 0; i < n; ++i) (*r)[i] = t[0] + t[1] * (i - mid_) - v_[static_cast<size_t>(i)];
     if (jac) {
       for (int i = 0; i < n; ++i) {
         (*jac)(i, 0) = 1.0;
-        (*jac)(i, 1) = i - mid;
+        (*jac)(i, 1) = i - mid_;
       }
     }
-    for (int j = 0; j < k; ++j) {
+    // Per stripe, the normal CDF and density at the n + 1 pixel edges
+    // (edge e between samples e - 1 and e), each shared by two samples.
+    for (int j = 0; j < k_; ++j) {
       const double area = t[2 + 3 * j], c = t[3 + 3 * j], sg = t[4 + 3 * j];
       for (int e = 0; e <= n; ++e) {
         const size_t ei = static_cast<size_t>(e);
-        u[ei] = (e - 0.5 - c) / sg;
-        cdf[ei] = NormalCdf(u[ei]);
-        if (jac) pdf[ei] = kInvSqrt2Pi * std::exp(-0.5 * u[ei] * u[ei]);
+        u_[ei] = (e - 0.5 - c) / sg;
+        cdf_[ei] = NormalCdf(u_[ei]);
+        if (jac) pdf_[ei] = kInvSqrt2Pi * std::exp(-0.5 * u_[ei] * u_[ei]);
       }
       for (int i = 0; i < n; ++i) {
         const size_t lo = static_cast<size_t>(i), hi = lo + 1;
-        const double g = cdf[hi] - cdf[lo];
+        const double g = cdf_[hi] - cdf_[lo];
         (*r)[i] += area * g;
         if (jac) {
           (*jac)(i, 2 + 3 * j) = g;
-          (*jac)(i, 3 + 3 * j) = -area * (pdf[hi] - pdf[lo]) / sg;
-          (*jac)(i, 4 + 3 * j) = -area * (u[hi] * pdf[hi] - u[lo] * pdf[lo]) / sg;
+          (*jac)(i, 3 + 3 * j) = -area * (pdf_[hi] - pdf_[lo]) / sg;
+          (*jac)(i, 4 + 3 * j) = -area * (u_[hi] * pdf_[hi] - u_[lo] * pdf_[lo]) / sg;
         }
       }
     }
-  };
-  // The search stays where an answer could be accepted (below): stripes no
-  // wider than max_width, none narrower than a quarter pixel, centres on
-  // the profile, the ground within the profile's range at both ends (a
-  // ground sinking below it while a wide stripe makes up the difference
-  // is a plateau, not stripes).
-  const double highest = *std::max_element(v.begin(), v.end());
-  const double max_sigma = params.max_width / 2.3548;
-  auto feasible = [&](const Eigen::VectorXd& t) {
-    for (const double end : {t[0] - t[1] * mid, t[0] + t[1] * mid})
-      if (!(end >= ground - (highest - ground) && end <= highest)) return false;
-    for (int j = 0; j < k; ++j) {
+  }
+
+  // The search stays where an answer could be accepted (AcceptedCentres):
+  // stripes no wider than max_width, none narrower than a quarter pixel,
+  // centres on the profile, the ground within the profile's range at both
+  // ends (a ground sinking below it while a wide stripe makes up the
+  // difference is a plateau, not stripes).
+  bool Feasible(const Eigen::VectorXd& t) const {
+    for (const double end : {t[0] - t[1] * mid_, t[0] + t[1] * mid_})
+      if (!(end >= ground_ - (highest_ - ground_) && end <= highest_)) return false;
+    for (int j = 0; j < k_; ++j) {
       const double c = t[3 + 3 * j], sg = t[4 + 3 * j];
-      if (!(t[2 + 3 * j] > 0.0 && sg > 0.25 && sg <= max_sigma && c > -0.5 && c < n - 0.5))
+      if (!(t[2 + 3 * j] > 0.0 && sg > 0.25 && sg <= max_sigma_ && c > -0.5 && c < n_ - 0.5))
         return false;
     }
     return true;
-  };
+  }
+
+ private:
+  std::span<const double> v_;
+  int n_;
+  int k_;
+  int m_;
+  double mid_;
+  double ground_;   // the profile's lowest value
+  double highest_;  // and its highest
+  double max_sigma_;
+  std::vector<double> cdf_, pdf_, u_;  // scratch of Residuals, per pixel edge
+};
+
+// Levenberg-Marquardt from *theta within the feasible region; true when it
+// converged (a step that moves no centre or sigma by a thousandth of a
+// pixel or barely lowers the cost, or no step that lowers it), with
+// *theta and *cost (the squared residual norm) where it ended.
+bool FitByLevenbergMarquardt(CrowdedModel& model, Eigen::VectorXd* theta_out, double* cost_out) {
+  Eigen::VectorXd& theta = *theta_out;
+  const int m = model.Parameters(), k = model.Stripes();
   Eigen::VectorXd r, r_new;
   Eigen::MatrixXd jac;
 
-  residuals(theta, &r, &jac);
+  model.Residuals(theta, &r, &jac);
   double cost = r.squaredNorm();
   double lambda = 1e-3;
   bool converged = false;
@@ -511,8 +544,8 @@ std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
       for (int d = 0; d < m; ++d) damped(d, d) += lambda * std::max(h(d, d), 1e-9);
       const Eigen::VectorXd delta = damped.ldlt().solve(-g);
       const Eigen::VectorXd candidate = theta + delta;
-      if (delta.allFinite() && feasible(candidate)) {
-        residuals(candidate, &r_new, nullptr);
+      if (delta.allFinite() && model.Feasible(candidate)) {
+        model.Residuals(candidate, &r_new, nullptr);
         const double cost_new = r_new.squaredNorm();
         if (cost_new <= cost) {
           double largest_shift = 0.0;
@@ -534,15 +567,24 @@ std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
       converged = true;  // no step lowers the cost: at the minimum (to rounding)
       break;
     }
-    residuals(theta, &r, &jac);
+    model.Residuals(theta, &r, &jac);
   }
-  if (!converged) return out;
-  // The fit as a whole: stripes of one projector seen side by side have
-  // like widths, none narrower than 0.4 min_sigma, and the model must
-  // explain the profile (residual RMS at most 7 % of the lowest stripe;
-  // noise sigma 3 leaves about 2 % of a 60 grey-level stripe). A fit that
-  // fails these has taken in something else: a segment, a shadow edge, or
-  // a stripe hidden behind another.
+  *cost_out = cost;
+  return converged;
+}
+
+// The centres of a converged fit (theta, cost over n samples) that are
+// kept. The fit as a whole: stripes of one projector seen side by side have
+// like widths, none narrower than 0.4 min_sigma, and the model must
+// explain the profile (residual RMS at most 7 % of the lowest stripe;
+// noise sigma 3 leaves about 2 % of a 60 grey-level stripe). A fit that
+// fails these has taken in something else: a segment, a shadow edge, or
+// a stripe hidden behind another.
+std::vector<std::optional<double>> AcceptedCentres(const Eigen::VectorXd& theta, double cost, int n,
+                                                   std::span<const double> approximate,
+                                                   const StripeCentreParams& params) {
+  const int k = static_cast<int>(approximate.size());
+  std::vector<std::optional<double>> out(static_cast<size_t>(k));
   std::vector<double> height(static_cast<size_t>(k));  // of each fitted stripe
   double narrowest = std::numeric_limits<double>::infinity(), widest = 0.0;
   for (int j = 0; j < k; ++j) {
@@ -566,6 +608,29 @@ std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
     out[static_cast<size_t>(j)] = c;
   }
   return out;
+}
+
+// Thesis 5.1.4.8 (lines that crowd or overlap in the image), measured
+// rather than skipped: the stripes near `approximate` (profile indices,
+// ascending) as one pixel-integrated Gaussian each (area, centre, sigma) on
+// a linear ground, fitted jointly by Levenberg-Marquardt, so that each
+// one's light does not pull the others' centres. A stripe's centre is kept
+// where its fitted height is at least min_contrast, its FWHM at most
+// max_width, it lies within search_radius + 0.5 of its approximate position
+// and more than 1 px from its neighbours in the fit.
+std::vector<std::optional<double>> FitCrowdedProfile(std::span<const double> v,
+                                                     std::span<const double> approximate,
+                                                     const StripeCentreParams& params) {
+  const int n = static_cast<int>(v.size());
+  const int k = static_cast<int>(approximate.size());
+  const int m = 2 + 3 * k;
+  if (n < m + 2) return std::vector<std::optional<double>>(static_cast<size_t>(k));
+  CrowdedModel model(v, k, params);
+  Eigen::VectorXd theta = model.Start(approximate, params);
+  double cost = 0.0;
+  if (!FitByLevenbergMarquardt(model, &theta, &cost))
+    return std::vector<std::optional<double>>(static_cast<size_t>(k));
+  return AcceptedCentres(theta, cost, n, approximate, params);
 }
 
 template <typename Pixel>

@@ -284,6 +284,131 @@ void JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::ve
   }
 }
 
+// One untrusted link between two components as they stand: the shift from
+// y's frame to x's (x < y), worth w half votes.
+struct Evidence {
+  int x, y;
+  Label h;
+  int w;  // half votes
+};
+
+// The evidence of the untrusted links between components, sorted by (x, y,
+// h), into `evidence` (reused from round to round).
+template <typename LabelOf>
+void GatherEvidence(const std::vector<ConsensusLink>& links, const std::vector<char>& trusted,
+                    LabelOf label_of, std::vector<Evidence>* evidence) {
+  evidence->clear();
+  for (size_t k = 0; k < links.size(); ++k) {
+    if (trusted[k]) continue;
+    // In half votes: a step across a break in a line (its rows counted
+    // over the gap, where an occluding edge may shift them) is half a vote.
+    const int w = links[k].gap ? 1 : 2;
+    const ConsensusLink& l = links[k];
+    auto [ca, la] = label_of(l.a);
+    auto [cb, lb] = label_of(l.b);
+    if (ca == cb) continue;
+    // b's label in a's frame is la + d: the shift from b's frame to a's.
+    Label h = la + Label{l.dp, l.dv} - lb;
+    if (ca > cb) {
+      std::swap(ca, cb);
+      h = Label{} - h;
+    }
+    evidence->push_back({ca, cb, h, w});
+  }
+  std::sort(evidence->begin(), evidence->end(), [](const Evidence& a, const Evidence& b) {
+    return std::tie(a.x, a.y, a.h) < std::tie(b.x, b.y, b.h);
+  });
+}
+
+// A join two components' evidence agrees on.
+struct Candidate {
+  int support, x, y;
+  Label h;
+};
+
+// Per pair of components in the sorted `evidence`, the shift most of it
+// gives, where that has min_support votes and little dissent; the best
+// supported first.
+std::vector<Candidate> AgreedJoins(const std::vector<Evidence>& evidence,
+                                   const ConsensusParams& params) {
+  std::vector<Candidate> candidates;
+  for (size_t i = 0; i < evidence.size();) {
+    size_t end = i;
+    int best = 0, total = 0;
+    Label best_h{};
+    while (end < evidence.size() && evidence[end].x == evidence[i].x &&
+           evidence[end].y == evidence[i].y) {
+      size_t run = end;
+      int count = 0;
+      while (run < evidence.size() && evidence[run].x == evidence[end].x &&
+             evidence[run].y == evidence[end].y && evidence[run].h == evidence[end].h)
+        count += evidence[run++].w;
+      total += count;
+      // A shift that changes the parity of p + v is impossible: dissent.
+      if (!OddSum(evidence[end].h) && count > best) {
+        best = count;
+        best_h = evidence[end].h;
+      }
+      end = run;
+    }
+    const int dissent = total - best;
+    if (best >= 2 * params.min_support && dissent <= params.max_dissent * best)
+      candidates.push_back({best, evidence[i].x, evidence[i].y, best_h});
+    i = end;
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [&](const Candidate& a, const Candidate& b) { return a.support > b.support; });
+  return candidates;
+}
+
+// Rounds of joining: the evidence between the components as they stand,
+// the best supported joins first; again while any join was made.
+template <typename LabelOf>
+void JoinAgreeingComponents(const std::vector<ConsensusLink>& links,
+                            const std::vector<char>& trusted, const ConsensusParams& params,
+                            LabelOf label_of, Components* comps) {
+  std::vector<Evidence> evidence;
+  for (bool joined = true; joined;) {
+    joined = false;
+    GatherEvidence(links, trusted, label_of, &evidence);
+    for (const Candidate& c : AgreedJoins(evidence, params)) {
+      if (comps->Find(c.x).first == comps->Find(c.y).first) continue;
+      comps->Join(c.x, c.y, c.h);
+      joined = true;
+    }
+  }
+}
+
+// What line 0's seeds say of the components: the (component, p shift) most
+// of them give, and how many give another shift in that component.
+struct LineZeroVote {
+  std::map<std::pair<int, int>, int> votes;  // (component, p shift) -> seeds
+  int component = -1;                        // -1: no seeds
+  int shift = 0;
+  int seeds = 0;
+  int dissent = 0;
+};
+
+// Line 0: each seed says its component's p is shifted by minus its p there.
+template <typename LabelOf>
+LineZeroVote VoteLineZero(const std::vector<int>& seeds, LabelOf label_of) {
+  LineZeroVote out;
+  for (int s : seeds) {
+    const auto [c, l] = label_of(s);
+    ++out.votes[{c, -l.p}];
+  }
+  std::map<int, int> seeds_of;  // component -> seeds
+  for (const auto& [key, count] : out.votes) seeds_of[key.first] += count;
+  for (const auto& [key, count] : out.votes)
+    if (count > out.seeds) {
+      out.seeds = count;
+      out.component = key.first;
+      out.shift = key.second;
+    }
+  if (out.component >= 0) out.dissent = seeds_of[out.component] - out.seeds;
+  return out;
+}
+
 }  // namespace
 
 Consensus LabelByConsensus(const std::vector<char>& odd_kind,
@@ -305,102 +430,21 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
     const auto [c, shift] = comps.Find(patches.of[j]);
     return std::make_pair(c, patches.rel[j] + shift);
   };
+  JoinAgreeingComponents(links, trusted, params, label_of, &comps);
 
-  // Rounds of joining: the evidence between the components as they stand,
-  // the best supported joins first; again while any join was made.
-  struct Evidence {
-    int x, y;
-    Label h;
-    int w;  // half votes
-  };
-  std::vector<Evidence> evidence;
-  for (bool joined = true; joined;) {
-    joined = false;
-    evidence.clear();
-    for (size_t k = 0; k < links.size(); ++k) {
-      if (trusted[k]) continue;
-      // In half votes: a step across a break in a line (its rows counted
-      // over the gap, where an occluding edge may shift them) is half a vote.
-      const int w = links[k].gap ? 1 : 2;
-      const ConsensusLink& l = links[k];
-      auto [ca, la] = label_of(l.a);
-      auto [cb, lb] = label_of(l.b);
-      if (ca == cb) continue;
-      // b's label in a's frame is la + d: the shift from b's frame to a's.
-      Label h = la + Label{l.dp, l.dv} - lb;
-      if (ca > cb) {
-        std::swap(ca, cb);
-        h = Label{} - h;
-      }
-      evidence.push_back({ca, cb, h, w});
-    }
-    std::sort(evidence.begin(), evidence.end(), [](const Evidence& a, const Evidence& b) {
-      return std::tie(a.x, a.y, a.h) < std::tie(b.x, b.y, b.h);
-    });
-    struct Candidate {
-      int support, x, y;
-      Label h;
-    };
-    std::vector<Candidate> candidates;
-    for (size_t i = 0; i < evidence.size();) {
-      size_t end = i;
-      int best = 0, total = 0;
-      Label best_h{};
-      while (end < evidence.size() && evidence[end].x == evidence[i].x &&
-             evidence[end].y == evidence[i].y) {
-        size_t run = end;
-        int count = 0;
-        while (run < evidence.size() && evidence[run].x == evidence[end].x &&
-               evidence[run].y == evidence[end].y && evidence[run].h == evidence[end].h)
-          count += evidence[run++].w;
-        total += count;
-        // A shift that changes the parity of p + v is impossible: dissent.
-        if (!OddSum(evidence[end].h) && count > best) {
-          best = count;
-          best_h = evidence[end].h;
-        }
-        end = run;
-      }
-      const int dissent = total - best;
-      if (best >= 2 * params.min_support && dissent <= params.max_dissent * best)
-        candidates.push_back({best, evidence[i].x, evidence[i].y, best_h});
-      i = end;
-    }
-    std::sort(candidates.begin(), candidates.end(),
-              [&](const Candidate& a, const Candidate& b) { return a.support > b.support; });
-    for (const Candidate& c : candidates) {
-      if (comps.Find(c.x).first == comps.Find(c.y).first) continue;
-      comps.Join(c.x, c.y, c.h);
-      joined = true;
-    }
-  }
-
-  // Line 0: each seed says its component's p is shifted by minus its p there.
-  std::map<std::pair<int, int>, int> votes;  // (component, p shift) -> seeds
-  for (int s : seeds) {
-    const auto [c, l] = label_of(s);
-    ++votes[{c, -l.p}];
-  }
-  std::map<int, int> seeds_of;  // component -> seeds
-  for (const auto& [key, count] : votes) seeds_of[key.first] += count;
-  int best_c = -1, best_shift = 0, best_votes = 0;
-  for (const auto& [key, count] : votes)
-    if (count > best_votes) {
-      best_votes = count;
-      best_c = key.first;
-      best_shift = key.second;
-    }
   // The seeds of the chosen component must agree: those that do not are
   // stray junctions beside line 0, and may not outnumber a third of them.
-  if (best_c < 0 || best_votes < min_seeds ||
-      seeds_of[best_c] - best_votes > params.max_dissent * best_votes)
+  const LineZeroVote zero = VoteLineZero(seeds, label_of);
+  if (zero.component < 0 || zero.seeds < min_seeds ||
+      zero.dissent > params.max_dissent * zero.seeds)
     return out;
-  const Label shift{best_shift, (best_shift % 2 + 2) % 2};  // keeps p + v's parity
-  JoinSeededComponents(links, trusted, votes, best_c, best_shift, min_seeds, params, label_of,
-                       &comps);
+  const Label shift{zero.shift, (zero.shift % 2 + 2) % 2};  // keeps p + v's parity
+  JoinSeededComponents(links, trusted, zero.votes, zero.component, zero.shift, min_seeds, params,
+                       label_of, &comps);
   // Labels in the frame of line 0's component as it now stands: its root
-  // may have moved with a join, so they are taken back to best_c's frame.
-  const auto [main_root, main_shift] = comps.Find(best_c);
+  // may have moved with a join, so they are taken back to the frame of the
+  // component the seeds chose.
+  const auto [main_root, main_shift] = comps.Find(zero.component);
   std::vector<char> labelled(n, 0);
   std::vector<Label> label(n);
   for (int j = 0; j < n; ++j) {

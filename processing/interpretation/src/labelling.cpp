@@ -177,73 +177,85 @@ std::vector<cv::Point> WalkPixels(const JunctionNetwork& net, int from, bool dow
   return out;
 }
 
-}  // namespace
-
-bool LabellingParams::IsValid(std::string* error) const {
-  auto fail = [error](const char* why) {
-    if (error) *error = why;
-    return false;
-  };
-  if (max_interpolated_run < 0 || max_interpolated_run > 10)
-    return fail("max_interpolated_run must lie in 0..10");
-  if (max_inner_fraction < 0 || max_inner_fraction > 1)
-    return fail("max_inner_fraction must lie in [0, 1]");
-  if (min_reference_junctions < 1) return fail("min_reference_junctions must be at least 1");
-  if (spacing_radius <= 0) return fail("spacing_radius must be positive");
-  return true;
-}
-
-// Thesis 5.1.4.9: labelling.
-bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loops,
-                  const ReferenceLine& reference, const pattern::PatternSpec& spec,
-                  const LabellingParams& params, Labelling* out, std::string* why) {
-  std::string invalid;
-  if (!params.IsValid(&invalid)) throw std::invalid_argument("LabelNetwork: " + invalid);
-  const SkeletonGraph& g = net.graph();
-  const int n_nodes = static_cast<int>(g.nodes().size());
-  *out = Labelling{};
-
-  // Links inside complete loops are trusted (thesis: a complete loop has its
-  // six junctions in the right order).
+// Half-edges inside complete loops, both ways: their links are trusted
+// (thesis: a complete loop has its six junctions in the right order).
+std::vector<char> TrustedHalfEdges(const SkeletonGraph& g, const std::vector<LoopRecord>& loops) {
   std::vector<char> trusted(g.HalfEdgeCount(), 0);
   for (const LoopRecord& loop : loops)
     if (loop.cls == LoopClass::kComplete)
       for (int h : loop.walk) trusted[h] = trusted[SkeletonGraph::Twin(h)] = 1;
+  return trusted;
+}
 
-  // Lines: consecutive pattern junctions along each line.
+// Lines: the links between consecutive pattern junctions along each line.
+std::vector<VerticalLink> LinesDown(const JunctionNetwork& net, const std::vector<char>& trusted) {
   std::vector<VerticalLink> vlinks;
-  for (int n = 0; n < n_nodes; ++n) {
+  for (int n = 0; n < static_cast<int>(net.graph().nodes().size()); ++n) {
     if (!net.IsPatternJunction(n)) continue;
     VerticalLink link;
     if (WalkDown(net, trusted, n, &link)) vlinks.push_back(link);
   }
-  // Row spacing samples: alternating steps are one row, equal kinds two.
-  std::vector<double> all_spacing;
-  std::vector<std::pair<cv::Point2d, double>> spacing_samples;
-  for (const VerticalLink& l : vlinks) {
-    const double s = l.alternating ? l.dy : l.dy / 2.0;
-    spacing_samples.push_back({l.mid, s});
-    all_spacing.push_back(s);
+  return vlinks;
+}
+
+// The row spacing near a point: the median of the line links' spacing
+// samples within `radius` (alternating steps are one row, equal kinds two),
+// the frame's median where fewer than three lie there. Holds a grid over
+// its own samples: neither copied nor moved.
+class LocalSpacing {
+ public:
+  LocalSpacing(const std::vector<VerticalLink>& vlinks, double radius)
+      : samples_(SamplesOf(vlinks)),
+        global_(GlobalMedian(samples_)),
+        grid_(samples_, radius),
+        radius_(radius) {}
+  LocalSpacing(const LocalSpacing&) = delete;
+  LocalSpacing& operator=(const LocalSpacing&) = delete;
+
+  double At(cv::Point2d at) const {
+    near_.clear();
+    const double r2 = radius_ * radius_;
+    grid_.ForEachNear(at, [&](const std::pair<cv::Point2d, double>& sample) {
+      const cv::Point2d d = sample.first - at;
+      if (d.x * d.x + d.y * d.y <= r2) near_.push_back(sample.second);
+    });
+    return near_.size() >= 3 ? Median(near_) : global_;
   }
-  const double global_spacing = Median(all_spacing);
+
+ private:
+  static std::vector<SampleGrid::Sample> SamplesOf(const std::vector<VerticalLink>& vlinks) {
+    std::vector<SampleGrid::Sample> samples;
+    for (const VerticalLink& l : vlinks)
+      samples.push_back({l.mid, l.alternating ? l.dy : l.dy / 2.0});
+    return samples;
+  }
+  static double GlobalMedian(const std::vector<SampleGrid::Sample>& samples) {
+    std::vector<double> all_spacing;
+    for (const SampleGrid::Sample& s : samples) all_spacing.push_back(s.second);
+    return Median(all_spacing);
+  }
+
+  const std::vector<SampleGrid::Sample> samples_;
+  const double global_;
   // The samples by cell of a grid spacing_radius wide, so that a query reads
   // the 3 x 3 cells around its own only: the same samples as a scan of all
   // (in another order, which the median does not see).
-  const SampleGrid grid(spacing_samples, params.spacing_radius);
-  std::vector<double> near;
-  auto local_spacing = [&](cv::Point2d at) {
-    near.clear();
-    const double r2 = params.spacing_radius * params.spacing_radius;
-    grid.ForEachNear(at, [&](const std::pair<cv::Point2d, double>& sample) {
-      const cv::Point2d d = sample.first - at;
-      if (d.x * d.x + d.y * d.y <= r2) near.push_back(sample.second);
-    });
-    return near.size() >= 3 ? Median(near) : global_spacing;
-  };
+  const SampleGrid grid_;
+  const double radius_;
+  mutable std::vector<double> near_;  // scratch of At
+};
 
+// The links between junctions, both ways: each line link that spans a whole
+// number of rows (weighted by its trust and its length in rows), and each
+// direct junction's segment to the next line's corresponding junction.
+std::vector<std::vector<Link>> LinkJunctions(const JunctionNetwork& net,
+                                             const std::vector<VerticalLink>& vlinks,
+                                             const std::vector<char>& trusted,
+                                             const LocalSpacing& spacing) {
+  const int n_nodes = static_cast<int>(net.graph().nodes().size());
   std::vector<std::vector<Link>> adj(n_nodes);
   for (const VerticalLink& l : vlinks) {
-    const double s = local_spacing(l.mid);
+    const double s = spacing.At(l.mid);
     const internal::RowCount step = internal::NearestRowCount(l.dy, s, l.alternating, 8);
     const int best_rows = step.rows;
     if (step.miss > 0.35 * s) continue;
@@ -262,11 +274,16 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     adj[n].push_back({step->target, +1, 0, w, step->half_edge, false});
     adj[step->target].push_back({n, -1, 0, w, -1, false});
   }
+  return adj;
+}
 
-  // Seeds: the junctions of line 0 in order along it.
+// Seeds: the direct junctions of line 0 in order along it; `inner` counts
+// its corresponding ones (segments on its inner side).
+std::vector<int> ReferenceJunctions(const JunctionNetwork& net, const ReferenceLine& reference,
+                                    int* inner) {
+  const SkeletonGraph& g = net.graph();
   std::vector<int> seeds;
   std::set<int> seen;
-  int inner = 0;
   for (const cv::Point& px : reference.pixels) {
     const int n = g.NodeAt(px);
     if (n < 0 || !seen.insert(n).second || g.nodes()[n].kind != NodeKind::kJunction) continue;
@@ -274,40 +291,46 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     if (KindOf(net, n) == JunctionKind::kDirect)
       seeds.push_back(n);
     else
-      ++inner;
+      ++*inner;
   }
-  out->reference_junctions = static_cast<int>(seeds.size());
-  if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
-    if (why) *why = "line 0 carries " + std::to_string(seeds.size()) + " junctions";
-    return false;
-  }
-  if (inner > params.max_inner_fraction * (inner + static_cast<double>(seeds.size()))) {
-    if (why)
-      *why = "the traced line has " + std::to_string(inner) +
-             " segments on its inner side, so it is not line 0";
-    return false;
-  }
-  std::sort(seeds.begin(), seeds.end(),
+  return seeds;
+}
+
+// Sorts the seeds down the image and gives each its v: two rows a step,
+// the steps counted from each gap at the mean of the seeds' own spacing and
+// the local one.
+std::vector<int> NumberSeeds(const JunctionNetwork& net, const LocalSpacing& spacing,
+                             std::vector<int>* seeds) {
+  std::sort(seeds->begin(), seeds->end(),
             [&](int a, int b) { return net.role(a).centre.y < net.role(b).centre.y; });
   std::vector<double> seed_gaps;
-  for (size_t i = 1; i < seeds.size(); ++i)
-    seed_gaps.push_back(net.role(seeds[i]).centre.y - net.role(seeds[i - 1]).centre.y);
+  for (size_t i = 1; i < seeds->size(); ++i)
+    seed_gaps.push_back(net.role((*seeds)[i]).centre.y - net.role((*seeds)[i - 1]).centre.y);
   const double seed_spacing = Median(seed_gaps);
   std::vector<int> seed_v{0};
-  for (size_t i = 1; i < seeds.size(); ++i) {
-    const double local = std::max(1.0, local_spacing(net.role(seeds[i]).centre) * 2.0);
+  for (size_t i = 1; i < seeds->size(); ++i) {
+    const double local = std::max(1.0, spacing.At(net.role((*seeds)[i]).centre) * 2.0);
     const double s = seed_spacing > 0 ? 0.5 * (local + seed_spacing) : local;
     const int steps = std::max(1, static_cast<int>(std::lround(seed_gaps[i - 1] / s)));
     seed_v.push_back(seed_v.back() + 2 * steps);
   }
+  return seed_v;
+}
 
-  // Propagation, most trusted links first (a Dijkstra order over link weights).
-  std::vector<Label> label(n_nodes, {kNoLabel, kNoLabel});
-  std::vector<double> cost(n_nodes, std::numeric_limits<double>::infinity());
+// Propagation, most trusted links first (a Dijkstra order over link
+// weights): labels every node reached from the seeds through links whose
+// labels fit the junctions' kinds, with its path's cost and provenance.
+void Propagate(const JunctionNetwork& net, const pattern::PatternSpec& spec,
+               const std::vector<std::vector<Link>>& adj, const std::vector<int>& seeds,
+               const std::vector<int>& seed_v, std::vector<Label>* label, std::vector<double>* cost,
+               Labelling* out) {
+  const int n_nodes = static_cast<int>(adj.size());
+  label->assign(n_nodes, {kNoLabel, kNoLabel});
+  cost->assign(n_nodes, std::numeric_limits<double>::infinity());
   using Item = std::tuple<double, int, int, int, int>;  // cost, node, p, v, parent
   std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
   for (size_t i = 0; i < seeds.size(); ++i) {
-    cost[seeds[i]] = 0;
+    (*cost)[seeds[i]] = 0;
     queue.push({0.0, seeds[i], 0, seed_v[i], -1});
   }
   std::vector<char> done(n_nodes, 0);
@@ -316,33 +339,26 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     queue.pop();
     if (done[n]) continue;
     done[n] = 1;
-    label[n] = {p, v};
+    (*label)[n] = {p, v};
     out->provenance[n] = {parent, c};
     for (const Link& l : adj[n]) {
       if (done[l.to]) continue;
       const int np = p + l.dp, nv = v + l.dv;
       if (!KindFits(spec, np, nv, KindOf(net, l.to))) continue;
       const double nc = c + l.weight;
-      if (nc < cost[l.to]) {
-        cost[l.to] = nc;
+      if (nc < (*cost)[l.to]) {
+        (*cost)[l.to] = nc;
         queue.push({nc, l.to, np, nv, n});
       }
     }
   }
+}
 
-  // A label most of whose neighbours disagree is dropped, not guessed.
-  out->conflicts += internal::DropDisagreeingLabels(
-      adj,
-      [&](int n) {
-        return label[n].p == kNoLabel ? std::nullopt
-                                      : std::optional(std::make_pair(label[n].p, label[n].v));
-      },
-      [&](int n) {
-        label[n] = {kNoLabel, kNoLabel};
-      });
-
-  // Thesis point O: line 0's junction nearest the centre row is v = 0.
-  const double centre_row = (g.size().height - 1) / 2.0;
+// Thesis point O: the v of line 0's junction nearest the centre row, which
+// becomes v = 0.
+int OriginV(const JunctionNetwork& net, const std::vector<int>& seeds,
+            const std::vector<Label>& label) {
+  const double centre_row = (net.graph().size().height - 1) / 2.0;
   int origin_v = 0;
   double best = 1e18;
   for (int s : seeds) {
@@ -353,6 +369,18 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
       origin_v = label[s].v;
     }
   }
+  return origin_v;
+}
+
+// Adds every labelled node to out->junctions, v from point O; where two
+// claim one label, the better supported one keeps it. Returns each label's
+// place in out->junctions.
+std::map<std::pair<int, int>, size_t> CollectJunctions(const JunctionNetwork& net,
+                                                       const std::vector<std::vector<Link>>& adj,
+                                                       const std::vector<Label>& label,
+                                                       const std::vector<double>& cost,
+                                                       int origin_v, Labelling* out) {
+  const SkeletonGraph& g = net.graph();
   // Support of a label: links to labelled neighbours that agree with it.
   auto support = [&](int n) {
     int agree = 0;
@@ -362,7 +390,7 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     return agree;
   };
   std::map<std::pair<int, int>, size_t> by_label;
-  for (int n = 0; n < n_nodes; ++n) {
+  for (int n = 0; n < static_cast<int>(label.size()); ++n) {
     if (label[n].p == kNoLabel) continue;
     LabelledJunction j;
     j.node = n;
@@ -384,65 +412,71 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     by_label[key] = out->junctions.size();
     out->junctions.push_back(j);
   }
+  return by_label;
+}
 
-  // Thesis 5.1.4.6-5.1.4.7: junctions missing on a continuous line between two
-  // labelled ones are placed on the line at the row of their relative junction.
-  if (params.interpolate_missing) {
-    std::vector<LabelledJunction> added;
-    for (const VerticalLink& l : vlinks) {
-      if (label[l.a].p == kNoLabel || label[l.b].p == kNoLabel) continue;
-      const int p = label[l.a].p;
-      if (label[l.b].p != p) continue;
-      const int va = label[l.a].v - origin_v, vb = label[l.b].v - origin_v;
-      const int step = (p == 0 || p == spec.lines - 1) ? 2 : 1;
-      const int missing = (vb - va) / step - 1;
-      if (missing <= 0 || missing > params.max_interpolated_run) continue;
-      // The line's pixels between the two junctions.
-      std::vector<cv::Point> chain;
-      int cur = l.a;
-      for (int guard = 0; guard < 64 && cur != l.b; ++guard) {
-        const auto s = net.AlongLine(cur, true);
-        if (!s) break;
-        for (const cv::Point& px : g.Pixels(s->half_edge)) chain.push_back(px);
-        cur = s->target;
-      }
-      if (chain.empty()) continue;
-      const cv::Point2d pa = net.role(l.a).centre, pb = net.role(l.b).centre;
-      for (int v = va + step; v < vb; v += step) {
-        const JunctionKind kind =
-            ((v - p) % 2 == 0) ? JunctionKind::kDirect : JunctionKind::kCorresponding;
-        if (!KindFits(spec, p, v, kind) || by_label.count({p, v})) continue;
-        // The segment's other line must be there: a labelled junction on it
-        // within two rows.
-        const int partner_p = kind == JunctionKind::kDirect ? p + 1 : p - 1;
-        bool partner_line = false;
-        for (int dv = -2; dv <= 2; ++dv) partner_line |= by_label.count({partner_p, v + dv}) > 0;
-        if (!partner_line) continue;
-        double target_y = pa.y + (pb.y - pa.y) * (v - va) / static_cast<double>(vb - va);
-        const auto partner = by_label.find({partner_p, v});
-        if (partner != by_label.end()) target_y = out->junctions[partner->second].position.y;
-        const auto nearest = std::min_element(chain.begin(), chain.end(), [&](auto a, auto b) {
-          return std::abs(a.y - target_y) < std::abs(b.y - target_y);
-        });
-        LabelledJunction j;
-        j.position = cv::Point2d(nearest->x, nearest->y);
-        j.p = p;
-        j.v = v;
-        j.kind = kind;
-        j.interpolated = true;
-        added.push_back(j);
-      }
+// Thesis 5.1.4.6-5.1.4.7: junctions missing on a continuous line between two
+// labelled ones are placed on the line at the row of their relative junction.
+void InterpolateMissing(const JunctionNetwork& net, const pattern::PatternSpec& spec,
+                        const LabellingParams& params, const std::vector<VerticalLink>& vlinks,
+                        const std::vector<Label>& label, int origin_v,
+                        std::map<std::pair<int, int>, size_t>* by_label_out, Labelling* out) {
+  const SkeletonGraph& g = net.graph();
+  std::map<std::pair<int, int>, size_t>& by_label = *by_label_out;
+  std::vector<LabelledJunction> added;
+  for (const VerticalLink& l : vlinks) {
+    if (label[l.a].p == kNoLabel || label[l.b].p == kNoLabel) continue;
+    const int p = label[l.a].p;
+    if (label[l.b].p != p) continue;
+    const int va = label[l.a].v - origin_v, vb = label[l.b].v - origin_v;
+    const int step = (p == 0 || p == spec.lines - 1) ? 2 : 1;
+    const int missing = (vb - va) / step - 1;
+    if (missing <= 0 || missing > params.max_interpolated_run) continue;
+    // The line's pixels between the two junctions.
+    std::vector<cv::Point> chain;
+    int cur = l.a;
+    for (int guard = 0; guard < 64 && cur != l.b; ++guard) {
+      const auto s = net.AlongLine(cur, true);
+      if (!s) break;
+      for (const cv::Point& px : g.Pixels(s->half_edge)) chain.push_back(px);
+      cur = s->target;
     }
-    for (const LabelledJunction& j : added) {
-      if (by_label.count({j.p, j.v})) continue;
-      by_label[{j.p, j.v}] = out->junctions.size();
-      out->junctions.push_back(j);
+    if (chain.empty()) continue;
+    const cv::Point2d pa = net.role(l.a).centre, pb = net.role(l.b).centre;
+    for (int v = va + step; v < vb; v += step) {
+      const JunctionKind kind =
+          ((v - p) % 2 == 0) ? JunctionKind::kDirect : JunctionKind::kCorresponding;
+      if (!KindFits(spec, p, v, kind) || by_label.count({p, v})) continue;
+      // The segment's other line must be there: a labelled junction on it
+      // within two rows.
+      const int partner_p = kind == JunctionKind::kDirect ? p + 1 : p - 1;
+      bool partner_line = false;
+      for (int dv = -2; dv <= 2; ++dv) partner_line |= by_label.count({partner_p, v + dv}) > 0;
+      if (!partner_line) continue;
+      double target_y = pa.y + (pb.y - pa.y) * (v - va) / static_cast<double>(vb - va);
+      const auto partner = by_label.find({partner_p, v});
+      if (partner != by_label.end()) target_y = out->junctions[partner->second].position.y;
+      const auto nearest = std::min_element(chain.begin(), chain.end(), [&](auto a, auto b) {
+        return std::abs(a.y - target_y) < std::abs(b.y - target_y);
+      });
+      LabelledJunction j;
+      j.position = cv::Point2d(nearest->x, nearest->y);
+      j.p = p;
+      j.v = v;
+      j.kind = kind;
+      j.interpolated = true;
+      added.push_back(j);
     }
   }
-  std::sort(out->junctions.begin(), out->junctions.end(),
-            [](const auto& a, const auto& b) { return a.p != b.p ? a.p < b.p : a.v < b.v; });
+  for (const LabelledJunction& j : added) {
+    if (by_label.count({j.p, j.v})) continue;
+    by_label[{j.p, j.v}] = out->junctions.size();
+    out->junctions.push_back(j);
+  }
+}
 
-  // Lines: walk each labelled line up and down from its junctions.
+// Lines: walks each labelled line up and down from its junctions into out->lines.
+void WalkLabelledLines(const JunctionNetwork& net, Labelling* out) {
   std::map<int, std::vector<int>> nodes_of_line;
   std::map<int, int> line_of_node;
   for (const LabelledJunction& j : out->junctions)
@@ -473,6 +507,75 @@ bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loo
     for (const auto& run : runs) line.pixels.insert(line.pixels.end(), run.begin(), run.end());
     out->lines.push_back(std::move(line));
   }
+}
+
+}  // namespace
+
+bool LabellingParams::IsValid(std::string* error) const {
+  auto fail = [error](const char* why) {
+    if (error) *error = why;
+    return false;
+  };
+  if (max_interpolated_run < 0 || max_interpolated_run > 10)
+    return fail("max_interpolated_run must lie in 0..10");
+  if (max_inner_fraction < 0 || max_inner_fraction > 1)
+    return fail("max_inner_fraction must lie in [0, 1]");
+  if (min_reference_junctions < 1) return fail("min_reference_junctions must be at least 1");
+  if (spacing_radius <= 0) return fail("spacing_radius must be positive");
+  return true;
+}
+
+// Thesis 5.1.4.9: labelling.
+bool LabelNetwork(const JunctionNetwork& net, const std::vector<LoopRecord>& loops,
+                  const ReferenceLine& reference, const pattern::PatternSpec& spec,
+                  const LabellingParams& params, Labelling* out, std::string* why) {
+  std::string invalid;
+  if (!params.IsValid(&invalid)) throw std::invalid_argument("LabelNetwork: " + invalid);
+  *out = Labelling{};
+
+  const std::vector<char> trusted = TrustedHalfEdges(net.graph(), loops);
+  const std::vector<VerticalLink> vlinks = LinesDown(net, trusted);
+  const LocalSpacing spacing(vlinks, params.spacing_radius);
+  const std::vector<std::vector<Link>> adj = LinkJunctions(net, vlinks, trusted, spacing);
+
+  int inner = 0;
+  std::vector<int> seeds = ReferenceJunctions(net, reference, &inner);
+  out->reference_junctions = static_cast<int>(seeds.size());
+  if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
+    if (why) *why = "line 0 carries " + std::to_string(seeds.size()) + " junctions";
+    return false;
+  }
+  if (inner > params.max_inner_fraction * (inner + static_cast<double>(seeds.size()))) {
+    if (why)
+      *why = "the traced line has " + std::to_string(inner) +
+             " segments on its inner side, so it is not line 0";
+    return false;
+  }
+  const std::vector<int> seed_v = NumberSeeds(net, spacing, &seeds);
+
+  std::vector<Label> label;
+  std::vector<double> cost;
+  Propagate(net, spec, adj, seeds, seed_v, &label, &cost, out);
+
+  // A label most of whose neighbours disagree is dropped, not guessed.
+  out->conflicts += internal::DropDisagreeingLabels(
+      adj,
+      [&](int n) {
+        return label[n].p == kNoLabel ? std::nullopt
+                                      : std::optional(std::make_pair(label[n].p, label[n].v));
+      },
+      [&](int n) {
+        label[n] = {kNoLabel, kNoLabel};
+      });
+
+  const int origin_v = OriginV(net, seeds, label);
+  std::map<std::pair<int, int>, size_t> by_label =
+      CollectJunctions(net, adj, label, cost, origin_v, out);
+  if (params.interpolate_missing)
+    InterpolateMissing(net, spec, params, vlinks, label, origin_v, &by_label, out);
+  std::sort(out->junctions.begin(), out->junctions.end(),
+            [](const auto& a, const auto& b) { return a.p != b.p ? a.p < b.p : a.v < b.v; });
+  WalkLabelledLines(net, out);
   return true;
 }
 

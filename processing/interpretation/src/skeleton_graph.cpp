@@ -193,48 +193,106 @@ double SkeletonGraph::SignedArea2(const std::vector<int>& face) const {
   return a;
 }
 
-SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& params) {
-  if (skeleton.empty()) throw std::invalid_argument("SkeletonGraph::Build: empty skeleton");
-  if (skeleton.type() != CV_8UC1)
-    throw std::invalid_argument("SkeletonGraph::Build: skeleton must be CV_8UC1");
-  std::string why;
-  if (!params.IsValid(&why)) throw std::invalid_argument("SkeletonGraph::Build: " + why);
+// The steps of one Build, on the skeleton as a 0/1 buffer with a one-pixel
+// frame (so that neighbour look-ups need no bounds checks: frame pixels are
+// unset, of degree 0), its set pixels, their degrees and the owner of every
+// pixel (laid out like the buffer, frame -1). Each step adds to the graph
+// `g`, in the order Build calls them.
+class SkeletonGraph::Builder {
+ public:
+  // Fills the 0/1 buffer, lists the set pixels in raster order with the
+  // corners of 4-connected steps cleared, counts their degrees and sets
+  // every owner to kNone (g's owner image: a view of the buffer's inner part).
+  Builder(const cv::Mat& skeleton, SkeletonGraph* g);
 
-  SkeletonGraph g;
-  g.size_ = skeleton.size();
-  const int rows = skeleton.rows, cols = skeleton.cols;
+  void FindJunctionClusters();
+  void JoinEnclosedPixels();
+  void SplitDoubleTs();
+  void AddLineEnds();
+  void TraceChains();
+  void AnchorClosedChains();
+  void SetCentres();
+  void SetDeparturesAndRotations(const GraphParams& params);
 
-  // Binary image (0 / 1) and degrees with a one-pixel frame, so that
-  // neighbour look-ups need no bounds checks: frame pixels are unset, of
-  // degree 0.
-  const int stride = cols + 2;
-  std::vector<uchar> bin(static_cast<size_t>(stride) * static_cast<size_t>(rows + 2), 0);
-  {
-    cv::Mat inner = cv::Mat(rows + 2, stride, CV_8UC1, bin.data())(cv::Rect(1, 1, cols, rows));
-    cv::threshold(skeleton, inner, 0, 1, cv::THRESH_BINARY);  // 0 / 1
-  }
-  auto at = [stride](int x, int y) {
-    return static_cast<size_t>(y + 1) * static_cast<size_t>(stride) + static_cast<size_t>(x + 1);
-  };
-  auto set = [&](int x, int y) { return bin[at(x, y)] != 0; };
-  auto neighbours = [&](size_t i) {  // the number of set 8-neighbours
-    const uchar* up = &bin[i - static_cast<size_t>(stride)];
-    const uchar* here = &bin[i];
-    const uchar* down = &bin[i + static_cast<size_t>(stride)];
-    return up[-1] + up[0] + up[1] + here[-1] + here[1] + down[-1] + down[0] + down[1];
-  };
-  // Only the set pixels are visited from here on (a skeleton is sparse),
-  // each with its buffer index.
+ private:
+  // A set pixel with its buffer index.
   struct Lit {
     size_t i;
     cv::Point p;
   };
-  std::vector<Lit> lit;
-  for (int y = 0; y < rows; ++y) {
-    const uchar* row = &bin[at(0, y)];
+
+  size_t At(int x, int y) const {
+    return static_cast<size_t>(y + 1) * static_cast<size_t>(stride_) + static_cast<size_t>(x + 1);
+  }
+  bool Set(int x, int y) const { return bin_[At(x, y)] != 0; }
+  // The number of set 8-neighbours of buffer index i.
+  int Neighbours(size_t i) const {
+    const uchar* up = &bin_[i - static_cast<size_t>(stride_)];
+    const uchar* here = &bin_[i];
+    const uchar* down = &bin_[i + static_cast<size_t>(stride_)];
+    return up[-1] + up[0] + up[1] + here[-1] + here[1] + down[-1] + down[0] + down[1];
+  }
+  // The chain-code neighbour c of buffer index i.
+  size_t Neighbour(size_t i, int c) const {
+    return static_cast<size_t>(static_cast<std::ptrdiff_t>(i) + step_[c]);
+  }
+  // The pixel of buffer index i.
+  cv::Point PointOf(size_t i) const {
+    return cv::Point(static_cast<int>(i % static_cast<size_t>(stride_)) - 1,
+                     static_cast<int>(i / static_cast<size_t>(stride_)) - 1);
+  }
+  int& Owner(int x, int y) { return owner_data_[At(x, y)]; }
+  int& OwnerAt(size_t i) { return owner_data_[i]; }
+  int NewNode(NodeKind kind) {
+    g_.nodes_.push_back(SkeletonNode{kind, {}, {}, {}});
+    return static_cast<int>(g_.nodes_.size()) - 1;
+  }
+
+  void ListSetPixels();
+  void DropStepCorners();
+  void TraceFrom(int node, cv::Point start, cv::Point first);
+
+  SkeletonGraph& g_;
+  int rows_;
+  int cols_;
+  int stride_;
+  std::vector<uchar> bin_;
+  std::vector<Lit> lit_;
+  std::vector<uchar> deg_;
+  cv::Mat owners_;
+  int* owner_data_ = nullptr;
+  std::array<std::ptrdiff_t, 8> step_;          // the chain-code neighbours by buffer index
+  std::set<std::pair<int, int>> direct_links_;  // node pairs joined without chain pixels
+};
+
+SkeletonGraph::Builder::Builder(const cv::Mat& skeleton, SkeletonGraph* g)
+    : g_(*g), rows_(skeleton.rows), cols_(skeleton.cols), stride_(skeleton.cols + 2) {
+  bin_.assign(static_cast<size_t>(stride_) * static_cast<size_t>(rows_ + 2), 0);
+  {
+    cv::Mat inner = cv::Mat(rows_ + 2, stride_, CV_8UC1, bin_.data())(cv::Rect(1, 1, cols_, rows_));
+    cv::threshold(skeleton, inner, 0, 1, cv::THRESH_BINARY);  // 0 / 1
+  }
+  ListSetPixels();
+  DropStepCorners();
+  deg_.assign(bin_.size(), 0);
+  for (const Lit& l : lit_) deg_[l.i] = static_cast<uchar>(Neighbours(l.i));
+
+  owners_.create(rows_ + 2, stride_, CV_32S);
+  owner_data_ = owners_.ptr<int>(0);  // continuous: freshly allocated
+  static_assert(kNone == -1);         // every byte 0xFF
+  std::memset(owner_data_, 0xFF, owners_.total() * sizeof(int));
+  g_.owner_ = owners_(cv::Rect(1, 1, cols_, rows_));
+  for (int c = 0; c < 8; ++c) step_[c] = kCodeDy[c] * std::ptrdiff_t{stride_} + kCodeDx[c];
+}
+
+// Lists every set pixel in lit_, in raster order. Only the set pixels are
+// visited from here on (a skeleton is sparse), each with its buffer index.
+void SkeletonGraph::Builder::ListSetPixels() {
+  for (int y = 0; y < rows_; ++y) {
+    const uchar* row = &bin_[At(0, y)];
     int x = 0;
-    for (; x + 8 <= cols; x += 8) {         // eight pixels (0 / 1 bytes) at a time
-      if (x % 32 == 0 && x + 32 <= cols) {  // skip empty 32-pixel runs
+    for (; x + 8 <= cols_; x += 8) {         // eight pixels (0 / 1 bytes) at a time
+      if (x % 32 == 0 && x + 32 <= cols_) {  // skip empty 32-pixel runs
         std::uint64_t words[4];
         std::memcpy(words, row + x, 32);
         if (!(words[0] | words[1] | words[2] | words[3])) {
@@ -247,126 +305,113 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
       static_assert(std::endian::native == std::endian::little);
       while (word) {  // pixel x + k is bit 8k
         const int px = x + std::countr_zero(word) / 8;
-        lit.push_back({at(px, y), {px, y}});
+        lit_.push_back({At(px, y), {px, y}});
         word &= word - 1;
       }
     }
-    for (; x < cols; ++x)
-      if (row[x]) lit.push_back({at(x, y), {x, y}});
+    for (; x < cols_; ++x)
+      if (row[x]) lit_.push_back({At(x, y), {x, y}});
   }
-  // Corner pixels of 4-connected steps (an L of three pixels) make their
-  // neighbours look like junctions; the skeleton stays 8-connected without them.
-  for (const Lit& l : lit) {
+}
+
+// Clears the corner pixels of 4-connected steps (an L of three pixels) from
+// the buffer and from lit_: they make their neighbours look like
+// junctions; the skeleton stays 8-connected without them.
+void SkeletonGraph::Builder::DropStepCorners() {
+  for (const Lit& l : lit_) {
     const size_t i = l.i;
-    if (neighbours(i) != 2) continue;
-    const bool horizontal = bin[i - 1] || bin[i + 1];
+    if (Neighbours(i) != 2) continue;
+    const bool horizontal = bin_[i - 1] || bin_[i + 1];
     const bool vertical =
-        bin[i - static_cast<size_t>(stride)] || bin[i + static_cast<size_t>(stride)];
-    if (horizontal && vertical) bin[i] = 0;
+        bin_[i - static_cast<size_t>(stride_)] || bin_[i + static_cast<size_t>(stride_)];
+    if (horizontal && vertical) bin_[i] = 0;
   }
-  std::erase_if(lit, [&](const Lit& l) { return !bin[l.i]; });
-  std::vector<uchar> deg(bin.size(), 0);
-  for (const Lit& l : lit) deg[l.i] = static_cast<uchar>(neighbours(l.i));
+  std::erase_if(lit_, [&](const Lit& l) { return !bin_[l.i]; });
+}
 
-  // Owners in a buffer laid out like bin (frame -1); the graph keeps its image part.
-  cv::Mat owners(rows + 2, stride, CV_32S);
-  int* const owner_data = owners.ptr<int>(0);  // continuous: freshly allocated
-  static_assert(kNone == -1);                  // every byte 0xFF
-  std::memset(owner_data, 0xFF, owners.total() * sizeof(int));
-  g.owner_ = owners(cv::Rect(1, 1, cols, rows));
-  auto owner = [&](int x, int y) -> int& { return owner_data[at(x, y)]; };
-  auto owner_at = [owner_data](size_t i) -> int& { return owner_data[i]; };
-  // The chain-code neighbours by buffer index, and buffer indices back to pixels.
-  std::array<std::ptrdiff_t, 8> step;
-  for (int c = 0; c < 8; ++c) step[c] = kCodeDy[c] * std::ptrdiff_t{stride} + kCodeDx[c];
-  auto neighbour = [&step](size_t i, int c) {
-    return static_cast<size_t>(static_cast<std::ptrdiff_t>(i) + step[c]);
-  };
-  auto point_of = [stride](size_t i) {
-    return cv::Point(static_cast<int>(i % static_cast<size_t>(stride)) - 1,
-                     static_cast<int>(i / static_cast<size_t>(stride)) - 1);
-  };
-
-  // Junction clusters: 8-connected groups of pixels with three or more neighbours.
-  auto new_node = [&](NodeKind kind) {
-    g.nodes_.push_back(SkeletonNode{kind, {}, {}, {}});
-    return static_cast<int>(g.nodes_.size()) - 1;
-  };
+// Junction clusters: one junction node per 8-connected group of pixels with
+// three or more neighbours, owning them.
+void SkeletonGraph::Builder::FindJunctionClusters() {
   std::vector<Lit> stack;
-  for (const Lit& l0 : lit) {
-    if (deg[l0.i] < 3 || owner_at(l0.i) != kNone) continue;
-    const int id = new_node(NodeKind::kJunction);
+  for (const Lit& l0 : lit_) {
+    if (deg_[l0.i] < 3 || OwnerAt(l0.i) != kNone) continue;
+    const int id = NewNode(NodeKind::kJunction);
     stack.assign(1, l0);
-    owner_at(l0.i) = id;
+    OwnerAt(l0.i) = id;
     while (!stack.empty()) {
       const Lit l = stack.back();
       stack.pop_back();
-      g.nodes_[id].pixels.push_back(l.p);
+      g_.nodes_[id].pixels.push_back(l.p);
       for (int c = 0; c < 8; ++c) {
-        const size_t q = neighbour(l.i, c);
-        if (deg[q] < 3) continue;  // also in the frame
-        if (owner_at(q) != kNone) continue;
-        owner_at(q) = id;
+        const size_t q = Neighbour(l.i, c);
+        if (deg_[q] < 3) continue;  // also in the frame
+        if (OwnerAt(q) != kNone) continue;
+        OwnerAt(q) = id;
         stack.push_back({q, l.p + CodeStep(c)});
       }
     }
   }
-  // A two-neighbour pixel whose neighbours all belong to one cluster is part
-  // of it. Pixels are taken in raster order, each seeing the pixels joined
-  // before it; only those next to a cluster pixel, or to a pixel joined
-  // before them, can join, so those alone are visited (a min-heap of buffer
-  // indices keeps the raster order).
-  {
-    std::vector<size_t> heap;
-    auto offer = [&](size_t i) {  // a neighbour that might join
-      if (deg[i] == 2 && owner_at(i) == kNone) {
-        heap.push_back(i);
-        std::push_heap(heap.begin(), heap.end(), std::greater<>());
-      }
-    };
-    for (const SkeletonNode& node : g.nodes_)
-      for (const cv::Point& p : node.pixels)
-        for (int c = 0; c < 8; ++c) offer(neighbour(at(p.x, p.y), c));
-    size_t last = 0;  // the index taken last (0 lies in the frame)
-    while (!heap.empty()) {
-      std::pop_heap(heap.begin(), heap.end(), std::greater<>());
-      const size_t i = heap.back();
-      heap.pop_back();
-      if (i == last) continue;  // offered twice
-      last = i;
-      if (owner_at(i) != kNone) continue;
-      int cluster = kNone;
-      bool same = true;
-      for (int c = 0; c < 8 && same; ++c) {
-        if (!bin[neighbour(i, c)]) continue;
-        const int o = owner_at(neighbour(i, c));
-        if (o < 0 || g.nodes_[o].kind != NodeKind::kJunction)
-          same = false;
-        else if (cluster == kNone)
-          cluster = o;
-        else if (cluster != o)
-          same = false;
-      }
-      if (!same || cluster == kNone) continue;
-      owner_at(i) = cluster;
-      g.nodes_[cluster].pixels.push_back(point_of(i));
-      for (int c = 0; c < 8; ++c)
-        if (neighbour(i, c) > i) offer(neighbour(i, c));  // only pixels after it see it
+}
+
+// Joins to a cluster every two-neighbour pixel whose neighbours all belong
+// to it. Pixels are taken in raster order, each seeing the pixels
+// joined before it; only those next to a cluster pixel, or to a pixel
+// joined before them, can join, so those alone are visited (a min-heap of
+// buffer indices keeps the raster order).
+void SkeletonGraph::Builder::JoinEnclosedPixels() {
+  std::vector<size_t> heap;
+  auto offer = [&](size_t i) {  // a neighbour that might join
+    if (deg_[i] == 2 && OwnerAt(i) == kNone) {
+      heap.push_back(i);
+      std::push_heap(heap.begin(), heap.end(), std::greater<>());
     }
+  };
+  for (const SkeletonNode& node : g_.nodes_)
+    for (const cv::Point& p : node.pixels)
+      for (int c = 0; c < 8; ++c) offer(Neighbour(At(p.x, p.y), c));
+  size_t last = 0;  // the index taken last (0 lies in the frame)
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+    const size_t i = heap.back();
+    heap.pop_back();
+    if (i == last) continue;  // offered twice
+    last = i;
+    if (OwnerAt(i) != kNone) continue;
+    int cluster = kNone;
+    bool same = true;
+    for (int c = 0; c < 8 && same; ++c) {
+      if (!bin_[Neighbour(i, c)]) continue;
+      const int o = OwnerAt(Neighbour(i, c));
+      if (o < 0 || g_.nodes_[o].kind != NodeKind::kJunction)
+        same = false;
+      else if (cluster == kNone)
+        cluster = o;
+      else if (cluster != o)
+        same = false;
+    }
+    if (!same || cluster == kNone) continue;
+    OwnerAt(i) = cluster;
+    g_.nodes_[cluster].pixels.push_back(PointOf(i));
+    for (int c = 0; c < 8; ++c)
+      if (Neighbour(i, c) > i) offer(Neighbour(i, c));  // only pixels after it see it
   }
-  // Thesis 5.1.4.8: where two lines run a few pixels apart, the short segment
-  // between them puts its two T-junctions into one cluster (an H of four
-  // branches, which reads as a crossing). Such a cluster holds two groups of
-  // branch pixels (three or more separate runs of neighbours) side by side;
-  // it is split between them when each half keeps a line up and down.
-  const int clusters = static_cast<int>(g.nodes_.size());
+}
+
+// Thesis 5.1.4.8: where two lines run a few pixels apart, the short segment
+// between them puts its two T-junctions into one cluster (an H of four
+// branches, which reads as a crossing). Such a cluster holds two groups of
+// branch pixels (three or more separate runs of neighbours) side by side;
+// it is split between them when each half keeps a line up and down.
+// Splits every such cluster into two junction nodes.
+void SkeletonGraph::Builder::SplitDoubleTs() {
+  const int clusters = static_cast<int>(g_.nodes_.size());
   std::vector<cv::Point> branch;
   for (int id = 0; id < clusters; ++id) {
-    const std::vector<cv::Point>& pixels = g.nodes_[id].pixels;  // until a node is added
+    const std::vector<cv::Point>& pixels = g_.nodes_[id].pixels;  // until a node is added
     if (pixels.size() < 3) continue;
     std::vector<cv::Point> halves[2];
     if (!SplitH(
-            pixels, [&](int x, int y) { return set(x, y); }, &branch, &halves[0], &halves[1]))
+            pixels, [&](int x, int y) { return Set(x, y); }, &branch, &halves[0], &halves[1]))
       continue;
     // Each half must leave the cluster on exactly two pixels: its line.
     auto exits = [&](const std::vector<cv::Point>& half) {
@@ -374,117 +419,136 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
       for (const cv::Point& p : half)
         for (int c = 0; c < 8; ++c) {
           const int nx = p.x + kCodeDx[c], ny = p.y + kCodeDy[c];
-          if (set(nx, ny) && owner(nx, ny) != id) out.insert({nx, ny});
+          if (Set(nx, ny) && Owner(nx, ny) != id) out.insert({nx, ny});
         }
       return out.size();
     };
     if (exits(halves[0]) != 2 || exits(halves[1]) != 2) continue;
-    const int other = new_node(NodeKind::kJunction);
-    for (const cv::Point& p : halves[1]) owner(p.x, p.y) = other;
-    g.nodes_[id].pixels = std::move(halves[0]);
-    g.nodes_[other].pixels = std::move(halves[1]);
+    const int other = NewNode(NodeKind::kJunction);
+    for (const cv::Point& p : halves[1]) Owner(p.x, p.y) = other;
+    g_.nodes_[id].pixels = std::move(halves[0]);
+    g_.nodes_[other].pixels = std::move(halves[1]);
   }
+}
 
-  // Line ends.
-  for (const Lit& l : lit)
-    if (deg[l.i] == 1 && owner_at(l.i) == kNone) {
-      const int id = new_node(NodeKind::kEnd);
-      g.nodes_[id].pixels.push_back(l.p);
-      owner_at(l.i) = id;
+// Line ends: an end node on every one-neighbour pixel no node owns.
+void SkeletonGraph::Builder::AddLineEnds() {
+  for (const Lit& l : lit_)
+    if (deg_[l.i] == 1 && OwnerAt(l.i) == kNone) {
+      const int id = NewNode(NodeKind::kEnd);
+      g_.nodes_[id].pixels.push_back(l.p);
+      OwnerAt(l.i) = id;
     }
+}
 
-  // Chains between nodes.
-  std::set<std::pair<int, int>> direct_links;
-  // Pixels are carried as (buffer index, point); a step moves both.
-  auto trace_from = [&](int node, cv::Point start, cv::Point first) {
-    SkeletonEdge edge;
-    edge.from = node;
-    const int id = static_cast<int>(g.edges_.size());
-    const size_t start_i = at(start.x, start.y);
-    size_t prev = start_i, cur = at(first.x, first.y);
-    cv::Point cur_p = first;
-    while (true) {
-      const int o = owner_at(cur);
-      if (o >= 0) {
-        edge.to = o;
+// Adds the edge from `node` along the chain that leaves its pixel `start`
+// through `first`, owning the chain's pixels, to the node it reaches (or to
+// a new end node where it stops). Pixels are carried as
+// (buffer index, point); a step moves both.
+void SkeletonGraph::Builder::TraceFrom(int node, cv::Point start, cv::Point first) {
+  SkeletonEdge edge;
+  edge.from = node;
+  const int id = static_cast<int>(g_.edges_.size());
+  const size_t start_i = At(start.x, start.y);
+  size_t prev = start_i, cur = At(first.x, first.y);
+  cv::Point cur_p = first;
+  while (true) {
+    const int o = OwnerAt(cur);
+    if (o >= 0) {
+      edge.to = o;
+      break;
+    }
+    OwnerAt(cur) = EncodeEdge(id);
+    edge.pixels.push_back(cur_p);
+    int next_c = -1;
+    // Prefer stepping onto a node pixel (other than the one we came from at
+    // the very start) so chains stop at their junction.
+    for (int c = 0; c < 8; ++c) {
+      const size_t q = Neighbour(cur, c);
+      if (!bin_[q] || q == prev) continue;
+      const int o2 = OwnerAt(q);
+      if (o2 >= 0) {
+        if (edge.pixels.size() == 1 && o2 == node && q != start_i) continue;
+        next_c = c;
         break;
       }
-      owner_at(cur) = EncodeEdge(id);
-      edge.pixels.push_back(cur_p);
-      int next_c = -1;
-      // Prefer stepping onto a node pixel (other than the one we came from at
-      // the very start) so chains stop at their junction.
-      for (int c = 0; c < 8; ++c) {
-        const size_t q = neighbour(cur, c);
-        if (!bin[q] || q == prev) continue;
-        const int o2 = owner_at(q);
-        if (o2 >= 0) {
-          if (edge.pixels.size() == 1 && o2 == node && q != start_i) continue;
-          next_c = c;
-          break;
-        }
-        if (o2 == kNone) next_c = c;
-      }
-      if (next_c < 0) {
-        // Dead end inside a chain (cannot happen on a thin skeleton): close at an end node.
-        const int end = new_node(NodeKind::kEnd);
-        edge.pixels.pop_back();
-        g.nodes_[end].pixels.push_back(cur_p);
-        owner_at(cur) = end;
-        edge.to = end;
-        break;
-      }
-      prev = cur;
-      cur = neighbour(cur, next_c);
-      cur_p += cv::Point(kCodeDx[next_c], kCodeDy[next_c]);
+      if (o2 == kNone) next_c = c;
     }
-    g.edges_.push_back(std::move(edge));
-  };
-  for (int n = 0; n < static_cast<int>(g.nodes_.size()); ++n) {
+    if (next_c < 0) {
+      // Dead end inside a chain (cannot happen on a thin skeleton): close at an end node.
+      const int end = NewNode(NodeKind::kEnd);
+      edge.pixels.pop_back();
+      g_.nodes_[end].pixels.push_back(cur_p);
+      OwnerAt(cur) = end;
+      edge.to = end;
+      break;
+    }
+    prev = cur;
+    cur = Neighbour(cur, next_c);
+    cur_p += cv::Point(kCodeDx[next_c], kCodeDy[next_c]);
+  }
+  g_.edges_.push_back(std::move(edge));
+}
+
+// Chains between nodes: an edge along each, and one without pixels for
+// each pair of nodes that touch.
+void SkeletonGraph::Builder::TraceChains() {
+  for (int n = 0; n < static_cast<int>(g_.nodes_.size()); ++n) {
     // By index: tracing may add nodes (moving nodes_), never pixels of node n.
-    for (size_t k = 0; k < g.nodes_[n].pixels.size(); ++k) {
-      const cv::Point p = g.nodes_[n].pixels[k];
-      const size_t i = at(p.x, p.y);
+    for (size_t k = 0; k < g_.nodes_[n].pixels.size(); ++k) {
+      const cv::Point p = g_.nodes_[n].pixels[k];
+      const size_t i = At(p.x, p.y);
       for (int c = 0; c < 8; ++c) {
-        const size_t q = neighbour(i, c);
-        if (!bin[q]) continue;
-        const int o = owner_at(q);
+        const size_t q = Neighbour(i, c);
+        if (!bin_[q]) continue;
+        const int o = OwnerAt(q);
         if (o == kNone) {
-          trace_from(n, p, p + CodeStep(c));
+          TraceFrom(n, p, p + CodeStep(c));
         } else if (o >= 0 && o != n) {
           const auto key = std::minmax(n, o);
-          if (direct_links.insert(key).second) {
+          if (direct_links_.insert(key).second) {
             SkeletonEdge e;
             e.from = n;
             e.to = o;
-            g.edges_.push_back(std::move(e));
+            g_.edges_.push_back(std::move(e));
           }
         }
       }
     }
   }
-  // Closed chains without any node get an anchor.
-  for (const Lit& l : lit) {
-    if (owner_at(l.i) != kNone || deg[l.i] == 0) continue;
-    const int id = new_node(NodeKind::kAnchor);
-    g.nodes_[id].pixels.push_back(l.p);
-    owner_at(l.i) = id;
+}
+
+// Closed chains without any node get an anchor node, and their edge.
+void SkeletonGraph::Builder::AnchorClosedChains() {
+  for (const Lit& l : lit_) {
+    if (OwnerAt(l.i) != kNone || deg_[l.i] == 0) continue;
+    const int id = NewNode(NodeKind::kAnchor);
+    g_.nodes_[id].pixels.push_back(l.p);
+    OwnerAt(l.i) = id;
     for (int c = 0; c < 8; ++c) {
-      const size_t q = neighbour(l.i, c);
-      if (bin[q] && owner_at(q) == kNone) {
-        trace_from(id, l.p, l.p + CodeStep(c));
+      const size_t q = Neighbour(l.i, c);
+      if (bin_[q] && OwnerAt(q) == kNone) {
+        TraceFrom(id, l.p, l.p + CodeStep(c));
         break;
       }
     }
   }
+}
 
-  for (SkeletonNode& node : g.nodes_) {
+// Sets every node's centre: the mean of its pixels.
+void SkeletonGraph::Builder::SetCentres() {
+  for (SkeletonNode& node : g_.nodes_) {
     cv::Point2d sum(0, 0);
     for (const cv::Point& p : node.pixels) sum += cv::Point2d(p.x, p.y);
     node.centre = sum * (1.0 / static_cast<double>(node.pixels.size()));
   }
+}
 
-  // Departure directions and rotations.
+// Departure directions and rotations: sets every half-edge's direction and
+// each node's rotation (its outgoing half-edges anticlockwise), with each
+// half-edge's place in it.
+void SkeletonGraph::Builder::SetDeparturesAndRotations(const GraphParams& params) {
+  SkeletonGraph& g = g_;
   const int half_edges = g.HalfEdgeCount();
   g.departure_.assign(half_edges, {0, 0});
   std::vector<double> angle(half_edges, 0.0);
@@ -520,6 +584,29 @@ SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& p
     for (int i = 0; i < static_cast<int>(node.rotation.size()); ++i)
       g.rotation_index_[node.rotation[i]] = i;
   }
+}
+
+SkeletonGraph SkeletonGraph::Build(const cv::Mat& skeleton, const GraphParams& params) {
+  if (skeleton.empty()) throw std::invalid_argument("SkeletonGraph::Build: empty skeleton");
+  if (skeleton.type() != CV_8UC1)
+    throw std::invalid_argument("SkeletonGraph::Build: skeleton must be CV_8UC1");
+  std::string why;
+  if (!params.IsValid(&why)) throw std::invalid_argument("SkeletonGraph::Build: " + why);
+
+  SkeletonGraph g;
+  g.size_ = skeleton.size();
+  Builder builder(skeleton, &g);
+  // Nodes: junction clusters (with the pixels they enclose, double Ts
+  // split), then line ends; then the chains between them as edges, closed
+  // chains anchored; then the directions in which edges leave their nodes.
+  builder.FindJunctionClusters();
+  builder.JoinEnclosedPixels();
+  builder.SplitDoubleTs();
+  builder.AddLineEnds();
+  builder.TraceChains();
+  builder.AnchorClosedChains();
+  builder.SetCentres();
+  builder.SetDeparturesAndRotations(params);
   return g;
 }
 

@@ -129,6 +129,327 @@ std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
   return chain;
 }
 
+// Row spacing: each line's own where it has enough steps, else the
+// frame's. A stray junction splits a step in two shorter ones, so a line's
+// own spacing is the median of its steps within kSpacingSpread of the
+// frame's (the median of all steps).
+struct RowSpacings {
+  double frame = 0;         // px a row: the median over the frame
+  std::vector<double> own;  // per line track: its own, or 0 where it has too few steps
+
+  // The spacing a line track's steps are judged by.
+  double Of(int track) const { return own[track] > 0 ? own[track] : frame; }
+};
+
+// Measures the row spacings; line 0's steps are taken between its direct
+// junctions only (`is_reference`: per line track, part of line 0).
+RowSpacings MeasureRowSpacings(const TrackNetwork& net, const std::vector<char>& is_reference,
+                               const TrackLabellingParams& params) {
+  std::vector<std::vector<double>> samples(net.lines.size());
+  std::vector<double> all_spacing;
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    int previous = -1;
+    for (int j : net.junctions_on_line[t]) {
+      if (is_reference[t] && net.junctions[j].kind != JunctionKind::kDirect) continue;
+      if (previous >= 0)
+        samples[t].push_back(RowSpacing(net.junctions[previous], net.junctions[j]));
+      previous = j;
+    }
+    all_spacing.insert(all_spacing.end(), samples[t].begin(), samples[t].end());
+  }
+  RowSpacings out;
+  out.frame = Median(all_spacing);
+  const double frame_spacing = out.frame;
+  out.own.assign(net.lines.size(), 0.0);
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    std::erase_if(samples[t], [&](double s) {
+      return !(s >= frame_spacing / kSpacingSpread && s <= frame_spacing * kSpacingSpread);
+    });
+    if (static_cast<int>(samples[t].size()) >= params.min_own_spacings)
+      out.own[t] = Median(samples[t]);
+  }
+  return out;
+}
+
+// The rows from junction a down to junction b on one line at `spacing` px
+// a row; nullopt where the step fits no whole number of rows of its
+// parity: it joins a false junction (a segment's end on the wrong line).
+std::optional<int> RowsBetween(const TrackNetwork& net, int a, int b, double spacing,
+                               const TrackLabellingParams& params) {
+  if (!(spacing > 0)) return std::nullopt;
+  const TrackJunction& ja = net.junctions[a];
+  const TrackJunction& jb = net.junctions[b];
+  const internal::RowCount step = internal::NearestRowCount(jb.position.y - ja.position.y, spacing,
+                                                            ja.kind != jb.kind, params.max_rows);
+  if (step.miss > params.max_row_miss * spacing) return std::nullopt;
+  return step.rows;
+}
+
+// A step along a line: to the next junction down its line track, a whole
+// number of rows below (to < 0: none).
+struct Step {
+  int to = -1;
+  int rows = 0;
+};
+
+// Per junction, its step down its line track: consecutive junctions of a
+// track, a whole number of rows apart.
+std::vector<Step> StepsDown(const TrackNetwork& net, const RowSpacings& spacing,
+                            const TrackLabellingParams& params) {
+  std::vector<Step> down(net.junctions.size());
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    const std::vector<int>& on = net.junctions_on_line[t];
+    const double s = spacing.Of(static_cast<int>(t));
+    for (size_t i = 1; i < on.size(); ++i)
+      if (const auto rows = RowsBetween(net, on[i - 1], on[i], s, params))
+        down[on[i - 1]] = {on[i], *rows};
+  }
+  return down;
+}
+
+// Segments: a direct junction at one end and a corresponding one at the
+// other join lines p and p + 1. Per junction: for a direct one, its
+// segment's corresponding end; -1 otherwise.
+std::vector<int> SegmentPartners(const TrackNetwork& net) {
+  const int n = static_cast<int>(net.junctions.size());
+  std::vector<int> across(n, -1);
+  // Per segment track: its (direct, corresponding) junctions.
+  std::vector<std::pair<int, int>> ends(net.segments.size(), {-1, -1});
+  for (int j = 0; j < n; ++j) {
+    auto& e = ends[net.junctions[j].segment];
+    (net.junctions[j].kind == JunctionKind::kDirect ? e.first : e.second) = j;
+  }
+  for (const auto& [direct, corresponding] : ends)
+    if (direct >= 0 && corresponding >= 0) across[direct] = corresponding;
+  return across;
+}
+
+// Per junction: whether its step down / its segment is a link of a closed brick.
+struct TrustedLinks {
+  std::vector<char> down;
+  std::vector<char> across;
+};
+
+// Thesis 5.1.4.1: a complete loop. The brick below segment A-B (A direct
+// on line p, B corresponding on p + 1) closes when both lines run down
+// exactly two rows, through their median junctions, to the ends of one
+// segment; its six links are trusted.
+TrustedLinks TrustClosedBricks(const std::vector<Step>& down, const std::vector<int>& across) {
+  const int n = static_cast<int>(down.size());
+  auto two_rows_down = [&](int j, std::vector<int>* path) {
+    int rows = 0;
+    for (int cur = j; rows < 2;) {
+      if (down[cur].to < 0) return -1;
+      rows += down[cur].rows;
+      path->push_back(cur);
+      cur = down[cur].to;
+      if (rows == 2) return cur;
+    }
+    return -1;
+  };
+  TrustedLinks trusted{std::vector<char>(n, 0), std::vector<char>(n, 0)};
+  std::vector<int> left_path, right_path;
+  for (int a = 0; a < n; ++a) {
+    const int b = across[a];
+    if (b < 0) continue;
+    left_path.clear();
+    right_path.clear();
+    const int a2 = two_rows_down(a, &left_path), b2 = two_rows_down(b, &right_path);
+    if (a2 < 0 || b2 < 0 || across[a2] != b2) continue;
+    trusted.across[a] = trusted.across[a2] = 1;
+    for (const auto* path : {&left_path, &right_path})
+      for (int j : *path) trusted.down[j] = 1;
+  }
+  return trusted;
+}
+
+// Per junction: px to the nearest other line in its row, or 0.
+std::vector<double> PitchAtJunctions(const TrackNetwork& net) {
+  auto pitch_at = [&](int j) {
+    const cv::Point2d at = net.junctions[j].position;
+    const auto row = net.rows.Row(static_cast<int>(std::lround(at.y)));
+    // The row runs left to right: the nearest beyond kOwnLine on each side.
+    const auto right = std::partition_point(row.begin(), row.end(),
+                                            [&](const auto& r) { return r.x <= at.x + kOwnLine; });
+    const auto left = std::partition_point(row.begin(), row.end(),
+                                           [&](const auto& r) { return r.x < at.x - kOwnLine; });
+    double nearest = 0;
+    if (right != row.end()) nearest = right->x - at.x;
+    if (left != row.begin() && (nearest == 0 || at.x - std::prev(left)->x < nearest))
+      nearest = at.x - std::prev(left)->x;
+    return nearest;
+  };
+  std::vector<double> pitch(net.junctions.size());
+  for (int j = 0; j < static_cast<int>(pitch.size()); ++j) pitch[j] = pitch_at(j);
+  return pitch;
+}
+
+bool Within(double a, double b, double spread) { return a > b / spread && a < b * spread; }
+
+// The links between junctions, each kept twice: as LabelByConsensus reads
+// them, and in both ends' adjacency for DropDisagreeingLabels.
+class TrackLinks {
+ public:
+  TrackLinks(const TrackNetwork& net, const RowSpacings& spacing,
+             const TrackLabellingParams& params)
+      : net_(net),
+        spacing_(spacing),
+        params_(params),
+        adj_(net.junctions.size()),
+        pitch_(PitchAtJunctions(net)) {
+    std::vector<double> measured;
+    for (double v : pitch_)
+      if (v > 0) measured.push_back(v);
+    frame_pitch_ = measured.empty() ? 0.0 : Median(measured);
+  }
+
+  // Adds, for each junction, its step down its line track and its segment
+  // (`trusted`: those of closed bricks).
+  void AddStepsAndSegments(const std::vector<Step>& down, const std::vector<int>& across,
+                           const TrustedLinks& trusted);
+  // A line broken by a gap (net.line_below): adds the step from its last
+  // junction above to its first below, a whole number of rows apart at the
+  // line's spacing.
+  void AddLineGaps() {
+    for (size_t t = 0; t < net_.lines.size(); ++t) {
+      const int b = net_.line_below[t];
+      if (b < 0 || net_.junctions_on_line[t].empty() || net_.junctions_on_line[b].empty()) continue;
+      AddGapStep(net_.junctions_on_line[t].back(), net_.junctions_on_line[b].front());
+    }
+  }
+  // Adds the step from junction a down to b across a break in their line,
+  // where it spans a whole number of rows at a's line's spacing.
+  void AddGapStep(int a, int b) {
+    if (const auto rows = RowsBetween(net_, a, b, spacing_.Of(net_.junctions[a].line), params_))
+      Add(a, b, 0, *rows, false, false, true);
+  }
+
+  const std::vector<std::vector<Link>>& adj() const { return adj_; }
+  const std::vector<ConsensusLink>& links() const { return links_; }
+
+ private:
+  // A link is abrupt where the line pitch at its two ends differs beyond
+  // what a smooth surface gives and one end's lines crowd (a grazing
+  // surface, an occluding edge beside it).
+  bool Abrupt(int a, int b) const {
+    if (!(pitch_[a] > 0 && pitch_[b] > 0) || Within(pitch_[a], pitch_[b], kAbruptPitchSpread))
+      return false;
+    return std::min(pitch_[a], pitch_[b]) < kCrowded * frame_pitch_;
+  }
+  void Add(int a, int b, int dp, int dv, bool trusted, bool smooth = false, bool gap = false) {
+    adj_[a].push_back({b, dp, dv});
+    adj_[b].push_back({a, -dp, -dv});
+    links_.push_back({a, b, dp, dv, trusted, smooth, Abrupt(a, b), gap});
+  }
+
+  const TrackNetwork& net_;
+  const RowSpacings& spacing_;
+  const TrackLabellingParams& params_;
+  std::vector<std::vector<Link>> adj_;
+  std::vector<ConsensusLink> links_;
+  std::vector<double> pitch_;  // PitchAtJunctions
+  double frame_pitch_ = 0.0;   // the median of the pitches measured
+};
+
+void TrackLinks::AddStepsAndSegments(const std::vector<Step>& down, const std::vector<int>& across,
+                                     const TrustedLinks& trusted) {
+  const int n = static_cast<int>(down.size());
+  // A step is smooth where the step before or after it on its track has a
+  // row spacing within kSmoothSpread of its own, and the lines beside its
+  // two ends lie as far apart within kPitchSpread (an occluding edge
+  // crossed by the track changes the spacing or the pitch).
+  std::vector<int> up(n, -1);  // the junction whose step down reaches j
+  for (int j = 0; j < n; ++j)
+    if (down[j].to >= 0) up[down[j].to] = j;
+  auto per_row = [&](int j) {
+    return (net_.junctions[down[j].to].position.y - net_.junctions[j].position.y) / down[j].rows;
+  };
+  auto smooth_step = [&](int j) {
+    const double s = per_row(j);
+    const int k = down[j].to;
+    if (!(pitch_[j] > 0 && pitch_[k] > 0 && Within(pitch_[j], pitch_[k], kPitchSpread)))
+      return false;
+    return (up[j] >= 0 && Within(per_row(up[j]), s, kSmoothSpread)) ||
+           (down[k].to >= 0 && Within(per_row(k), s, kSmoothSpread));
+  };
+  for (int j = 0; j < n; ++j) {
+    if (const Step st = down[j]; st.to >= 0)
+      Add(j, st.to, 0, st.rows, trusted.down[j], smooth_step(j));
+    if (const int c = across[j]; c >= 0) Add(j, c, +1, 0, trusted.across[j]);
+  }
+}
+
+// Seeds: line 0's direct junctions in order down the image, two rows per
+// step of their spacing; two closer than one step cannot both be line
+// 0's junctions (a stray segment's end at a fold): neither seeds.
+std::vector<int> LineZeroSeeds(const TrackNetwork& net, const std::vector<int>& reference,
+                               const RowSpacings& spacing) {
+  std::vector<int> seeds;
+  for (int t : reference)
+    for (int j : net.junctions_on_line[t])
+      if (net.junctions[j].kind == JunctionKind::kDirect) seeds.push_back(j);
+  std::sort(seeds.begin(), seeds.end(), [&](int a, int b) {
+    return net.junctions[a].position.y < net.junctions[b].position.y;
+  });
+  auto steps_between = [&](int a, int b) {
+    const double gap = net.junctions[b].position.y - net.junctions[a].position.y;
+    const double s = spacing.Of(net.junctions[b].line);
+    if (!(s > 0)) return 1;  // no spacing measured anywhere: one step each
+    return static_cast<int>(std::lround(gap / (2 * s)));
+  };
+  std::vector<char> doubtful(seeds.size(), 0);
+  for (size_t i = 1; i < seeds.size(); ++i)
+    if (steps_between(seeds[i - 1], seeds[i]) < 1) doubtful[i - 1] = doubtful[i] = 1;
+  std::vector<int> kept;
+  for (size_t i = 0; i < seeds.size(); ++i)
+    if (!doubtful[i]) kept.push_back(seeds[i]);
+  return kept;
+}
+
+// Takes the consensus labels into `out`; a label outside the slide, or of
+// the other kind, is not reported but counted as a conflict.
+void TakeLabelsThatFit(const Consensus& consensus, const TrackNetwork& net,
+                       const pattern::PatternSpec& spec, TrackLabels* out) {
+  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j) {
+    if (consensus.p[j] == kUnlabelled) continue;
+    if (pattern::JunctionOnRowParity(spec, consensus.p[j], consensus.v[j]) !=
+        net.junctions[j].kind) {
+      ++out->conflicts;
+      continue;
+    }
+    out->p[j] = consensus.p[j];
+    out->v[j] = consensus.v[j];
+  }
+}
+
+// Thesis point O: shifts every v so that line 0's junction nearest the
+// centre row is v = 0.
+void SetPointO(const TrackNetwork& net, const std::vector<int>& seeds, double centre_row,
+               TrackLabels* out) {
+  int origin_v = 0;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (int s : seeds)
+    if (out->p[s] == 0 && std::abs(net.junctions[s].position.y - centre_row) < nearest) {
+      nearest = std::abs(net.junctions[s].position.y - centre_row);
+      origin_v = out->v[s];
+    }
+  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
+    if (out->v[j] != kUnlabelled) out->v[j] -= origin_v;
+}
+
+// Gives each line track the p most of its labelled junctions carry.
+void LabelLineTracks(const TrackNetwork& net, TrackLabels* out) {
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    std::map<int, int> votes;
+    for (int j : net.junctions_on_line[t])
+      if (out->p[j] != kUnlabelled) ++votes[out->p[j]];
+    if (votes.empty()) continue;
+    out->line_p[t] = std::max_element(votes.begin(), votes.end(), [](const auto& a, const auto& b) {
+                       return a.second < b.second;
+                     })->first;
+  }
+}
+
 }  // namespace
 
 bool TrackLabellingParams::IsValid(std::string* error) const {
@@ -173,196 +494,17 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   cancel.ThrowIfRequested("line 0");
   std::vector<char> is_reference(net.lines.size(), 0);
   for (int t : out.reference) is_reference[t] = 1;
+  const RowSpacings spacing = MeasureRowSpacings(net, is_reference, params);
+  out.row_spacing = spacing.frame;
 
-  // Row spacing: each line's own where it has enough steps, else the
-  // frame's. A stray junction splits a step in two shorter ones, so a line's
-  // own spacing is the median of its steps within kSpacingSpread of the
-  // frame's (the median of all steps).
-  std::vector<std::vector<double>> samples(net.lines.size());
-  std::vector<double> all_spacing;
-  for (size_t t = 0; t < net.lines.size(); ++t) {
-    int previous = -1;
-    for (int j : net.junctions_on_line[t]) {
-      if (is_reference[t] && net.junctions[j].kind != JunctionKind::kDirect) continue;
-      if (previous >= 0)
-        samples[t].push_back(RowSpacing(net.junctions[previous], net.junctions[j]));
-      previous = j;
-    }
-    all_spacing.insert(all_spacing.end(), samples[t].begin(), samples[t].end());
-  }
-  const double frame_spacing = Median(all_spacing);
-  out.row_spacing = frame_spacing;
-  std::vector<double> own_spacing(net.lines.size(), 0.0);
-  for (size_t t = 0; t < net.lines.size(); ++t) {
-    std::erase_if(samples[t], [&](double s) {
-      return !(s >= frame_spacing / kSpacingSpread && s <= frame_spacing * kSpacingSpread);
-    });
-    if (static_cast<int>(samples[t].size()) >= params.min_own_spacings)
-      own_spacing[t] = Median(samples[t]);
-  }
-  auto spacing_of = [&](int track) {
-    return own_spacing[track] > 0 ? own_spacing[track] : frame_spacing;
-  };
+  // The links: steps along lines, segments, steps across a line's gap.
+  const std::vector<Step> down = StepsDown(net, spacing, params);
+  const std::vector<int> across = SegmentPartners(net);
+  TrackLinks links(net, spacing, params);
+  links.AddStepsAndSegments(down, across, TrustClosedBricks(down, across));
+  links.AddLineGaps();
 
-  // The rows from junction a down to junction b on one line at `spacing` px
-  // a row; nullopt where the step fits no whole number of rows of its
-  // parity: it joins a false junction (a segment's end on the wrong line).
-  auto rows_between = [&](int a, int b, double spacing) -> std::optional<int> {
-    if (!(spacing > 0)) return std::nullopt;
-    const TrackJunction& ja = net.junctions[a];
-    const TrackJunction& jb = net.junctions[b];
-    const internal::RowCount step = internal::NearestRowCount(
-        jb.position.y - ja.position.y, spacing, ja.kind != jb.kind, params.max_rows);
-    if (step.miss > params.max_row_miss * spacing) return std::nullopt;
-    return step.rows;
-  };
-
-  // Steps along lines: consecutive junctions of a track, a whole number of rows apart.
-  struct Step {
-    int to = -1;
-    int rows = 0;
-  };
-  std::vector<Step> down(n);  // the next junction down the junction's line track
-  for (size_t t = 0; t < net.lines.size(); ++t) {
-    const std::vector<int>& on = net.junctions_on_line[t];
-    const double s = spacing_of(static_cast<int>(t));
-    for (size_t i = 1; i < on.size(); ++i)
-      if (const auto rows = rows_between(on[i - 1], on[i], s)) down[on[i - 1]] = {on[i], *rows};
-  }
-  // Segments: a direct junction at one end and a corresponding one at the
-  // other join lines p and p + 1.
-  std::vector<int> across(n, -1);  // for a direct junction: its segment's corresponding end
-  // Per segment track: its (direct, corresponding) junctions.
-  std::vector<std::pair<int, int>> ends(net.segments.size(), {-1, -1});
-  for (int j = 0; j < n; ++j) {
-    auto& e = ends[net.junctions[j].segment];
-    (net.junctions[j].kind == JunctionKind::kDirect ? e.first : e.second) = j;
-  }
-  for (const auto& [direct, corresponding] : ends)
-    if (direct >= 0 && corresponding >= 0) across[direct] = corresponding;
-
-  // Thesis 5.1.4.1: a complete loop. The brick below segment A-B (A direct
-  // on line p, B corresponding on p + 1) closes when both lines run down
-  // exactly two rows, through their median junctions, to the ends of one
-  // segment; its six links are trusted.
-  auto two_rows_down = [&](int j, std::vector<int>* path) {
-    int rows = 0;
-    for (int cur = j; rows < 2;) {
-      if (down[cur].to < 0) return -1;
-      rows += down[cur].rows;
-      path->push_back(cur);
-      cur = down[cur].to;
-      if (rows == 2) return cur;
-    }
-    return -1;
-  };
-  std::vector<char> trusted_down(n, 0), trusted_across(n, 0);  // the junction's step / segment
-  std::vector<int> left_path, right_path;
-  for (int a = 0; a < n; ++a) {
-    const int b = across[a];
-    if (b < 0) continue;
-    left_path.clear();
-    right_path.clear();
-    const int a2 = two_rows_down(a, &left_path), b2 = two_rows_down(b, &right_path);
-    if (a2 < 0 || b2 < 0 || across[a2] != b2) continue;
-    trusted_across[a] = trusted_across[a2] = 1;
-    for (const auto* path : {&left_path, &right_path})
-      for (int j : *path) trusted_down[j] = 1;
-  }
-  std::vector<std::vector<Link>> adj(n);
-  std::vector<ConsensusLink> links;
-  auto pitch_at = [&](int j) {  // px to the nearest other line in j's row, or 0
-    const cv::Point2d at = net.junctions[j].position;
-    const auto row = net.rows.Row(static_cast<int>(std::lround(at.y)));
-    // The row runs left to right: the nearest beyond kOwnLine on each side.
-    const auto right = std::partition_point(row.begin(), row.end(),
-                                            [&](const auto& r) { return r.x <= at.x + kOwnLine; });
-    const auto left = std::partition_point(row.begin(), row.end(),
-                                           [&](const auto& r) { return r.x < at.x - kOwnLine; });
-    double nearest = 0;
-    if (right != row.end()) nearest = right->x - at.x;
-    if (left != row.begin() && (nearest == 0 || at.x - std::prev(left)->x < nearest))
-      nearest = at.x - std::prev(left)->x;
-    return nearest;
-  };
-  std::vector<double> pitch(n);
-  for (int j = 0; j < n; ++j) pitch[j] = pitch_at(j);
-  auto within = [](double a, double b, double spread) { return a > b / spread && a < b * spread; };
-  // A link is abrupt where the line pitch at its two ends differs beyond
-  // what a smooth surface gives and one end's lines crowd (a grazing
-  // surface, an occluding edge beside it).
-  std::vector<double> measured;
-  for (double v : pitch)
-    if (v > 0) measured.push_back(v);
-  const double frame_pitch = measured.empty() ? 0.0 : Median(measured);
-  auto abrupt = [&](int a, int b) {
-    if (!(pitch[a] > 0 && pitch[b] > 0) || within(pitch[a], pitch[b], kAbruptPitchSpread))
-      return false;
-    return std::min(pitch[a], pitch[b]) < kCrowded * frame_pitch;
-  };
-  auto link = [&](int a, int b, int dp, int dv, bool trusted, bool smooth = false,
-                  bool gap = false) {
-    adj[a].push_back({b, dp, dv});
-    adj[b].push_back({a, -dp, -dv});
-    links.push_back({a, b, dp, dv, trusted, smooth, abrupt(a, b), gap});
-  };
-  // A step is smooth where the step before or after it on its track has a
-  // row spacing within kSmoothSpread of its own, and the lines beside its
-  // two ends lie as far apart within kPitchSpread (an occluding edge
-  // crossed by the track changes the spacing or the pitch).
-  std::vector<int> up(n, -1);  // the junction whose step down reaches j
-  for (int j = 0; j < n; ++j)
-    if (down[j].to >= 0) up[down[j].to] = j;
-  auto per_row = [&](int j) {
-    return (net.junctions[down[j].to].position.y - net.junctions[j].position.y) / down[j].rows;
-  };
-  auto smooth_step = [&](int j) {
-    const double s = per_row(j);
-    const int k = down[j].to;
-    if (!(pitch[j] > 0 && pitch[k] > 0 && within(pitch[j], pitch[k], kPitchSpread))) return false;
-    return (up[j] >= 0 && within(per_row(up[j]), s, kSmoothSpread)) ||
-           (down[k].to >= 0 && within(per_row(k), s, kSmoothSpread));
-  };
-  for (int j = 0; j < n; ++j) {
-    if (const Step st = down[j]; st.to >= 0)
-      link(j, st.to, 0, st.rows, trusted_down[j], smooth_step(j));
-    if (const int c = across[j]; c >= 0) link(j, c, +1, 0, trusted_across[j]);
-  }
-  // A line broken by a gap (net.line_below): its last junction above and
-  // first below, a whole number of rows apart at the line's spacing.
-  auto gap_step = [&](int a, int b) {
-    if (const auto rows = rows_between(a, b, spacing_of(net.junctions[a].line)))
-      link(a, b, 0, *rows, false, false, true);
-  };
-  for (size_t t = 0; t < net.lines.size(); ++t) {
-    const int b = net.line_below[t];
-    if (b < 0 || net.junctions_on_line[t].empty() || net.junctions_on_line[b].empty()) continue;
-    gap_step(net.junctions_on_line[t].back(), net.junctions_on_line[b].front());
-  }
-
-  // Seeds: line 0's direct junctions in order down the image, two rows per
-  // step of their spacing; two closer than one step cannot both be line
-  // 0's junctions (a stray segment's end at a fold): neither seeds.
-  std::vector<int> seeds;
-  for (int t : out.reference)
-    for (int j : net.junctions_on_line[t])
-      if (net.junctions[j].kind == JunctionKind::kDirect) seeds.push_back(j);
-  std::sort(seeds.begin(), seeds.end(), [&](int a, int b) {
-    return net.junctions[a].position.y < net.junctions[b].position.y;
-  });
-  auto steps_between = [&](int a, int b) {
-    const double gap = net.junctions[b].position.y - net.junctions[a].position.y;
-    const double s = spacing_of(net.junctions[b].line);
-    if (!(s > 0)) return 1;  // no spacing measured anywhere: one step each
-    return static_cast<int>(std::lround(gap / (2 * s)));
-  };
-  std::vector<char> doubtful(seeds.size(), 0);
-  for (size_t i = 1; i < seeds.size(); ++i)
-    if (steps_between(seeds[i - 1], seeds[i]) < 1) doubtful[i - 1] = doubtful[i] = 1;
-  std::vector<int> kept;
-  for (size_t i = 0; i < seeds.size(); ++i)
-    if (!doubtful[i]) kept.push_back(seeds[i]);
-  seeds.swap(kept);
+  const std::vector<int> seeds = LineZeroSeeds(net, out.reference, spacing);
   if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
     out.error = "no reference line (line 0): it carries " + std::to_string(seeds.size()) +
                 " junctions that number its rows";
@@ -372,7 +514,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // joins (thesis 5.2.1): the rows counted from the gap's length.
   for (size_t i = 1; i < seeds.size(); ++i) {
     const int above = net.junctions[seeds[i - 1]].line, below = net.junctions[seeds[i]].line;
-    if (above != below && net.line_below[above] != below) gap_step(seeds[i - 1], seeds[i]);
+    if (above != below && net.line_below[above] != below) links.AddGapStep(seeds[i - 1], seeds[i]);
   }
 
   cancel.ThrowIfRequested("the links between junctions");
@@ -381,57 +523,28 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   std::vector<char> odd_kind(n);
   for (int j = 0; j < n; ++j) odd_kind[j] = net.junctions[j].kind == JunctionKind::kCorresponding;
   const Consensus consensus =
-      LabelByConsensus(odd_kind, links, seeds, params.min_reference_junctions,
+      LabelByConsensus(odd_kind, links.links(), seeds, params.min_reference_junctions,
                        {params.min_support, params.max_dissent});
   if (consensus.p.empty() || std::none_of(consensus.p.begin(), consensus.p.end(),
                                           [](int p) { return p != kUnlabelled; })) {
     out.error = "no reference line (line 0): its junctions do not agree on their labels";
     return out;
   }
-  for (int j = 0; j < n; ++j) {
-    if (consensus.p[j] == kUnlabelled) continue;
-    // A label outside the slide, or of the other kind, is not reported.
-    if (pattern::JunctionOnRowParity(spec, consensus.p[j], consensus.v[j]) !=
-        net.junctions[j].kind) {
-      ++out.conflicts;
-      continue;
-    }
-    out.p[j] = consensus.p[j];
-    out.v[j] = consensus.v[j];
-  }
+  TakeLabelsThatFit(consensus, net, spec, &out);
   const double centre_row = (static_cast<int>(net.rows.row_start.size()) - 2) / 2.0;
   cancel.ThrowIfRequested("the consensus of labels");
 
   // A label most of whose neighbours disagree is dropped, not guessed.
   out.conflicts += internal::DropDisagreeingLabels(
-      adj,
+      links.adj(),
       [&](int j) {
         return out.p[j] == kUnlabelled ? std::nullopt
                                        : std::optional(std::make_pair(out.p[j], out.v[j]));
       },
       [&](int j) { out.p[j] = out.v[j] = kUnlabelled; });
 
-  // Thesis point O: line 0's junction nearest the centre row is v = 0.
-  int origin_v = 0;
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int s : seeds)
-    if (out.p[s] == 0 && std::abs(net.junctions[s].position.y - centre_row) < nearest) {
-      nearest = std::abs(net.junctions[s].position.y - centre_row);
-      origin_v = out.v[s];
-    }
-  for (int j = 0; j < n; ++j)
-    if (out.v[j] != kUnlabelled) out.v[j] -= origin_v;
-
-  // Each line track takes the p most of its labelled junctions carry.
-  for (size_t t = 0; t < net.lines.size(); ++t) {
-    std::map<int, int> votes;
-    for (int j : net.junctions_on_line[t])
-      if (out.p[j] != kUnlabelled) ++votes[out.p[j]];
-    if (votes.empty()) continue;
-    out.line_p[t] = std::max_element(votes.begin(), votes.end(), [](const auto& a, const auto& b) {
-                      return a.second < b.second;
-                    })->first;
-  }
+  SetPointO(net, seeds, centre_row, &out);
+  LabelLineTracks(net, &out);
   out.ok = true;
   return out;
 }

@@ -91,6 +91,8 @@ class SkeletonGraph {
   int EdgeAt(cv::Point p) const;
 
  private:
+  class Builder;  // the steps of Build (skeleton_graph.cpp)
+
   cv::Size size_;
   std::vector<SkeletonNode> nodes_;
   std::vector<SkeletonEdge> edges_;
