@@ -264,6 +264,24 @@ def failures(row):
     return why
 
 
+def print_table(columns, rows, failures_of, cells, note=lambda r, why: ""):
+    """Prints one line per frame: the label figures, `cells(r)` under the
+    `columns` heading, and the bounds it misses; returns how many miss any."""
+    print(f"{'frame':22} {'truth':>5} {'right':>6} {'recall':>7} {'wrong':>5} {'spur':>5} "
+          f"{columns}  bounds")
+    bad = 0
+    for r in rows:
+        why = failures_of(r)
+        bad += bool(why)
+        verdict = ("; ".join(why) or "ok") + note(r, why)
+        if r["refused"]:
+            print(f"{r['frame']:22} refused (exit {r['exit']}): {r['reason'][:60]}  {verdict}")
+            continue
+        print(f"{r['frame']:22} {r['truth']:5d} {r['right']:6d} {r['recall']:7.3f} {r['wrong']:5d} "
+              f"{r['spurious']:5d} {cells(r)}  {verdict}")
+    return bad
+
+
 def calibrated_failures(row):
     """The calibrated bounds `row` misses, as phrases (empty: it meets them)."""
     if row["expect_failure"]:
@@ -299,23 +317,17 @@ def report_calibrated(bsls, corpus, work):
     for side in ("left", "right"):
         if not calibration[side]:
             print(f"calibration of the {side} side refused: {calibration[side + '_why']}")
-    rows, bad = [], 0
-    print(f"{'frame':22} {'truth':>5} {'right':>6} {'recall':>7} {'wrong':>5} {'spur':>5} "
-          f"{'rms mm':>7} {'p95 mm':>7} {'cover':>6}  bounds")
+    rows = []
     for obj, side, folder in frames(corpus):
         r = score_frame_calibrated(bsls, obj, side, folder, work, calibration)
         r["object_name"] = obj
         rows.append(r)
-        why = calibrated_failures(r)
-        bad += bool(why)
-        if r["refused"]:
-            print(f"{r['frame']:22} refused (exit {r['exit']}): {r['reason'][:60]}"
-                  f"  {'; '.join(why) or 'ok'}")
-            continue
+
+    def cells(r):
         surf = r["surface"] or {"rms_mm": float("nan"), "p95_mm": float("nan"), "coverage": 0.0}
-        print(f"{r['frame']:22} {r['truth']:5d} {r['right']:6d} {r['recall']:7.3f} {r['wrong']:5d} "
-              f"{r['spurious']:5d} {surf['rms_mm']:7.3f} {surf['p95_mm']:7.3f} "
-              f"{surf['coverage']:6.3f}  {'; '.join(why) or 'ok'}")
+        return f"{surf['rms_mm']:7.3f} {surf['p95_mm']:7.3f} {surf['coverage']:6.3f}"
+
+    bad = print_table(f"{'rms mm':>7} {'p95 mm':>7} {'cover':>6}", rows, calibrated_failures, cells)
     print(f"frames meeting the calibrated bounds: {len(rows) - bad} of {len(rows)}")
     return rows, bad
 
@@ -348,20 +360,14 @@ def main():
             row = score_frame(a.bsls, obj, side, folder, work)
             row["object_name"] = obj
             rows.append(row)
-    bad = 0
-    print(f"{'frame':22} {'truth':>5} {'right':>6} {'recall':>7} {'wrong':>5} {'spur':>5} "
-          f"{'object':>7} {'lineRMS':>7}  bounds")
-    for r in rows:
-        why = failures(r)
-        bad += bool(why)
-        if r["refused"]:
-            print(f"{r['frame']:22} refused (exit {r['exit']}): {r['reason'][:60]}"
-                  f"  {'; '.join(why) or 'ok'}")
-            continue
+    def cells(r):
         obj = "" if r["object"] is None else f"{r['object']:.3f}"
-        short = (" (goal 0.98)" if r["frame"] in FACE_RECALL_NOW and not why else "")
-        print(f"{r['frame']:22} {r['truth']:5d} {r['right']:6d} {r['recall']:7.3f} {r['wrong']:5d} "
-              f"{r['spurious']:5d} {obj:>7} {r['line_rms']:7.3f}  {'; '.join(why) or 'ok'}{short}")
+        return f"{obj:>7} {r['line_rms']:7.3f}"
+
+    def note(r, why):
+        return " (goal 0.98)" if r["frame"] in FACE_RECALL_NOW and not why else ""
+
+    bad = print_table(f"{'object':>7} {'lineRMS':>7}", rows, failures, cells, note)
     print(f"frames meeting the bounds: {len(rows) - bad} of {len(rows)}")
     if a.json:
         with open(a.json, "w") as f:
