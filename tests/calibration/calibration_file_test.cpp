@@ -11,7 +11,7 @@
 #include <sstream>
 #include <string>
 
-#include "bsls/io/frame_file.h"
+#include "bsls/common/errors.h"
 #include "bsls/testing/calibration_sessions.h"
 
 namespace bsls::calibration {
@@ -251,7 +251,7 @@ TEST_F(CalibrationFile, SaveReplacesAWholeFileAndLeavesNothingOnFailure) {
   for (const auto& entry : fs::directory_iterator(dir_)) files += entry.is_regular_file();
   EXPECT_EQ(files, 1);  // no temporary left behind
   EXPECT_THROW(SaveCalibration(dir_ / "missing_folder" / "left.yaml", Calibration(), kVersion),
-               io::OutputError);
+               OutputError);
   EXPECT_FALSE(fs::exists(dir_ / "missing_folder"));
 }
 

@@ -2,7 +2,6 @@
 // socket and store, driven over gRPC.
 #include <grp.h>
 #include <gtest/gtest.h>
-#include <openssl/sha.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -16,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "bsls/common/sha256.h"
 #include "bsls/testing/certificates.h"
 #include "bsls/testing/raw_connections.h"
 #include "daemon_process.h"
@@ -32,24 +32,12 @@ constexpr const char* kSimulatedSlides = "slides:\n  backend: simulated\n";
 // Bytes that are no message of any type: field 1, length-delimited, with a
 // length of 4 GiB that does not follow.
 
-std::string Hex(const unsigned char* digest, std::size_t n) {
-  static const char* kDigits = "0123456789abcdef";
-  std::string out;
-  for (std::size_t i = 0; i < n; ++i) {
-    out += kDigits[digest[i] >> 4];
-    out += kDigits[digest[i] & 15];
-  }
-  return out;
-}
-
 // SHA-256 of a frame's packed pixels (what the store hashes).
 std::string PixelHash(const v1::Frame& frame) {
   std::string packed;
   for (std::uint32_t y = 0; y < frame.height(); ++y)
     packed.append(frame.pixels(), static_cast<std::size_t>(y) * frame.stride(), frame.width());
-  unsigned char digest[SHA256_DIGEST_LENGTH];
-  SHA256(reinterpret_cast<const unsigned char*>(packed.data()), packed.size(), digest);
-  return Hex(digest, sizeof digest);
+  return Sha256Hex(packed);
 }
 
 v1::GrabResponse GrabBoth(v1::CaptureDaemon::Stub& stub, const std::string& session,
