@@ -30,7 +30,6 @@
 #include <thread>
 #include <vector>
 
-#include "bsls/rpc/unix_acceptor.h"
 #include "bsls/testing/raw_connections.h"
 #include "bsls/v1/capture.grpc.pb.h"
 
@@ -124,15 +123,14 @@ TEST(UnixListener, OutOfDescriptorsItShedsCallersAndDoesNotSpin) {
   EXPECT_GE(closed, 20) << "callers beyond the descriptor limit were not shed";
 }
 
-// A Create that fails after the socket is bound (here pipe2, out of
-// descriptors) removes the socket file it made: a file left behind would
-// be found stale and replaced by the next start, but a daemon that failed
-// to start must not leave it for others to connect to. Run in a child
+// A Create that fails after the socket is bound (here rpc::UnixAcceptor's
+// pipe2, out of descriptors) removes the socket file it made: a daemon that
+// failed to start leaves no file for callers to find. Run in a child
 // process whose descriptor limit leaves exactly one descriptor free: the
 // socket takes it, the wake pipe finds none.
-TEST(UnixAcceptor, AFailedCreateLeavesNoSocketFile) {
+TEST(UnixListener, AFailedCreateLeavesNoSocketFile) {
   const std::string path = (std::filesystem::temp_directory_path() /
-                            ("bsls_acceptor_pipe_" + std::to_string(::getpid()) + ".sock"))
+                            ("bsls_listener_pipe_" + std::to_string(::getpid()) + ".sock"))
                                .string();
   std::filesystem::remove(path);
   const pid_t child = ::fork();
@@ -145,14 +143,10 @@ TEST(UnixAcceptor, AFailedCreateLeavesNoSocketFile) {
     for (int fd; (fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC)) >= 0;) filler.push_back(fd);
     if (errno != EMFILE || filler.empty()) ::_exit(3);
     ::close(filler.back());  // the one descriptor free
-    rpc::UnixAcceptorOptions options;
-    options.path = path;
-    options.mode = 0600;
-    rpc::UnixAcceptorError error;
-    const std::unique_ptr<rpc::UnixAcceptor> acceptor = rpc::UnixAcceptor::Create(options, &error);
-    if (acceptor) ::_exit(4);
-    if (error.kind != rpc::UnixAcceptorError::Kind::kSystem ||
-        error.message.find("pipe") == std::string::npos)
+    auto listener = UnixListener::Create({path, 0600});
+    if (listener.ok()) ::_exit(4);
+    if (listener.status().code() != ErrorCode::kUnavailable ||
+        listener.status().message().find("pipe") == std::string::npos)
       ::_exit(5);
     ::_exit(std::filesystem::exists(path) ? 6 : 0);
   }
