@@ -724,6 +724,29 @@ TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
   EXPECT_EQ(code, 0) << output;
 }
 
+// bslsd reads the head of each calibration file (format, version, side):
+// a file of the other side, or of another format, stops the start with the
+// key and the reason, before anything is served.
+TEST(BslsdConfig, ACalibrationOfTheOtherSideOrFormatIsRefusedAtStart) {
+  const fs::path dir = MakeDaemonDir("calibration");
+  const fs::path config = WriteDaemonConfig(dir);
+  const fs::path right = dir / "right.yaml";
+  std::ofstream(right) << "format: bsls-calibration\nformat_version: 1\n"
+                          "software_version: test\nside: right\n";
+  const fs::path other = dir / "other.yaml";
+  std::ofstream(other) << "format: other\nformat_version: 1\nside: left\n";
+  for (const auto& [file, expected] :
+       {std::pair{right, std::string("is a calibration of the other side")},
+        std::pair{other, std::string("format is 'other'")}}) {
+    const auto [code, output] =
+        RunCommand("timeout 60 " + std::string(BSLSD_PATH) + " --config " + config.string() +
+                   " --set processing.calibration_left=" + file.string());
+    EXPECT_EQ(code, 78) << output;
+    EXPECT_NE(output.find("processing.calibration_left"), std::string::npos) << output;
+    EXPECT_NE(output.find(expected), std::string::npos) << output;
+  }
+}
+
 // Started as root with a `user` that does not exist, bslsd
 // refuses to start (it never serves as root by accident) and names it.
 TEST(BslsdConfig, StartedAsRootWithAnUnknownUserItRefusesToStart) {
