@@ -10,7 +10,7 @@
 #include "bsls/calibration/calibration_report.h"
 #include "bsls/calibration/manifest.h"
 #include "bsls/calibration/side_calibration.h"
-#include "bsls/io/frame_file.h"
+#include "bsls/common/atomic_file.h"
 #include "command.h"
 #include "daemon_connection.h"
 
@@ -64,8 +64,8 @@ void RunCalibrateRemote(const CalibrateOptions& o) {
                        ProgressPrinter(o.quiet));
   CheckWork(out.status, o.manifest, o.server);
   const nlohmann::json report = nlohmann::json::parse(out.files.at("calibration-report.json"));
-  if (!o.report.empty()) io::WriteFileAtomically(o.report, out.files.at("calibration-report.json"));
-  io::WriteFileAtomically(o.output, out.files.at("calibration.yaml"));
+  if (!o.report.empty()) WriteFileAtomically(o.report, out.files.at("calibration-report.json"));
+  WriteFileAtomically(o.output, out.files.at("calibration.yaml"));
   if (o.json) {
     nlohmann::json summary = report;
     summary["calibration_id"] = out.result.calibration_id();
@@ -117,8 +117,8 @@ void RunCalibrate(const CalibrateOptions& o) {
   // Both outputs are rendered before either is written.
   const std::string yaml = calibration::CalibrationToYaml(result, BSLS_VERSION);
   const std::string report = calibration::CalibrationReport(result).dump(1) + "\n";
-  if (!o.report.empty()) io::WriteFileAtomically(o.report, report);
-  io::WriteFileAtomically(o.output, yaml);
+  if (!o.report.empty()) WriteFileAtomically(o.report, report);
+  WriteFileAtomically(o.output, yaml);
   if (o.json) {
     std::cout << calibration::CalibrationReport(result).dump() << "\n";
     return;

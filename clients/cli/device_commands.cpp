@@ -12,6 +12,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/highgui.hpp>
 
+#include "bsls/common/atomic_file.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/rpc/artifacts.h"
 #include "bsls/rpc/frame_message.h"
@@ -372,7 +373,7 @@ void FetchResults(const DeviceOptions& options, const GetArgs& args) {
   MakeFolder(args.out);
   for (const auto& [name, bytes] : assembler.files()) {
     const std::string path = args.out + "/" + name;
-    io::WriteFileAtomically(path, bytes);
+    WriteFileAtomically(path, bytes);
     if (options.json)
       std::cout << nlohmann::json{{"file", path}, {"bytes", bytes.size()}}.dump() << "\n";
     else

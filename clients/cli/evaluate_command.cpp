@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "bsls/io/frame_file.h"
+#include "bsls/common/errors.h"
 #include "bsls/simulator/evaluation.h"
 #include "command.h"
 
@@ -25,12 +25,12 @@ struct EvaluateOptions {
 
 nlohmann::json ReadJson(const std::string& path) {
   std::ifstream in(path);
-  if (!in) throw io::InputError(path + ": cannot be opened");
+  if (!in) throw InputError(path + ": cannot be opened");
   try {
     return nlohmann::json::parse(in);
   } catch (const nlohmann::json::parse_error& e) {
     // The parser's own message quotes the bytes it read, which may be binary.
-    throw io::InputError(path + ": not valid JSON (error at byte " + std::to_string(e.byte) + ")");
+    throw InputError(path + ": not valid JSON (error at byte " + std::to_string(e.byte) + ")");
   }
 }
 
@@ -55,7 +55,7 @@ void ReadLabels(const std::string& path, const char* what,
       lines->push_back(std::move(line));
     }
   } catch (const nlohmann::json::exception& e) {
-    throw io::InputError(path + ": not a " + what + " file: " + e.what());
+    throw InputError(path + ": not a " + what + " file: " + e.what());
   }
 }
 

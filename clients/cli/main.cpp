@@ -4,7 +4,7 @@
 #include <exception>
 #include <iostream>
 
-#include "bsls/io/frame_file.h"
+#include "bsls/common/errors.h"
 #include "command.h"
 
 int main(int argc, char** argv) {
@@ -34,10 +34,10 @@ int main(int argc, char** argv) {
   } catch (const CommandError& e) {
     std::cerr << "bsls: " << e.what() << "\n";
     return e.code();
-  } catch (const bsls::io::InputError& e) {
+  } catch (const bsls::InputError& e) {
     std::cerr << "bsls: " << e.what() << "\n";
     return kExitInput;
-  } catch (const bsls::io::OutputError& e) {
+  } catch (const bsls::OutputError& e) {
     std::cerr << "bsls: " << e.what() << "\n";
     return kExitOutput;
   } catch (const std::exception& e) {

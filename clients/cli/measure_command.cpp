@@ -15,7 +15,7 @@
 #include <tuple>
 #include <vector>
 
-#include "bsls/io/frame_file.h"
+#include "bsls/common/atomic_file.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/measurement/measurement_error.h"
 #include "bsls/measurement/plan.h"
@@ -119,7 +119,7 @@ void RunMeasureRemote(const MeasureOptions& o, const measurement::MeasurementPla
                     row.at("unit")});
   measured.erase("table");
   report.update(measured);
-  if (!o.json.empty()) io::WriteFileAtomically(o.json, report.dump(2) + "\n");
+  if (!o.json.empty()) WriteFileAtomically(o.json, report.dump(2) + "\n");
   std::cout << measurement::FormatTable(rows, o.decimals);
 }
 
@@ -172,7 +172,7 @@ void RunMeasure(const MeasureOptions& o) {
       {"surface", o.surface},
       {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
   report.update(outcome.report);
-  if (!o.json.empty()) io::WriteFileAtomically(o.json, report.dump(2) + "\n");
+  if (!o.json.empty()) WriteFileAtomically(o.json, report.dump(2) + "\n");
   std::cout << measurement::FormatTable(outcome.rows, o.decimals);
 }
 

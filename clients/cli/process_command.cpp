@@ -8,6 +8,7 @@
 #include <string>
 
 #include "bsls/calibration/calibration_file.h"
+#include "bsls/common/atomic_file.h"
 #include "bsls/decoder/decode_output.h"
 #include "bsls/decoder/decoder.h"
 #include "bsls/io/frame_file.h"
@@ -112,9 +113,9 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   const v1::SideSummary& s = out.result.sides(0);
   if (!o.calibration.empty() && !s.q_absolute())
     std::cerr << "bsls: note: " << o.image << ": q stays relative: " << s.rows_note() << "\n";
-  io::WriteFileAtomically(o.junctions, out.files.at("junctions.json"));
-  if (!o.overlay.empty()) io::WriteFileAtomically(o.overlay, out.files.at("overlay.png"));
-  if (!o.surface.empty()) io::WriteFileAtomically(o.surface, out.files.at("surface.ply"));
+  WriteFileAtomically(o.junctions, out.files.at("junctions.json"));
+  if (!o.overlay.empty()) WriteFileAtomically(o.overlay, out.files.at("overlay.png"));
+  if (!o.surface.empty()) WriteFileAtomically(o.surface, out.files.at("surface.ply"));
   double total_ms = 0;
   for (const v1::StageTime& t : out.result.times())
     if (t.stage() == "decode") total_ms = t.ms();
@@ -192,7 +193,7 @@ void RunProcess(const ProcessOptions& o) {
   if (cal && !result.q_absolute)
     std::cerr << "bsls: note: " << o.image << ": q stays relative: " << outcome.rows_note << "\n";
 
-  io::WriteFileAtomically(o.junctions, decoder::ToJson(result).dump(1) + "\n");
+  WriteFileAtomically(o.junctions, decoder::ToJson(result).dump(1) + "\n");
   if (!o.overlay.empty()) io::WritePngAtomically(o.overlay, decoder::RenderOverlay(frame, result));
   if (outcome.surface)
     io::WriteSurface(o.surface, *outcome.surface,

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "bsls/calibration/side_calibration.h"
+#include "bsls/common/atomic_file.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/rpc/frame_message.h"
@@ -111,7 +112,7 @@ void RunReconstructRemote(const ReconstructOptions& o) {
   };
   if (!o.left_surface.empty()) write(o.left_surface, "left.ply");
   if (!o.right_surface.empty()) write(o.right_surface, "right.ply");
-  if (!o.report.empty()) io::WriteFileAtomically(o.report, report.dump(2) + "\n");
+  if (!o.report.empty()) WriteFileAtomically(o.report, report.dump(2) + "\n");
   write(o.output, "surface.ply");
   if (o.json)
     std::cout << report.dump() << "\n";
@@ -159,7 +160,7 @@ void RunReconstruct(const ReconstructOptions& o) {
   // Side surfaces first: the joined one, written last, says the run is complete.
   if (!o.left_surface.empty()) io::WriteSurface(o.left_surface, *s.left.surface, encoding);
   if (!o.right_surface.empty()) io::WriteSurface(o.right_surface, *s.right.surface, encoding);
-  if (!o.report.empty()) io::WriteFileAtomically(o.report, report.dump(2) + "\n");
+  if (!o.report.empty()) WriteFileAtomically(o.report, report.dump(2) + "\n");
   io::WriteSurface(o.output, s.joined.mesh, encoding);
   if (o.json)
     std::cout << report.dump() << "\n";

@@ -7,7 +7,7 @@
 #include <string>
 #include <system_error>
 
-#include "bsls/io/frame_file.h"
+#include "bsls/common/errors.h"
 #include "bsls/simulator/calibration_session.h"
 #include "command.h"
 
@@ -33,19 +33,19 @@ struct SimulateCalibrationOptions {
 // filled under a temporary name and renamed when complete, so it appears
 // whole or not at all; into an existing folder every file is written
 // atomically and the manifest last.
-// Throws io::OutputError when `folder` cannot receive a session: checked
+// Throws OutputError when `folder` cannot receive a session: checked
 // before anything is rendered.
 void CheckOutputFolder(const fs::path& folder) {
   std::error_code ec;
   if (fs::exists(folder, ec)) {
     if (!fs::is_directory(folder, ec))
-      throw io::OutputError(folder.string() + ": exists and is not a folder");
+      throw OutputError(folder.string() + ": exists and is not a folder");
     return;
   }
   const fs::path parent = folder.has_parent_path() ? folder.parent_path() : fs::path(".");
   if (!fs::is_directory(parent, ec))
-    throw io::OutputError(folder.string() + ": the parent folder " + parent.string() +
-                          " does not exist");
+    throw OutputError(folder.string() + ": the parent folder " + parent.string() +
+                      " does not exist");
 }
 
 fs::path WriteSession(const simulator::CalibrationSession& session, const fs::path& folder) {
@@ -62,7 +62,7 @@ fs::path WriteSession(const simulator::CalibrationSession& session, const fs::pa
     fs::remove_all(temp, ec);
     throw;
   }
-  if (ec) throw io::OutputError(folder.string() + ": cannot move the session in place");
+  if (ec) throw OutputError(folder.string() + ": cannot move the session in place");
   return folder / simulator::kSessionManifestName;
 }
 

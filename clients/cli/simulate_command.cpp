@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/atomic_file.h"
+#include "bsls/common/errors.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
@@ -77,7 +79,7 @@ void RunSimulate(const SimulateOptions& o) {
   try {
     scene = simulator::ThesisScene(*side, *kind, options);
   } catch (const simulator::MeshLoadError& e) {
-    throw io::InputError(e.what());
+    throw InputError(e.what());
   } catch (const std::invalid_argument& e) {  // overlapping lesions
     throw CommandError(kExitUsage, e.what());
   }
@@ -89,8 +91,7 @@ void RunSimulate(const SimulateOptions& o) {
   if (!params.IsValid(&why)) throw CommandError(kExitUsage, why);
   const simulator::Frame frame = simulator::Render(scene, params);
   io::WritePngAtomically(o.output, frame.image);
-  if (!o.truth.empty())
-    io::WriteFileAtomically(o.truth, simulator::ToJson(frame.truth).dump(1) + "\n");
+  if (!o.truth.empty()) WriteFileAtomically(o.truth, simulator::ToJson(frame.truth).dump(1) + "\n");
   int visible = 0;
   for (const auto& j : frame.truth.junctions) visible += j.visible;
   std::printf("%s: %s, %s side, %dx%d, noise %.1f, %d visible junctions\n", o.output.c_str(),

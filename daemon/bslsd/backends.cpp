@@ -13,10 +13,6 @@
 
 namespace bsls::bslsd {
 
-using framestore::ErrorCode;
-using framestore::Result;
-using framestore::Status;
-
 namespace {
 
 framestore::PortRange IsaPorts(std::uint16_t base) { return {base, 4}; }

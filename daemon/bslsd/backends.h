@@ -22,17 +22,18 @@ struct PrivilegedDevices {
 
 // Opens the port I/O of the ISA backend (nothing for the others). A kernel
 // lockdown or a missing CAP_SYS_RAWIO is kPermissionDenied with the cause.
-framestore::Result<PrivilegedDevices> OpenPrivileged(const Config& config);
+Result<PrivilegedDevices> OpenPrivileged(const Config& config);
 
 // The configured slide controller (nullptr for slides.backend none); its
 // state changes are published on `events`.
-framestore::Result<std::unique_ptr<slides::SlideController>> OpenSlides(const Config& config,
-                                                                        service::EventHub* events);
+Result<std::unique_ptr<slides::SlideController>> OpenSlides(const Config& config,
+                                                            service::EventHub* events);
 
 // The configured framestore. The simulated backends show the slide that
 // `slides` has in place (when given).
-framestore::Result<std::unique_ptr<framestore::Framestore>> OpenFramestore(
-    const Config& config, PrivilegedDevices privileged, slides::SlideController* slides);
+Result<std::unique_ptr<framestore::Framestore>> OpenFramestore(const Config& config,
+                                                               PrivilegedDevices privileged,
+                                                               slides::SlideController* slides);
 
 }  // namespace bsls::bslsd
 

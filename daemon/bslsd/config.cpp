@@ -9,32 +9,26 @@
 #include <set>
 #include <sstream>
 
-#include "bsls/io/config_document.h"
+#include "bsls/config/config_document.h"
 #include "bsls/rpc/tls.h"
 
 namespace bsls::bslsd {
 
-using framestore::ErrorCode;
-using framestore::Result;
-using framestore::Status;
-
 namespace {
 
 [[noreturn]] void Fail(const std::string& key, const std::string& reason) {
-  throw io::ConfigKeyError(key, reason);
+  throw ConfigKeyError(key, reason);
 }
-
-using io::OnlyKeys;
 
 template <typename T>
 void Read(const YAML::Node& parent, const std::string& where, const char* key, T& out) {
-  io::ReadKey(parent, where, key, out);
+  ReadKey(parent, where, key, out);
 }
 
 template <typename Number>
 void ReadInRange(const YAML::Node& parent, const std::string& where, const char* key, Number& out,
                  Number min, Number max) {
-  io::ReadKeyInRange(parent, where, key, out, min, max);
+  ReadKeyInRange(parent, where, key, out, min, max);
 }
 
 service::Role RoleFrom(const std::string& key, const std::string& text) {
@@ -95,18 +89,12 @@ void ParseStore(const YAML::Node& node, store::CaptureStoreOptions& out) {
 }
 
 void ParseListen(const YAML::Node& node, ListenConfig& out) {
-  std::set<std::string> keys = {"unix_socket",
-                                "socket_group",
-                                "socket_mode",
-                                "max_connections",
-                                "max_connections_per_user",
-                                "tcp",
-                                "tls_certificate",
-                                "tls_key",
-                                "tls_client_ca",
-                                "max_receive_message_bytes",
-                                "max_send_message_bytes"};
-  keys.insert(rpc::Http2LimitKeys().begin(), rpc::Http2LimitKeys().end());
+  std::set<std::string> keys = {
+      "unix_socket",           "socket_group", "socket_mode",   "tcp",
+      "tls_certificate",       "tls_key",      "tls_client_ca", "max_receive_message_bytes",
+      "max_send_message_bytes"};
+  for (const auto& key : rpc::ConnectionLimitKeys()) keys.insert(key.name);
+  for (const auto& key : rpc::Http2LimitKeys()) keys.insert(key.name);
   OnlyKeys(node, "listen", keys);
   if (!node) return;
   Read(node, "listen", "unix_socket", out.unix_socket);
@@ -124,9 +112,8 @@ void ParseListen(const YAML::Node& node, ListenConfig& out) {
       Fail("listen.socket_mode", "'" + text + "' is not an octal mode 000..777");
     out.socket_mode = mode;  // a world-writable one is refused by Validate
   }
-  ReadInRange(node, "listen", "max_connections", out.max_connections, 1, 65536);
-  ReadInRange(node, "listen", "max_connections_per_user", out.max_connections_per_user, 1, 65536);
-  rpc::ReadHttp2Limits(node, "listen", out.http2);
+  ReadKeysInRange(node, "listen", rpc::ConnectionLimitKeys(), out.connections);
+  ReadKeysInRange(node, "listen", rpc::Http2LimitKeys(), out.http2);
   Read(node, "listen", "tcp", out.tcp);
   Read(node, "listen", "tls_certificate", out.tls_certificate);
   Read(node, "listen", "tls_key", out.tls_key);
@@ -273,15 +260,15 @@ Result<Config> LoadConfig(const std::optional<std::string>& path,
                           const std::vector<std::string>& overrides) {
   YAML::Node root;
   try {
-    root = io::LoadConfigDocument(path, overrides);
-  } catch (const io::ConfigKeyError& e) {
+    root = LoadConfigDocument(path, overrides);
+  } catch (const ConfigKeyError& e) {
     return Status(e.missing_file() ? ErrorCode::kNotFound : ErrorCode::kInvalidArgument, e.what());
   }
   try {
     Config config = Parse(root);
     if (Status status = Validate(config); !status.ok()) return status;
     return config;
-  } catch (const io::ConfigKeyError& e) {
+  } catch (const ConfigKeyError& e) {
     return Status(ErrorCode::kInvalidArgument,
                   "configuration" + (path ? " " + *path : std::string()) + ": " + e.what());
   } catch (const YAML::Exception& e) {
@@ -303,7 +290,8 @@ Status Validate(const Config& config) {
                 "' lets every local user connect (world-writable); give the callers a group "
                 "(listen.socket_group) and a mode such as 0660");
   }
-  if (config.listen.max_connections_per_user > config.listen.max_connections)
+  if (config.listen.connections.max_connections_per_user >
+      config.listen.connections.max_connections)
     return fail("listen.max_connections_per_user is above listen.max_connections");
   if (config.listen.unix_socket.empty() && config.listen.tcp.empty())
     return fail("listen.unix_socket and listen.tcp are both empty: nobody could connect");
@@ -411,10 +399,8 @@ std::string Dump(const Config& config) {
   char mode[8];
   std::snprintf(mode, sizeof mode, "%04o", config.listen.socket_mode);
   out << YAML::Key << "socket_mode" << YAML::Value << YAML::DoubleQuoted << mode;
-  out << YAML::Key << "max_connections" << YAML::Value << config.listen.max_connections;
-  out << YAML::Key << "max_connections_per_user" << YAML::Value
-      << config.listen.max_connections_per_user;
-  rpc::DumpHttp2Limits(out, config.listen.http2);
+  DumpKeys(out, rpc::ConnectionLimitKeys(), config.listen.connections);
+  DumpKeys(out, rpc::Http2LimitKeys(), config.listen.http2);
   out << YAML::Key << "tcp" << YAML::Value << config.listen.tcp;
   out << YAML::Key << "tls_certificate" << YAML::Value << config.listen.tls_certificate;
   out << YAML::Key << "tls_key" << YAML::Value << config.listen.tls_key;

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 #include "bsls/rpc/server_limits.h"
 #include "bsls/service/capture_service.h"
 #include "bsls/service/roles.h"
@@ -47,13 +47,10 @@ struct ListenConfig {
   // Permissions of the socket file; world-writable modes (o+w) are refused:
   // any local user could then call the daemon.
   int socket_mode = 0660;
-  // Connections of the Unix socket open at once, in all and per user (peer
-  // uid); more are closed as soon as they are accepted.
-  int max_connections = 128;
-  int max_connections_per_user = 32;
-  rpc::Http2Limits http2;       // keep-alive, pings, idle connections, streams
-  std::string tcp;              // "host:port" with mutual TLS; "" : no TCP (the default)
-  std::string tls_certificate;  // PEM files, required with tcp
+  rpc::ConnectionLimits connections;  // of the Unix socket
+  rpc::Http2Limits http2;             // keep-alive, pings, idle connections, streams
+  std::string tcp;                    // "host:port" with mutual TLS; "" : no TCP (the default)
+  std::string tls_certificate;        // PEM files, required with tcp
   std::string tls_key;
   std::string tls_client_ca;
   int max_receive_message_bytes = 64 * 1024;      // requests are small
@@ -103,13 +100,13 @@ Config DefaultConfig();
 // override (the same dotted keys as the file, e.g. framestore.backend=usb).
 // Unknown keys are errors (a typo must not silently keep a default).
 // kNotFound when the file is missing; kInvalidArgument naming the key and why.
-framestore::Result<Config> LoadConfig(const std::optional<std::string>& path,
-                                      const std::vector<std::string>& overrides);
+Result<Config> LoadConfig(const std::optional<std::string>& path,
+                          const std::vector<std::string>& overrides);
 // Checks the whole configuration (ranges, TLS completeness); names the first bad key.
-framestore::Status Validate(const Config& config);
+Status Validate(const Config& config);
 // The role policy of `roles`: user names and groups resolved to ids;
 // kInvalidArgument naming an unknown user or group.
-framestore::Result<service::RolePolicy> ResolveRoles(const RolesConfig& roles);
+Result<service::RolePolicy> ResolveRoles(const RolesConfig& roles);
 // The configuration as YAML (what --check-config prints).
 std::string Dump(const Config& config);
 

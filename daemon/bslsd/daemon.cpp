@@ -4,10 +4,9 @@
 #include <grpcpp/security/server_credentials.h>
 #include <spdlog/spdlog.h>
 
-#include <fstream>
 #include <tuple>
 
-#include "bsls/calibration/calibration_file.h"
+#include "bsls/calibration/calibration_header.h"
 #include "bsls/rpc/malformed_requests.h"
 #include "bsls/rpc/server_limits.h"
 #include "bsls/rpc/tls.h"
@@ -17,10 +16,6 @@
 #endif
 
 namespace bsls::bslsd {
-
-using framestore::ErrorCode;
-using framestore::Result;
-using framestore::Status;
 
 namespace {
 
@@ -91,13 +86,16 @@ Status ReadProcessingOptions(const Config& config, service::ProcessingQueueOptio
         std::tuple{p.calibration_right, "processing.calibration_right", pattern::Side::kRight,
                    &processing->right_calibration}}) {
     if (file.empty()) continue;
+    // The head only (format, version, side): the processing service checks
+    // the whole calibration when it is used.
     try {
-      const calibration::CalibrationRecord record = calibration::LoadCalibration(file);
-      if (record.calibration.side != side)
+      std::string text = calibration::ReadCalibrationText(file);
+      const calibration::CalibrationHeader header =
+          calibration::ReadCalibrationHeader(calibration::ParseCalibrationYaml(text, file), file);
+      if (header.side != side)
         return Status(ErrorCode::kInvalidArgument,
                       std::string(key) + " " + file + ": is a calibration of the other side");
-      std::ifstream in(file, std::ios::binary);
-      out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+      *out = std::move(text);
     } catch (const calibration::CalibrationFileError& e) {
       return Status(ErrorCode::kInvalidArgument, std::string(key) + ": " + e.what());
     }
@@ -154,8 +152,7 @@ Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& co
   service::UnixListenerOptions options;
   options.path = config.listen.unix_socket;
   options.mode = static_cast<mode_t>(config.listen.socket_mode);
-  options.max_connections = config.listen.max_connections;
-  options.max_connections_per_user = config.listen.max_connections_per_user;
+  options.connections = config.listen.connections;
   const std::string& group = config.listen.socket_group;
   if (!group.empty()) {
     if (group.find_first_not_of("0123456789") == std::string::npos && group.size() <= 9) {

@@ -27,7 +27,7 @@ namespace bsls::bslsd {
 // empty). main() opens it before dropping privileges: setting the socket's
 // group to one the daemon's user is not in needs CAP_CHOWN. Errors name the
 // key (kInvalidArgument for an unknown group) or the socket and the reason.
-framestore::Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& config);
+Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& config);
 
 class Daemon {
  public:
@@ -36,7 +36,7 @@ class Daemon {
   // from OpenUnixListener (opened here when nullptr). `tick` is called from
   // the capture loop (the watchdog). Errors name the part that failed;
   // kInvalidArgument for what the configuration got wrong.
-  static framestore::Result<std::unique_ptr<Daemon>> Start(
+  static Result<std::unique_ptr<Daemon>> Start(
       const Config& config, PrivilegedDevices privileged, std::function<void()> tick = {},
       std::unique_ptr<service::UnixListener> listener = nullptr);
   // Drains (see Drain) if not done yet.

@@ -69,8 +69,7 @@ class Watchdog {
 
 int Run(const bslsd::Config& config) {
   spdlog::set_level(spdlog::level::from_str(config.log_level));
-  if (framestore::Result<service::RolePolicy> policy = bslsd::ResolveRoles(config.roles);
-      !policy.ok()) {
+  if (Result<service::RolePolicy> policy = bslsd::ResolveRoles(config.roles); !policy.ok()) {
     spdlog::critical("{}", policy.status().message());
     return kExitConfig;
   }
@@ -78,7 +77,7 @@ int Run(const bslsd::Config& config) {
   // Started as root, bslsd becomes `user` (never serves as root by accident).
   std::optional<bslsd::Identity> identity;
   if (::geteuid() == 0) {
-    framestore::Result<bslsd::Identity> resolved = bslsd::ResolveIdentity(config.user);
+    Result<bslsd::Identity> resolved = bslsd::ResolveIdentity(config.user);
     if (!resolved.ok()) {
       spdlog::critical("{}", resolved.status().message());
       return kExitConfig;
@@ -93,21 +92,18 @@ int Run(const bslsd::Config& config) {
 
   // 1. Devices that need a privilege, and the socket (its group may be one
   // the user is not in), while single-threaded.
-  framestore::Result<bslsd::PrivilegedDevices> privileged = bslsd::OpenPrivileged(config);
+  Result<bslsd::PrivilegedDevices> privileged = bslsd::OpenPrivileged(config);
   if (!privileged.ok()) {
     spdlog::critical("{}", privileged.status().message());
-    return privileged.status().code() == framestore::ErrorCode::kPermissionDenied ? kExitConfig
-                                                                                  : kExitRuntime;
+    return privileged.status().code() == ErrorCode::kPermissionDenied ? kExitConfig : kExitRuntime;
   }
-  framestore::Result<std::unique_ptr<service::UnixListener>> listener =
-      bslsd::OpenUnixListener(config);
+  Result<std::unique_ptr<service::UnixListener>> listener = bslsd::OpenUnixListener(config);
   if (!listener.ok()) {
     spdlog::critical("{}", listener.status().message());
-    return listener.status().code() == framestore::ErrorCode::kInvalidArgument ? kExitConfig
-                                                                               : kExitRuntime;
+    return listener.status().code() == ErrorCode::kInvalidArgument ? kExitConfig : kExitRuntime;
   }
   // 2. No privilege from here on: the user's identity, no capabilities, no_new_privs.
-  if (framestore::Status dropped = bslsd::DropAllCapabilities(identity); !dropped.ok()) {
+  if (Status dropped = bslsd::DropAllCapabilities(identity); !dropped.ok()) {
     spdlog::critical("{}", dropped.message());
     return kExitConfig;
   }
@@ -125,13 +121,12 @@ int Run(const bslsd::Config& config) {
 
   // 3. Everything else, then serve.
   Watchdog watchdog;
-  framestore::Result<std::unique_ptr<bslsd::Daemon>> started = bslsd::Daemon::Start(
+  Result<std::unique_ptr<bslsd::Daemon>> started = bslsd::Daemon::Start(
       config, std::move(privileged).value(), [&watchdog] { watchdog.Feed(); },
       std::move(listener).value());
   if (!started.ok()) {
     spdlog::critical("{}", started.status().message());
-    return started.status().code() == framestore::ErrorCode::kInvalidArgument ? kExitConfig
-                                                                              : kExitRuntime;
+    return started.status().code() == ErrorCode::kInvalidArgument ? kExitConfig : kExitRuntime;
   }
   std::unique_ptr<bslsd::Daemon> daemon = std::move(started).value();
   spdlog::info("bslsd {} serving on {}{}", BSLS_VERSION, config.listen.unix_socket,
@@ -188,22 +183,19 @@ int main(int argc, char** argv) {
   if (!socket.empty()) overrides.push_back("listen.unix_socket=" + socket);
   if (!tcp.empty()) overrides.push_back("listen.tcp=" + tcp);
 
-  bsls::framestore::Result<bsls::bslsd::Config> config =
-      bsls::bslsd::LoadConfig(config_path, overrides);
+  bsls::Result<bsls::bslsd::Config> config = bsls::bslsd::LoadConfig(config_path, overrides);
   if (!config.ok()) {
     std::fprintf(stderr, "bslsd: %s\n", config.status().message().c_str());
     return kExitConfig;
   }
   if (check) {
-    bsls::framestore::Result<bsls::service::RolePolicy> policy =
-        bsls::bslsd::ResolveRoles(config->roles);
+    bsls::Result<bsls::service::RolePolicy> policy = bsls::bslsd::ResolveRoles(config->roles);
     if (!policy.ok()) {
       std::fprintf(stderr, "bslsd: %s\n", policy.status().message().c_str());
       return kExitConfig;
     }
     if (::geteuid() == 0) {
-      bsls::framestore::Result<bsls::bslsd::Identity> identity =
-          bsls::bslsd::ResolveIdentity(config->user);
+      bsls::Result<bsls::bslsd::Identity> identity = bsls::bslsd::ResolveIdentity(config->user);
       if (!identity.ok()) {
         std::fprintf(stderr, "bslsd: %s\n", identity.status().message().c_str());
         return kExitConfig;

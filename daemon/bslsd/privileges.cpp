@@ -16,10 +16,6 @@
 
 namespace bsls::bslsd {
 
-using framestore::ErrorCode;
-using framestore::Result;
-using framestore::Status;
-
 Result<CapabilitySets> ReadCapabilitySets(const std::string& status_path) {
   std::ifstream in(status_path);
   if (!in) return Status(ErrorCode::kUnavailable, "cannot read " + status_path);

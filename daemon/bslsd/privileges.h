@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 
 namespace bsls::bslsd {
 
@@ -31,7 +31,7 @@ struct CapabilitySets {
 };
 
 // The sets of `status_path` (/proc/self/status or /proc/PID/task/TID/status).
-framestore::Result<CapabilitySets> ReadCapabilitySets(const std::string& status_path);
+Result<CapabilitySets> ReadCapabilitySets(const std::string& status_path);
 
 // The account a daemon started as root switches to: its uid, primary gid
 // and supplementary groups.
@@ -46,7 +46,7 @@ struct Identity {
 // group and every group it is a member of) or "UID:GID" numbers (no
 // supplementary groups). kInvalidArgument naming the key and the user when
 // there is no such user.
-framestore::Result<Identity> ResolveIdentity(const std::string& user);
+Result<Identity> ResolveIdentity(const std::string& user);
 
 // Drops every privilege for good: the bounding set where CAP_SETPCAP allows;
 // then, given an identity (started as root), switches the groups, gid and
@@ -55,7 +55,7 @@ framestore::Result<Identity> ResolveIdentity(const std::string& user);
 // /proc/self/status and the ids: kPermissionDenied naming what is left when
 // anything is. Must be called while the process has a single thread (ids
 // and capabilities are per thread in Linux).
-framestore::Status DropAllCapabilities(const std::optional<Identity>& identity = std::nullopt);
+Status DropAllCapabilities(const std::optional<Identity>& identity = std::nullopt);
 
 // The number of threads of this process (from /proc/self/status).
 int ThreadCount();

@@ -7,60 +7,50 @@
 #include <set>
 #include <thread>
 
-#include "bsls/io/config_document.h"
+#include "bsls/config/config_document.h"
 #include "bsls/rpc/tls.h"
 
 namespace bsls::processd {
 namespace {
 
-using io::ConfigKeyError;
-
 Config Parse(const YAML::Node& root) {
   Config c;
-  io::OnlyKeys(root, "",
-               {"listen", "workers", "queue", "calibration_cache_entries", "replica", "scratch_dir",
-                "max_upload_bytes", "max_frame_pixels", "drain_timeout_ms", "log_level"});
+  OnlyKeys(root, "",
+           {"listen", "workers", "queue", "calibration_cache_entries", "replica", "scratch_dir",
+            "max_upload_bytes", "max_frame_pixels", "drain_timeout_ms", "log_level"});
   const YAML::Node listen = root["listen"];
-  std::set<std::string> listen_keys = {"unix_socket",
-                                       "tcp",
-                                       "plaintext_loopback",
-                                       "tls_certificate",
-                                       "tls_key",
-                                       "tls_client_ca",
-                                       "max_receive_message_bytes",
-                                       "max_send_message_bytes",
-                                       "max_connections",
-                                       "max_connections_per_user"};
-  listen_keys.insert(rpc::Http2LimitKeys().begin(), rpc::Http2LimitKeys().end());
-  io::OnlyKeys(listen, "listen", listen_keys);
+  std::set<std::string> listen_keys = {
+      "unix_socket", "tcp",           "plaintext_loopback",        "tls_certificate",
+      "tls_key",     "tls_client_ca", "max_receive_message_bytes", "max_send_message_bytes"};
+  for (const auto& key : rpc::ConnectionLimitKeys()) listen_keys.insert(key.name);
+  for (const auto& key : rpc::Http2LimitKeys()) listen_keys.insert(key.name);
+  OnlyKeys(listen, "listen", listen_keys);
   if (listen) {
     ListenConfig& l = c.listen;
-    io::ReadKey(listen, "listen", "unix_socket", l.unix_socket);
-    io::ReadKey(listen, "listen", "tcp", l.tcp);
-    io::ReadKey(listen, "listen", "plaintext_loopback", l.plaintext_loopback);
-    io::ReadKey(listen, "listen", "tls_certificate", l.tls_certificate);
-    io::ReadKey(listen, "listen", "tls_key", l.tls_key);
-    io::ReadKey(listen, "listen", "tls_client_ca", l.tls_client_ca);
-    io::ReadKeyInRange(listen, "listen", "max_receive_message_bytes", l.max_receive_message_bytes,
-                       1 << 20, 1 << 30);
-    io::ReadKeyInRange(listen, "listen", "max_send_message_bytes", l.max_send_message_bytes,
-                       2 << 20, 1 << 30);
-    io::ReadKeyInRange(listen, "listen", "max_connections", l.max_connections, 1, 65536);
-    io::ReadKeyInRange(listen, "listen", "max_connections_per_user", l.max_connections_per_user, 1,
-                       65536);
-    rpc::ReadHttp2Limits(listen, "listen", l.http2);
+    ReadKey(listen, "listen", "unix_socket", l.unix_socket);
+    ReadKey(listen, "listen", "tcp", l.tcp);
+    ReadKey(listen, "listen", "plaintext_loopback", l.plaintext_loopback);
+    ReadKey(listen, "listen", "tls_certificate", l.tls_certificate);
+    ReadKey(listen, "listen", "tls_key", l.tls_key);
+    ReadKey(listen, "listen", "tls_client_ca", l.tls_client_ca);
+    ReadKeyInRange(listen, "listen", "max_receive_message_bytes", l.max_receive_message_bytes,
+                   1 << 20, 1 << 30);
+    ReadKeyInRange(listen, "listen", "max_send_message_bytes", l.max_send_message_bytes, 2 << 20,
+                   1 << 30);
+    ReadKeysInRange(listen, "listen", rpc::ConnectionLimitKeys(), l.connections);
+    ReadKeysInRange(listen, "listen", rpc::Http2LimitKeys(), l.http2);
   }
-  io::ReadKeyInRange(root, "", "workers", c.workers, 0, 256);
-  io::ReadKeyInRange(root, "", "queue", c.queue, -1, 4096);
-  io::ReadKeyInRange(root, "", "calibration_cache_entries", c.calibration_cache_entries, 1, 100000);
-  io::ReadKey(root, "", "replica", c.replica);
-  io::ReadKey(root, "", "scratch_dir", c.scratch_dir);
-  io::ReadKeyInRange(root, "", "max_upload_bytes", c.max_upload_bytes, std::uint64_t{1} << 20,
-                     std::uint64_t{64} << 30);
-  io::ReadKeyInRange(root, "", "max_frame_pixels", c.max_frame_pixels, std::int64_t{512} * 512,
-                     std::int64_t{4096} * 4096);
-  io::ReadKeyInRange(root, "", "drain_timeout_ms", c.drain_timeout_ms, 0, 600000);
-  io::ReadKey(root, "", "log_level", c.log_level);
+  ReadKeyInRange(root, "", "workers", c.workers, 0, 256);
+  ReadKeyInRange(root, "", "queue", c.queue, -1, 4096);
+  ReadKeyInRange(root, "", "calibration_cache_entries", c.calibration_cache_entries, 1, 100000);
+  ReadKey(root, "", "replica", c.replica);
+  ReadKey(root, "", "scratch_dir", c.scratch_dir);
+  ReadKeyInRange(root, "", "max_upload_bytes", c.max_upload_bytes, std::uint64_t{1} << 20,
+                 std::uint64_t{64} << 30);
+  ReadKeyInRange(root, "", "max_frame_pixels", c.max_frame_pixels, std::int64_t{512} * 512,
+                 std::int64_t{4096} * 4096);
+  ReadKeyInRange(root, "", "drain_timeout_ms", c.drain_timeout_ms, 0, 600000);
+  ReadKey(root, "", "log_level", c.log_level);
   return c;
 }
 
@@ -70,7 +60,7 @@ Config LoadConfig(const std::optional<std::string>& path,
                   const std::vector<std::string>& overrides) {
   const std::string where = "configuration" + (path ? " " + *path : std::string());
   try {
-    Config config = Parse(io::LoadConfigDocument(path, overrides));
+    Config config = Parse(LoadConfigDocument(path, overrides));
     Validate(config);
     return config;
   } catch (const ConfigKeyError& e) {
@@ -98,7 +88,7 @@ void Validate(const Config& c) {
                         ": TCP is mutual TLS only: give listen.tls_certificate, listen.tls_key "
                         "and listen.tls_client_ca");
   }
-  if (l.max_connections_per_user > l.max_connections)
+  if (l.connections.max_connections_per_user > l.connections.max_connections)
     throw ConfigError(
         "configuration: listen.max_connections_per_user is above listen.max_connections");
   static const std::set<std::string> levels = {"trace", "debug", "info", "warn", "error", "off"};
@@ -128,10 +118,8 @@ std::string Dump(const Config& c) {
   out << YAML::Key << "max_receive_message_bytes" << YAML::Value
       << c.listen.max_receive_message_bytes;
   out << YAML::Key << "max_send_message_bytes" << YAML::Value << c.listen.max_send_message_bytes;
-  out << YAML::Key << "max_connections" << YAML::Value << c.listen.max_connections;
-  out << YAML::Key << "max_connections_per_user" << YAML::Value
-      << c.listen.max_connections_per_user;
-  rpc::DumpHttp2Limits(out, c.listen.http2);
+  DumpKeys(out, rpc::ConnectionLimitKeys(), c.listen.connections);
+  DumpKeys(out, rpc::Http2LimitKeys(), c.listen.http2);
   out << YAML::EndMap;
   out << YAML::Key << "workers" << YAML::Value << Workers(c);
   out << YAML::Key << "queue" << YAML::Value << Queue(c);

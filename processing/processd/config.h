@@ -31,10 +31,7 @@ struct ListenConfig {
   std::string tls_client_ca;
   int max_receive_message_bytes = 40 << 20;  // two 4096^2 frames and their request
   int max_send_message_bytes = 5 << 20;      // artifacts travel in 1 MiB chunks
-  // Connections of the Unix socket open at once, in all and per peer uid;
-  // more are closed as soon as they are accepted (TCP is gRPC's own).
-  int max_connections = 128;
-  int max_connections_per_user = 32;
+  rpc::ConnectionLimits connections;         // of the Unix socket (TCP is gRPC's own)
   rpc::Http2Limits http2;  // keep-alive, pings, idle connections, streams (same keys)
 };
 

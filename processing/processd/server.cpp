@@ -43,8 +43,7 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     rpc::UnixAcceptorOptions socket;
     socket.path = config.listen.unix_socket;
     socket.mode = 0660;
-    socket.max_connections = config.listen.max_connections;
-    socket.max_connections_per_user = config.listen.max_connections_per_user;
+    socket.connections = config.listen.connections;
     rpc::UnixAcceptorError error;
     s->acceptor_ = rpc::UnixAcceptor::Create(socket, &error);
     if (!s->acceptor_) throw std::runtime_error("listen.unix_socket: " + error.message);

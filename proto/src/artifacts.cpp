@@ -2,13 +2,13 @@
 
 #include <algorithm>
 
-#include "bsls/io/digest.h"
+#include "bsls/common/sha256.h"
 
 namespace bsls::rpc {
 
 bool EmitArtifact(const std::string& name, const std::string& media_type, std::string_view bytes,
                   const std::function<bool(const v1::WorkEvent&)>& emit, std::size_t chunk_bytes) {
-  const std::string sha256 = io::Sha256Hex(bytes);
+  const std::string sha256 = Sha256Hex(bytes);
   std::size_t offset = 0;
   do {
     const std::size_t n = std::min(chunk_bytes, bytes.size() - offset);
@@ -54,7 +54,7 @@ void ArtifactAssembler::Add(const v1::Artifact& chunk) {
   if (p.bytes.size() != p.total_size)
     throw ArtifactError(name + ": ended after " + std::to_string(p.bytes.size()) + " of " +
                         std::to_string(p.total_size) + " bytes");
-  if (io::Sha256Hex(p.bytes) != chunk.sha256())
+  if (Sha256Hex(p.bytes) != chunk.sha256())
     throw ArtifactError(name + ": SHA-256 does not match (damaged in transit)");
   files_[name] = std::move(p.bytes);
   partial_.erase(name);

@@ -3,35 +3,25 @@
 #include <grpcpp/server_builder.h>
 #include <malloc.h>
 
-#include "bsls/io/config_document.h"
-
 namespace bsls::rpc {
 
-const std::set<std::string>& Http2LimitKeys() {
-  static const std::set<std::string> keys = {"keepalive_time_ms",      "keepalive_timeout_ms",
-                                             "min_ping_interval_ms",   "max_ping_strikes",
-                                             "max_connection_idle_ms", "max_concurrent_streams"};
+const std::vector<LimitKey<ConnectionLimits>>& ConnectionLimitKeys() {
+  static const std::vector<LimitKey<ConnectionLimits>> keys = {
+      {"max_connections", &ConnectionLimits::max_connections, 1, 65536},
+      {"max_connections_per_user", &ConnectionLimits::max_connections_per_user, 1, 65536}};
   return keys;
 }
 
-void ReadHttp2Limits(const YAML::Node& node, const std::string& where, Http2Limits& out) {
-  if (!node) return;
+const std::vector<LimitKey<Http2Limits>>& Http2LimitKeys() {
   constexpr int kDay = 24 * 3600 * 1000;
-  io::ReadKeyInRange(node, where, "keepalive_time_ms", out.keepalive_time_ms, 1000, kDay);
-  io::ReadKeyInRange(node, where, "keepalive_timeout_ms", out.keepalive_timeout_ms, 1000, 600000);
-  io::ReadKeyInRange(node, where, "min_ping_interval_ms", out.min_ping_interval_ms, 1000, kDay);
-  io::ReadKeyInRange(node, where, "max_ping_strikes", out.max_ping_strikes, 1, 100);
-  io::ReadKeyInRange(node, where, "max_connection_idle_ms", out.max_connection_idle_ms, 100, kDay);
-  io::ReadKeyInRange(node, where, "max_concurrent_streams", out.max_concurrent_streams, 1, 10000);
-}
-
-void DumpHttp2Limits(YAML::Emitter& out, const Http2Limits& limits) {
-  out << YAML::Key << "keepalive_time_ms" << YAML::Value << limits.keepalive_time_ms;
-  out << YAML::Key << "keepalive_timeout_ms" << YAML::Value << limits.keepalive_timeout_ms;
-  out << YAML::Key << "min_ping_interval_ms" << YAML::Value << limits.min_ping_interval_ms;
-  out << YAML::Key << "max_ping_strikes" << YAML::Value << limits.max_ping_strikes;
-  out << YAML::Key << "max_connection_idle_ms" << YAML::Value << limits.max_connection_idle_ms;
-  out << YAML::Key << "max_concurrent_streams" << YAML::Value << limits.max_concurrent_streams;
+  static const std::vector<LimitKey<Http2Limits>> keys = {
+      {"keepalive_time_ms", &Http2Limits::keepalive_time_ms, 1000, kDay},
+      {"keepalive_timeout_ms", &Http2Limits::keepalive_timeout_ms, 1000, 600000},
+      {"min_ping_interval_ms", &Http2Limits::min_ping_interval_ms, 1000, kDay},
+      {"max_ping_strikes", &Http2Limits::max_ping_strikes, 1, 100},
+      {"max_connection_idle_ms", &Http2Limits::max_connection_idle_ms, 100, kDay},
+      {"max_concurrent_streams", &Http2Limits::max_concurrent_streams, 1, 10000}};
+  return keys;
 }
 
 void ApplyHttp2Limits(const Http2Limits& limits, grpc::ServerBuilder& builder) {

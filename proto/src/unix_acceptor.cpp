@@ -59,22 +59,24 @@ std::unique_ptr<UnixAcceptor> UnixAcceptor::Create(const UnixAcceptorOptions& op
                                 : UnixAcceptorError::Kind::kSystem,
                 Errno("bind " + options.path));
   acceptor->socket_file_ = FileId(options.path);
+  // From here on a failure removes the socket file bound above (while it is
+  // that file), so that no stale file is left for the next start to find.
+  const auto fail_bound = [&](UnixAcceptorError::Kind kind, std::string message) {
+    if (acceptor->socket_file_ && FileId(options.path) == acceptor->socket_file_)
+      ::unlink(options.path.c_str());
+    return fail(kind, std::move(message));
+  };
   if (::chmod(options.path.c_str(), options.mode) != 0 ||
-      (options.group &&
-       ::chown(options.path.c_str(), static_cast<uid_t>(-1), *options.group) != 0)) {
-    const std::string message = Errno("setting owner/mode of " + options.path);
-    ::unlink(options.path.c_str());
-    return fail(UnixAcceptorError::Kind::kPermissionDenied, message);
-  }
-  if (::listen(fd, options.backlog) != 0) {
-    const std::string message = Errno("listen " + options.path);
-    ::unlink(options.path.c_str());
-    return fail(UnixAcceptorError::Kind::kSystem, message);
-  }
+      (options.group && ::chown(options.path.c_str(), static_cast<uid_t>(-1), *options.group) != 0))
+    return fail_bound(UnixAcceptorError::Kind::kPermissionDenied,
+                      Errno("setting owner/mode of " + options.path));
+  if (::listen(fd, options.backlog) != 0)
+    return fail_bound(UnixAcceptorError::Kind::kSystem, Errno("listen " + options.path));
   if (::pipe2(acceptor->wake_, O_CLOEXEC) != 0)
-    return fail(UnixAcceptorError::Kind::kSystem, Errno("pipe"));
+    return fail_bound(UnixAcceptorError::Kind::kSystem, Errno("pipe"));
   acceptor->spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-  if (acceptor->spare_ < 0) return fail(UnixAcceptorError::Kind::kSystem, Errno("open /dev/null"));
+  if (acceptor->spare_ < 0)
+    return fail_bound(UnixAcceptorError::Kind::kSystem, Errno("open /dev/null"));
   return acceptor;
 }
 
@@ -159,15 +161,15 @@ void UnixAcceptor::ForgetClosed() {
 }
 
 std::string UnixAcceptor::OverLimit(uid_t uid) const {
-  if (static_cast<int>(handed_.size()) >= options_.max_connections)
+  if (static_cast<int>(handed_.size()) >= options_.connections.max_connections)
     return std::to_string(handed_.size()) + " connections are open (listen.max_connections " +
-           std::to_string(options_.max_connections) + ")";
+           std::to_string(options_.connections.max_connections) + ")";
   int mine = 0;
   for (const auto& [fd, handed] : handed_) mine += handed.uid == uid ? 1 : 0;
-  if (mine >= options_.max_connections_per_user)
+  if (mine >= options_.connections.max_connections_per_user)
     return "the user has " + std::to_string(mine) +
            " connections open (listen.max_connections_per_user " +
-           std::to_string(options_.max_connections_per_user) + ")";
+           std::to_string(options_.connections.max_connections_per_user) + ")";
   return "";
 }
 

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "bsls/common/atomic_file.h"
+#include "bsls/common/errors.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/simulator/ground_truth.h"
 
@@ -388,13 +390,13 @@ std::filesystem::path WriteCalibrationSession(const CalibrationSession& session,
                                               const std::filesystem::path& folder) {
   std::error_code ec;
   std::filesystem::create_directories(folder, ec);
-  if (ec) throw io::OutputError(folder.string() + ": cannot create the folder: " + ec.message());
+  if (ec) throw OutputError(folder.string() + ": cannot create the folder: " + ec.message());
   for (const auto* views : {&session.camera_views, &session.screen_views, &session.reference_views})
     for (const CalibrationView& view : *views)
       io::WritePngAtomically((folder / view.image_name).string(), view.image);
-  io::WriteFileAtomically((folder / kSessionTruthName).string(), TruthJson(session).dump(1) + "\n");
+  WriteFileAtomically((folder / kSessionTruthName).string(), TruthJson(session).dump(1) + "\n");
   const std::filesystem::path manifest = folder / kSessionManifestName;
-  io::WriteFileAtomically(manifest.string(), ManifestYaml(session));
+  WriteFileAtomically(manifest.string(), ManifestYaml(session));
   return manifest;
 }
 

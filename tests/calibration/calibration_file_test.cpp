@@ -11,7 +11,8 @@
 #include <sstream>
 #include <string>
 
-#include "bsls/io/frame_file.h"
+#include "bsls/calibration/calibration_header.h"
+#include "bsls/common/errors.h"
 #include "bsls/testing/calibration_sessions.h"
 
 namespace bsls::calibration {
@@ -251,7 +252,7 @@ TEST_F(CalibrationFile, SaveReplacesAWholeFileAndLeavesNothingOnFailure) {
   for (const auto& entry : fs::directory_iterator(dir_)) files += entry.is_regular_file();
   EXPECT_EQ(files, 1);  // no temporary left behind
   EXPECT_THROW(SaveCalibration(dir_ / "missing_folder" / "left.yaml", Calibration(), kVersion),
-               io::OutputError);
+               OutputError);
   EXPECT_FALSE(fs::exists(dir_ / "missing_folder"));
 }
 
@@ -279,6 +280,42 @@ TEST_F(CalibrationFile, CorruptFileIsRefused) {
   EXPECT_NE(LoadError("{{{ not yaml").find("not valid YAML"), std::string::npos);
   EXPECT_NE(LoadError("- a list\n- not a map\n").find("expected a YAML mapping"),
             std::string::npos);
+}
+
+// The head alone (what bslsd reads): the side and versions of a whole
+// file, and the same refusals as LoadCalibration for the same faults in the
+// head; a fault in the body is not its business.
+TEST_F(CalibrationFile, TheHeadIsReadAlone) {
+  const fs::path path = dir_ / "left.yaml";
+  SaveCalibration(path, Calibration(), kVersion);
+  const CalibrationHeader header = LoadCalibrationHeader(path);
+  EXPECT_EQ(header.side, pattern::Side::kLeft);
+  EXPECT_EQ(header.format_version, kCalibrationFormatVersion);
+  EXPECT_EQ(header.software_version, kVersion);
+
+  const fs::path right = dir_ / "right.yaml";
+  std::ofstream(right, std::ios::binary) << Replaced("side: left\n", "side: right\n");
+  EXPECT_EQ(LoadCalibrationHeader(right).side, pattern::Side::kRight);
+
+  const fs::path body = dir_ / "body.yaml";
+  std::ofstream(body, std::ios::binary) << Replaced("{width: 512", "{width: wide");
+  EXPECT_EQ(LoadCalibrationHeader(body).side, pattern::Side::kLeft);
+  EXPECT_THROW(LoadCalibration(body), CalibrationFileError);
+
+  for (const std::string& text :
+       {Replaced("format: bsls-calibration", "format: other"),
+        Replaced("format_version: 1\n", "format_version: 2\n"),
+        Replaced("side: left\n", "side: middle\n"), std::string("{{{ not yaml"),
+        std::string("- a list\n"), std::string("")}) {
+    const std::string from_load = LoadError(text);
+    try {
+      LoadCalibrationHeader(dir_ / "bad.yaml");
+      ADD_FAILURE() << "read the head of a bad file: " << from_load;
+    } catch (const CalibrationFileError& e) {
+      EXPECT_EQ(e.what(), from_load);
+    }
+  }
+  EXPECT_THROW(LoadCalibrationHeader(dir_ / "missing.yaml"), CalibrationFileError);
 }
 
 TEST_F(CalibrationFile, MissingKeyIsNamed) {

@@ -2,7 +2,6 @@
 // socket and store, driven over gRPC.
 #include <grp.h>
 #include <gtest/gtest.h>
-#include <openssl/sha.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 
@@ -16,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "bsls/common/sha256.h"
 #include "bsls/testing/certificates.h"
 #include "bsls/testing/raw_connections.h"
 #include "daemon_process.h"
@@ -32,24 +32,12 @@ constexpr const char* kSimulatedSlides = "slides:\n  backend: simulated\n";
 // Bytes that are no message of any type: field 1, length-delimited, with a
 // length of 4 GiB that does not follow.
 
-std::string Hex(const unsigned char* digest, std::size_t n) {
-  static const char* kDigits = "0123456789abcdef";
-  std::string out;
-  for (std::size_t i = 0; i < n; ++i) {
-    out += kDigits[digest[i] >> 4];
-    out += kDigits[digest[i] & 15];
-  }
-  return out;
-}
-
 // SHA-256 of a frame's packed pixels (what the store hashes).
 std::string PixelHash(const v1::Frame& frame) {
   std::string packed;
   for (std::uint32_t y = 0; y < frame.height(); ++y)
     packed.append(frame.pixels(), static_cast<std::size_t>(y) * frame.stride(), frame.width());
-  unsigned char digest[SHA256_DIGEST_LENGTH];
-  SHA256(reinterpret_cast<const unsigned char*>(packed.data()), packed.size(), digest);
-  return Hex(digest, sizeof digest);
+  return Sha256Hex(packed);
 }
 
 v1::GrabResponse GrabBoth(v1::CaptureDaemon::Stub& stub, const std::string& session,
@@ -734,6 +722,29 @@ TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
   const auto [code, output] = RunCommand(std::string(BSLSD_PATH) + " --check-config --config " +
                                          config.string() + " --set 'listen.socket_mode=\"0660\"'");
   EXPECT_EQ(code, 0) << output;
+}
+
+// bslsd reads the head of each calibration file (format, version, side):
+// a file of the other side, or of another format, stops the start with the
+// key and the reason, before anything is served.
+TEST(BslsdConfig, ACalibrationOfTheOtherSideOrFormatIsRefusedAtStart) {
+  const fs::path dir = MakeDaemonDir("calibration");
+  const fs::path config = WriteDaemonConfig(dir);
+  const fs::path right = dir / "right.yaml";
+  std::ofstream(right) << "format: bsls-calibration\nformat_version: 1\n"
+                          "software_version: test\nside: right\n";
+  const fs::path other = dir / "other.yaml";
+  std::ofstream(other) << "format: other\nformat_version: 1\nside: left\n";
+  for (const auto& [file, expected] :
+       {std::pair{right, std::string("is a calibration of the other side")},
+        std::pair{other, std::string("format is 'other'")}}) {
+    const auto [code, output] =
+        RunCommand("timeout 60 " + std::string(BSLSD_PATH) + " --config " + config.string() +
+                   " --set processing.calibration_left=" + file.string());
+    EXPECT_EQ(code, 78) << output;
+    EXPECT_NE(output.find("processing.calibration_left"), std::string::npos) << output;
+    EXPECT_NE(output.find(expected), std::string::npos) << output;
+  }
 }
 
 // Started as root with a `user` that does not exist, bslsd

@@ -9,7 +9,7 @@
 #include <thread>
 
 #include "bsls/calibration/calibration_file.h"
-#include "bsls/io/digest.h"
+#include "bsls/common/sha256.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/testing/calibration_sessions.h"
 #include "bsls/v1/processing.grpc.pb.h"
@@ -138,7 +138,7 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
        {"surface.ply", "left.ply", "right.ply", "report.json", "record.json", "left.junctions.json",
         "right.junctions.json", "calibration-left.yaml", "calibration-right.yaml"})
     EXPECT_TRUE(files.count(name)) << name;
-  EXPECT_EQ(io::Sha256Hex(files.at("record.json")), info.processing().record_sha256());
+  EXPECT_EQ(Sha256Hex(files.at("record.json")), info.processing().record_sha256());
 
   // The record ties the result to the frames, the calibrations and the software.
   const nlohmann::json record = nlohmann::json::parse(files.at("record.json"));
@@ -147,9 +147,9 @@ TEST_F(Pipeline, AGrabOfBothSidesIsReconstructedAndSealedBesideTheCapture) {
   ASSERT_EQ(record.at("frames").size(), 2u);
   EXPECT_EQ(record.at("frames")[0].at("sha256"), info.frames(0).sha256());
   EXPECT_EQ(record.at("calibrations").at("left"),
-            "sha256:" + io::Sha256Hex(files.at("calibration-left.yaml")));
+            "sha256:" + Sha256Hex(files.at("calibration-left.yaml")));
   for (const auto& [name, sha256] : record.at("files").items())
-    EXPECT_EQ(io::Sha256Hex(files.at(name)), sha256.get<std::string>()) << name;
+    EXPECT_EQ(Sha256Hex(files.at(name)), sha256.get<std::string>()) << name;
   EXPECT_FALSE(record.at("processing_software_version").get<std::string>().empty());
   EXPECT_FALSE(record.at("daemon_software_version").get<std::string>().empty());
   const geometry::SurfaceMesh mesh = io::DecodePly(files.at("surface.ply"), "surface.ply");

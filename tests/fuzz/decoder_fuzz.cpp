@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "bsls/common/errors.h"
 #include "bsls/decoder/decoder.h"
 #include "bsls/io/frame_file.h"
 
@@ -21,7 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     limits.max_side = 1024;  // keep each run short
     try {
       frame = bsls::io::DecodeGreyFrame(bytes, "fuzz input", nullptr, limits);
-    } catch (const bsls::io::InputError&) {
+    } catch (const bsls::InputError&) {
       return 0;
     }
   } else {

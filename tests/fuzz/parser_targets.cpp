@@ -18,7 +18,8 @@
 
 #include "bsls/calibration/calibration_file.h"
 #include "bsls/calibration/manifest.h"
-#include "bsls/io/bounded_yaml.h"
+#include "bsls/common/errors.h"
+#include "bsls/config/bounded_yaml.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/simulator/mesh.h"
@@ -64,7 +65,7 @@ std::vector<std::string> YamlTemplates(const std::string& target) {
     std::ifstream in(file, std::ios::binary);
     std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     try {
-      io::LoadBoundedYaml(text);
+      LoadBoundedYaml(text);
       templates.push_back(std::move(text));
     } catch (const YAML::Exception&) {
     }
@@ -170,7 +171,7 @@ void WriteFile(const fs::path& path, const std::string& text) {
 // Walks a loaded tree without recursion; a violation when it is deeper or
 // larger than `limits` allow (an alias that got through would show here as
 // a node reached twice, a cycle as a walk that does not end).
-void CheckTree(const YAML::Node& root, const io::YamlLimits& limits) {
+void CheckTree(const YAML::Node& root, const YamlLimits& limits) {
   std::vector<std::pair<YAML::Node, int>> stack = {{root, 0}};
   std::size_t nodes = 0;
   while (!stack.empty()) {
@@ -194,10 +195,10 @@ void CheckTree(const YAML::Node& root, const io::YamlLimits& limits) {
 }
 
 bool OneYaml(const std::string& text) {
-  io::YamlLimits limits;
+  YamlLimits limits;
   YAML::Node root;
   try {
-    root = io::LoadBoundedYaml(text, limits);
+    root = LoadBoundedYaml(text, limits);
   } catch (const YAML::Exception&) {
     return false;  // the documented error
   }
@@ -324,7 +325,7 @@ std::vector<std::string> Overrides(FuzzInput& in) {
 bool OneBslsdConfig(const std::string& text, const std::vector<std::string>& overrides) {
   const fs::path path = Scratch() / "bslsd.yaml";
   WriteFile(path, text);
-  std::optional<framestore::Result<bslsd::Config>> config;
+  std::optional<Result<bslsd::Config>> config;
   try {
     config.emplace(bslsd::LoadConfig(path.string(), overrides));
   } catch (const std::exception& e) {
@@ -340,7 +341,7 @@ bool OneBslsdConfig(const std::string& text, const std::vector<std::string>& ove
   // What --check-config prints loads back as the same configuration.
   const std::string dump = bslsd::Dump(**config);
   WriteFile(path, dump);
-  const framestore::Result<bslsd::Config> again = bslsd::LoadConfig(path.string(), {});
+  const Result<bslsd::Config> again = bslsd::LoadConfig(path.string(), {});
   if (!again.ok())
     Violation("bslsd::LoadConfig", "its own Dump is refused: " + again.status().message());
   if (bslsd::Dump(*again) != dump)
@@ -392,8 +393,8 @@ bool RunProcessdConfig(const std::uint8_t* data, std::size_t size) {
 // ------------------------------------------------------------------ PLY
 
 bool OnePly(const std::string& bytes) {
-  const auto loaded = ParsedOrRefused<io::InputError>(
-      "DecodePly", "InputError", [&] { return io::DecodePly(bytes, "fuzz.ply"); });
+  const auto loaded = ParsedOrRefused<InputError>("DecodePly", "InputError",
+                                                  [&] { return io::DecodePly(bytes, "fuzz.ply"); });
   if (!loaded) return false;
   const geometry::SurfaceMesh& mesh = *loaded;
   std::string why;
@@ -435,7 +436,7 @@ bool RunObj(const std::uint8_t* data, std::size_t size) {
 bool OnePng(const std::string& bytes) {
   const std::vector<unsigned char> buffer(bytes.begin(), bytes.end());
   const io::FrameLimits limits;  // what the services and the CLI read frames with
-  const auto loaded = ParsedOrRefused<io::InputError>("DecodeGreyFrame", "InputError", [&] {
+  const auto loaded = ParsedOrRefused<InputError>("DecodeGreyFrame", "InputError", [&] {
     return io::DecodeGreyFrame(buffer, "fuzz.png", nullptr, limits);
   });
   if (!loaded) return false;
@@ -475,7 +476,7 @@ bool RunJson(const std::uint8_t* data, std::size_t size) {
 
 const std::vector<ParserTarget>& ParserTargets() {
   static const std::vector<ParserTarget> targets = {
-      {"yaml", "io::LoadBoundedYaml", &RunYaml},
+      {"yaml", "LoadBoundedYaml", &RunYaml},
       {"manifest", "calibration::LoadManifest", &RunManifest},
       {"calibration", "calibration::CalibrationFromYaml", &RunCalibration},
       {"bslsd_config", "bslsd::LoadConfig", &RunBslsdConfig},

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/errors.h"
+
 namespace bsls::io {
 namespace {
 

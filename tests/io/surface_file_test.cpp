@@ -10,6 +10,8 @@
 #include <random>
 #include <sstream>
 
+#include "bsls/common/errors.h"
+
 namespace bsls::io {
 namespace {
 

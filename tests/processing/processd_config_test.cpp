@@ -61,8 +61,8 @@ TEST(ProcessdConfig, Http2LimitsHaveBoundedDefaults) {
   EXPECT_NE(ErrorOf({"listen.max_concurrent_streams=100000"}).find("max_concurrent_streams"),
             std::string::npos);
   EXPECT_NE(Dump(c).find("max_connection_idle_ms: 1000"), std::string::npos) << Dump(c);
-  EXPECT_EQ(defaults.listen.max_connections, 128);
-  EXPECT_EQ(defaults.listen.max_connections_per_user, 32);
+  EXPECT_EQ(defaults.listen.connections.max_connections, 128);
+  EXPECT_EQ(defaults.listen.connections.max_connections_per_user, 32);
   EXPECT_NE(ErrorOf({"listen.max_connections_per_user=200"}).find("max_connections_per_user"),
             std::string::npos);
 }

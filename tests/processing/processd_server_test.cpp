@@ -167,8 +167,8 @@ TEST_F(ProcessdServer, UnixConnectionsBeyondTheLimitsAreClosedAtOnce) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root to connect as other uids";
   Config config;
   config.listen.unix_socket = (dir_ / "processd.sock").string();
-  config.listen.max_connections = 4;
-  config.listen.max_connections_per_user = 2;
+  config.listen.connections.max_connections = 4;
+  config.listen.connections.max_connections_per_user = 2;
   config.workers = 1;
   auto server = Server::Start(config, "test");
   // Other uids reach the socket: the folder is searchable, the socket 0660 of root's group.

@@ -17,7 +17,6 @@
 namespace bsls::service {
 namespace {
 
-using framestore::ErrorCode;
 using std::chrono::milliseconds;
 
 std::shared_ptr<const framestore::VideoFrame> Grey(int input) {

@@ -3,8 +3,10 @@
 // listener runs in a child process whose descriptor limit is set just above
 // what it holds, so that each further connection meets EMFILE). Beyond the
 // connection limits, per user and in total, connections are closed at once.
+// A Create that fails after binding leaves no socket file.
 #include "bsls/service/unix_listener.h"
 
+#include <fcntl.h>
 #include <grp.h>
 #include <grpcpp/create_channel.h>
 #include <grpcpp/server.h>
@@ -121,6 +123,44 @@ TEST(UnixListener, OutOfDescriptorsItShedsCallersAndDoesNotSpin) {
   EXPECT_GE(closed, 20) << "callers beyond the descriptor limit were not shed";
 }
 
+// A Create that fails after the socket is bound (here rpc::UnixAcceptor's
+// pipe2, out of descriptors) removes the socket file it made: a daemon that
+// failed to start leaves no file for callers to find. Run in a child
+// process whose descriptor limit leaves exactly one descriptor free: the
+// socket takes it, the wake pipe finds none.
+TEST(UnixListener, AFailedCreateLeavesNoSocketFile) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("bsls_listener_pipe_" + std::to_string(::getpid()) + ".sock"))
+                               .string();
+  std::filesystem::remove(path);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const rlim_t limit = static_cast<rlim_t>(OpenDescriptors() + 16);
+    const rlimit low{limit, limit};
+    if (::setrlimit(RLIMIT_NOFILE, &low) != 0) ::_exit(2);
+    std::vector<int> filler;
+    for (int fd; (fd = ::open("/dev/null", O_RDONLY | O_CLOEXEC)) >= 0;) filler.push_back(fd);
+    if (errno != EMFILE || filler.empty()) ::_exit(3);
+    ::close(filler.back());  // the one descriptor free
+    auto listener = UnixListener::Create({path, 0600});
+    if (listener.ok()) ::_exit(4);
+    if (listener.status().code() != ErrorCode::kUnavailable ||
+        listener.status().message().find("pipe") == std::string::npos)
+      ::_exit(5);
+    ::_exit(std::filesystem::exists(path) ? 6 : 0);
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  const bool left_behind = std::filesystem::exists(path);
+  std::filesystem::remove(path);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_NE(WEXITSTATUS(status), 4) << "Create succeeded with one descriptor free";
+  EXPECT_NE(WEXITSTATUS(status), 5) << "Create failed, but not at pipe2";
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "exit " << WEXITSTATUS(status);
+  EXPECT_FALSE(left_behind) << "the failed Create left its socket file " << path;
+}
+
 // One daemon per socket: a second listener on a live socket is refused and
 // leaves it working; once the first is gone, its stale file is replaced.
 TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
@@ -132,7 +172,7 @@ TEST(UnixListener, ASecondListenerOnALiveSocketIsRefused) {
   ASSERT_TRUE(first.ok()) << first.status().message();
   auto second = UnixListener::Create({path, 0600});
   ASSERT_FALSE(second.ok());
-  EXPECT_EQ(second.status().code(), framestore::ErrorCode::kAlreadyExists);
+  EXPECT_EQ(second.status().code(), ErrorCode::kAlreadyExists);
   const int client = testing::ConnectUnixAs(0, path);
   EXPECT_GE(client, 0) << "the first listener's socket was taken";
   if (client >= 0) ::close(client);
@@ -167,8 +207,8 @@ TEST(UnixListener, ConnectionsBeyondTheUsersShareOrTheTotalAreClosedAtOnce) {
     UnixListenerOptions options;
     options.path = path;
     options.mode = 0666;
-    options.max_connections = 6;
-    options.max_connections_per_user = 3;
+    options.connections.max_connections = 6;
+    options.connections.max_connections_per_user = 3;
     auto listener = UnixListener::Create(options);
     if (!server || !listener.ok()) ::_exit(2);
     PeerRegistry registry;

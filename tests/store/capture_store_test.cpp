@@ -51,8 +51,8 @@ TEST(CaptureStoreTest, PutGetRoundTripIsByteExactWithHashes) {
   ASSERT_TRUE(put.ok()) << put.status().ToString();
   EXPECT_TRUE(CaptureId::Parse(put->id.str()));
   ASSERT_EQ(put->frames.size(), 2u);
-  EXPECT_EQ(put->frames[0].sha256, PixelSha256(request.frames[0]));
-  EXPECT_EQ(put->frames[1].sha256, PixelSha256(request.frames[1]));
+  EXPECT_EQ(put->frames[0].sha256, PixelSha256(request.frames[0]).value());
+  EXPECT_EQ(put->frames[1].sha256, PixelSha256(request.frames[1]).value());
 
   auto got = store->Get(put->id.str());
   ASSERT_TRUE(got.ok()) << got.status().ToString();
@@ -71,7 +71,7 @@ TEST(CaptureStoreTest, PutGetRoundTripIsByteExactWithHashes) {
     for (int x = 0; x < back.width; ++x) differing += back.at(x, y) != padded.at(x, y);
   }
   EXPECT_EQ(differing, 0);
-  EXPECT_EQ(PixelSha256(back), got->info.frames[1].sha256);
+  EXPECT_EQ(PixelSha256(back).value(), got->info.frames[1].sha256);
 
   // Metadata survives exactly.
   const CaptureInfo& info = got->info;
@@ -99,7 +99,10 @@ TEST(CaptureStoreTest, PutGetRoundTripIsByteExactWithHashes) {
   auto content = ReadFrameFile(*MakePosixFileSystem(),
                                dir.path() + "/store/frames/" + info.frames[0].file_name);
   ASSERT_TRUE(content.ok()) << content.status().ToString();
-  EXPECT_EQ(Sha256(content->pixels.data(), content->pixels.size()), info.frames[0].sha256);
+  EXPECT_EQ(BytesSha256(std::string_view(reinterpret_cast<const char*>(content->pixels.data()),
+                                         content->pixels.size()))
+                .value(),
+            info.frames[0].sha256);
 }
 
 TEST(CaptureStoreTest, SurvivesReopenAndChecksIntegrity) {

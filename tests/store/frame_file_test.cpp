@@ -20,10 +20,7 @@ using testing::TempDir;
 
 const CaptureId kId = *CaptureId::Parse("0190aabbccddeeff0011223344556677");
 
-TEST(Sha256Test, KnownDigestAndStrideIndependence) {
-  const std::string abc = "abc";
-  EXPECT_EQ(Sha256(reinterpret_cast<const std::uint8_t*>(abc.data()), abc.size()),
-            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+TEST(Sha256Test, PixelDigestIsStrideIndependent) {
   framestore::GreyFrame packed;
   packed.width = 3;
   packed.height = 1;
@@ -32,8 +29,33 @@ TEST(Sha256Test, KnownDigestAndStrideIndependence) {
   framestore::GreyFrame padded = packed;
   padded.stride = 5;
   padded.pixels = {'a', 'b', 'c', 'x', 'y'};
-  EXPECT_EQ(PixelSha256(packed), PixelSha256(padded));
-  EXPECT_EQ(PixelSha256(packed), Sha256(packed.pixels.data(), 3));
+  EXPECT_EQ(PixelSha256(packed).value(),
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(PixelSha256(packed).value(), PixelSha256(padded).value());
+  EXPECT_EQ(BytesSha256("abc").value(), PixelSha256(packed).value());
+}
+
+// A frame whose pixels are fewer than stride * height, or whose sides or
+// stride make no frame, is refused with kInvalidArgument, not read past its
+// end (the check was an assert, which Release compiles out).
+TEST(Sha256Test, AMalformedFrameIsRefused) {
+  framestore::GreyFrame frame;
+  frame.width = 4;
+  frame.height = 3;
+  frame.stride = 5;
+  frame.pixels.assign(14, 0);  // 15 needed
+  Result<std::string> short_frame = PixelSha256(frame);
+  ASSERT_FALSE(short_frame.ok());
+  EXPECT_EQ(short_frame.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(short_frame.status().message().find("14 bytes"), std::string::npos)
+      << short_frame.status().message();
+  frame.pixels.assign(15, 0);
+  EXPECT_TRUE(PixelSha256(frame).ok());
+  frame.stride = 3;  // below the width
+  EXPECT_EQ(PixelSha256(frame).status().code(), ErrorCode::kInvalidArgument);
+  frame.stride = 5;
+  frame.height = 0;
+  EXPECT_EQ(PixelSha256(frame).status().code(), ErrorCode::kInvalidArgument);
 }
 
 TEST(FrameFileTest, NamesRoundTrip) {

@@ -5,11 +5,8 @@
 namespace bsls::service {
 
 using framestore::Camera;
-using framestore::ErrorCode;
 using framestore::Framestore;
 using framestore::GreyFrame;
-using framestore::Result;
-using framestore::Status;
 
 namespace {
 

@@ -8,12 +8,10 @@
 #include <tuple>
 
 #include "bsls/rpc/artifacts.h"
-#include "bsls/store/sha256.h"
 
 namespace bsls::service {
 
 using framestore::Camera;
-using framestore::ErrorCode;
 using google::protobuf::util::TimeUtil;
 
 grpc::StatusCode ToGrpcCode(ErrorCode code) {
@@ -44,7 +42,7 @@ grpc::StatusCode ToGrpcCode(ErrorCode code) {
   return grpc::StatusCode::INTERNAL;
 }
 
-grpc::Status ToGrpc(const framestore::Status& status) {
+grpc::Status ToGrpc(const Status& status) {
   if (status.ok()) return grpc::Status::OK;
   return {ToGrpcCode(status.code()), status.message()};
 }
@@ -187,8 +185,7 @@ CaptureService::CaptureService(CaptureDevice* device, store::CaptureStore* store
 
 void CaptureService::FillCapture(const store::CaptureInfo& info, v1::CaptureInfo* reply) {
   FillInfo(info, reply);
-  framestore::Result<std::optional<store::ProcessingRecord>> record =
-      store_->Processing(info.id.str());
+  Result<std::optional<store::ProcessingRecord>> record = store_->Processing(info.id.str());
   if (record.ok())
     FillProcessingStatus(*record, processing_ != nullptr && processing_->enabled(),
                          reply->mutable_processing());
@@ -257,7 +254,7 @@ void CaptureService::FillStatus(const Caller& caller, v1::DeviceStatus* reply) {
   reply->set_preview_rate_hz(device.preview_rate_hz);
   FillSlideState(reply->mutable_slide());
   reply->set_software_version(software_version_);
-  if (framestore::Result<store::StoreUsage> usage = store_->Usage(); usage.ok()) {
+  if (Result<store::StoreUsage> usage = store_->Usage(); usage.ok()) {
     reply->set_captures_stored(usage->captures);
     reply->set_store_free_bytes(usage->free_bytes);
   }
@@ -381,20 +378,16 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
   // right). With a brick slide in place, a grab of both sides puts each
   // side's slide in place before its frame (the right one stays in); with
   // the reference cross (slide 1) both cameras see the cross (calibration).
-  framestore::Result<std::vector<framestore::GreyFrame>> frames =
-      std::vector<framestore::GreyFrame>{};
+  Result<std::vector<framestore::GreyFrame>> frames = std::vector<framestore::GreyFrame>{};
   int slide = slides_ ? slides_->State().slide : 0;
   if (sides == GrabSides::kBoth && (slide == 2 || slide == 3)) {
     for (const auto& [one, side_slide] : {std::pair{GrabSides::kLeft, 2}, {GrabSides::kRight, 3}}) {
-      if (framestore::Status changed = slides_->ChangeTo(side_slide, Deadline(context));
-          !changed.ok()) {
-        frames = framestore::Status(changed.code(),
-                                    "slide " + std::to_string(side_slide) +
-                                        " for the grab of both sides: " + changed.message());
+      if (Status changed = slides_->ChangeTo(side_slide, Deadline(context)); !changed.ok()) {
+        frames = Status(changed.code(), "slide " + std::to_string(side_slide) +
+                                            " for the grab of both sides: " + changed.message());
         break;
       }
-      framestore::Result<std::vector<framestore::GreyFrame>> grabbed =
-          device_->Grab(one, Deadline(context));
+      Result<std::vector<framestore::GreyFrame>> grabbed = device_->Grab(one, Deadline(context));
       if (!grabbed.ok()) {
         frames = grabbed.status();
         break;
@@ -418,7 +411,7 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
   capture.software_version = software_version_;
   capture.requested_by = {caller.uid, caller.name};
   capture.frames = std::move(frames).value();
-  framestore::Result<store::CaptureInfo> stored = store_->Put(capture);
+  Result<store::CaptureInfo> stored = store_->Put(capture);
   if (!stored.ok()) {
     spdlog::error("grab {} for {} not stored: {}", store::ToString(side), caller.Describe(),
                   stored.status().ToString());
@@ -467,7 +460,7 @@ grpc::Status CaptureService::ListCaptures(grpc::ServerContext* context,
   if (request->has_taken_before()) filter.taken_before = FromProto(request->taken_before());
   filter.page_size = request->page_size();
   filter.page_token = request->page_token();
-  framestore::Result<store::CapturePage> page = store_->List(filter);
+  Result<store::CapturePage> page = store_->List(filter);
   if (!page.ok()) return ToGrpc(page.status());
   for (const store::CaptureInfo& info : page->captures) FillCapture(info, reply->add_captures());
   reply->set_next_page_token(page->next_page_token);
@@ -479,7 +472,7 @@ grpc::Status CaptureService::GetCapture(grpc::ServerContext* context,
                                         v1::CaptureInfo* reply) {
   Caller caller;
   if (grpc::Status s = Authorize(context, "GetCapture", &caller); !s.ok()) return s;
-  framestore::Result<store::Capture> capture = store_->Get(request->capture_id());
+  Result<store::Capture> capture = store_->Get(request->capture_id());
   if (!capture.ok()) return ToGrpc(capture.status());
   FillCapture(capture->info, reply);
   for (std::size_t i = 0; i < capture->frames.size(); ++i) {
@@ -496,7 +489,7 @@ grpc::Status CaptureService::GetCaptureResult(grpc::ServerContext* context,
   Caller caller;
   if (grpc::Status s = Authorize(context, "GetCaptureResult", &caller); !s.ok()) return s;
   if (request->name().size() > 64) return Invalid("name: at most 64 bytes");
-  framestore::Result<std::map<std::string, std::string>> files =
+  Result<std::map<std::string, std::string>> files =
       store_->ReadProcessingFiles(request->capture_id(), request->name());
   if (!files.ok()) return ToGrpc(files.status());
   for (const auto& [name, bytes] : *files) {

@@ -6,7 +6,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "bsls/io/digest.h"
+#include "bsls/common/sha256.h"
 
 namespace bsls::service {
 namespace {
@@ -151,11 +151,11 @@ void ProcessingQueue::Run() {
 }
 
 ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std::string* error) {
-  store::Result<store::Capture> capture = store_->Get(id);
+  Result<store::Capture> capture = store_->Get(id);
   if (!capture.ok()) {
     *error = capture.status().message();
-    if (capture.status().code() == store::ErrorCode::kNotFound) return Outcome::kGone;
-    if (capture.status().code() == store::ErrorCode::kDataLoss) {
+    if (capture.status().code() == ErrorCode::kNotFound) return Outcome::kGone;
+    if (capture.status().code() == ErrorCode::kDataLoss) {
       *error = "the capture is damaged: " + *error;
       if (auto s = store_->PutProcessingFailure(id, *error); !s.ok()) *error += "; " + s.message();
       return Outcome::kFailed;
@@ -179,7 +179,7 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
   auto keep_calibration = [&](framestore::Camera camera) {
     const std::string& yaml = calibration_of(camera);
     if (yaml.empty()) return;
-    calibrations[SideName(camera)] = "sha256:" + io::Sha256Hex(yaml);  // the service's id
+    calibrations[SideName(camera)] = "sha256:" + Sha256Hex(yaml);  // the service's id
     files[std::string("calibration-") + SideName(camera) + ".yaml"] = yaml;
   };
   auto failed = [&](const grpc::Status& status) {
@@ -247,7 +247,7 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
                           {"height", f.height},
                           {"sha256", f.sha256}});
   nlohmann::json file_hashes = nlohmann::json::object();
-  for (const auto& [name, bytes] : files) file_hashes[name] = io::Sha256Hex(bytes);
+  for (const auto& [name, bytes] : files) file_hashes[name] = Sha256Hex(bytes);
   const nlohmann::json record = {{"format", "bsls-processing-record"},
                                  {"format_version", 1},
                                  {"capture_id", id},
@@ -265,7 +265,7 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
   files["record.json"] = record.dump(2) + "\n";
   if (auto stored = store_->PutProcessingResult(id, files, replica, version); !stored.ok()) {
     *error = stored.message();
-    return stored.code() == store::ErrorCode::kNotFound ? Outcome::kGone : Outcome::kRetry;
+    return stored.code() == ErrorCode::kNotFound ? Outcome::kGone : Outcome::kRetry;
   }
   return Outcome::kDone;
 }

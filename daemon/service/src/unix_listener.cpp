@@ -9,10 +9,6 @@
 
 namespace bsls::service {
 
-using framestore::ErrorCode;
-using framestore::Result;
-using framestore::Status;
-
 void PeerRegistry::Add(const std::string& peer, Caller caller) {
   std::lock_guard lock(mutex_);
   callers_[peer] = std::move(caller);
@@ -52,8 +48,7 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
   socket.mode = options.mode;
   socket.group = options.group;
   socket.backlog = options.backlog;
-  socket.max_connections = options.max_connections;
-  socket.max_connections_per_user = options.max_connections_per_user;
+  socket.connections = options.connections;
   rpc::UnixAcceptorError error;
   std::unique_ptr<rpc::UnixAcceptor> acceptor = rpc::UnixAcceptor::Create(socket, &error);
   if (!acceptor) {

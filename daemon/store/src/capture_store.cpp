@@ -249,7 +249,10 @@ Status CaptureStore::VerifyFrame(const CaptureInfo& info, const StoredFrameInfo&
                                             ", the index recorded " + std::to_string(frame.width) +
                                             "x" + std::to_string(frame.height));
   }
-  const std::string digest = Sha256(content->pixels.data(), content->pixels.size());
+  const Result<std::string> hashed = BytesSha256(std::string_view(
+      reinterpret_cast<const char*>(content->pixels.data()), content->pixels.size()));
+  if (!hashed.ok()) return WithContext(hashed.status(), path);
+  const std::string& digest = *hashed;
   if (digest != frame.sha256) {
     return Status(ErrorCode::kDataLoss, path + " has SHA-256 " + digest + ", the index recorded " +
                                             frame.sha256 + " when capture " + info.id.str() +
@@ -330,7 +333,9 @@ Result<CaptureInfo> CaptureStore::Put(const CaptureRequest& request) {
     stored.width = frame->width;
     stored.height = frame->height;
     stored.timestamps = frame->timestamps;
-    stored.sha256 = PixelSha256(*frame);
+    Result<std::string> sha256 = PixelSha256(*frame);
+    if (!sha256.ok()) return WithContext(sha256.status(), context);
+    stored.sha256 = std::move(sha256).value();
     stored.file_name = FrameFileName(id, frame->camera);
     stored.file_bytes = FrameFileBytes(id, frame->camera, frame->width, frame->height);
     info.total_bytes += stored.file_bytes;
@@ -480,10 +485,6 @@ bool IsResultFileName(std::string_view name) {
   });
 }
 
-std::string Sha256Hex(const std::string& bytes) {
-  return Sha256(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
-}
-
 }  // namespace
 
 Status CaptureStore::PutProcessingResult(std::string_view text,
@@ -519,7 +520,9 @@ Status CaptureStore::PutProcessingResult(std::string_view text,
     if (Status status = WriteFileDurably(fs_, results_dir_, file, {content}, kFileMode);
         !status.ok())
       return WithContext(status, context);
-    record.files[name] = Sha256Hex(content);
+    Result<std::string> sha256 = BytesSha256(content);
+    if (!sha256.ok()) return WithContext(sha256.status(), context);
+    record.files[name] = std::move(sha256).value();
   }
   if (Status status = fs_.FsyncDirectory(results_dir_); !status.ok())
     return WithContext(status, context);
@@ -546,7 +549,9 @@ Result<std::map<std::string, std::string>> CaptureStore::ReadProcessingFiles(
         return Status(ErrorCode::kDataLoss, "result file " + path + " is missing");
       return content.status();
     }
-    if (Sha256Hex(*content) != sha256)
+    const Result<std::string> hashed = BytesSha256(*content);
+    if (!hashed.ok()) return WithContext(hashed.status(), path);
+    if (*hashed != sha256)
       return Status(ErrorCode::kDataLoss, "result file " + path + " does not match its SHA-256");
     out[name] = std::move(*content);
   }

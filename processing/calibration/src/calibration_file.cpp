@@ -5,11 +5,9 @@
 #include <Eigen/LU>
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
-#include "bsls/io/bounded_yaml.h"
-#include "bsls/io/frame_file.h"
+#include "bsls/common/atomic_file.h"
+#include "calibration_reader.h"
 
 namespace bsls::calibration {
 namespace {
@@ -90,43 +88,11 @@ void CameraSigmas(YAML::Emitter& out, const CameraParameterSigmas& s) {
 
 // ---------------------------------------------------------------- reading
 
-// Reads nodes, naming the file and the key path in every error.
-class Reader {
+// Reads nodes, naming the file and the key path in every error: scalars
+// and mappings as the head is read (calibration_reader.h), and vectors.
+class Reader : public CalibrationReader {
  public:
-  explicit Reader(std::string name) : name_(std::move(name)) {}
-
-  [[noreturn]] void Fail(const std::string& where, const std::string& why) const {
-    throw CalibrationFileError(name_ + ": " + (where.empty() ? "" : where + ": ") + why);
-  }
-
-  YAML::Node Child(const YAML::Node& node, const std::string& key, const std::string& where,
-                   bool map = true) const {
-    const std::string path = where.empty() ? key : where + "." + key;
-    // A list item written as a value, or a value where a mapping belongs:
-    // yaml-cpp's operator[] would throw its own BadSubscript.
-    if (!node.IsMap()) Fail("", "'" + where + "' must be a mapping with '" + key + "'");
-    const YAML::Node child = node[key];
-    if (!child) Fail("", "missing key '" + path + "'");
-    if (map && !child.IsMap()) Fail("", "'" + path + "' must be a mapping");
-    return child;
-  }
-
-  template <typename T>
-  T Get(const YAML::Node& node, const std::string& key, const std::string& where) const {
-    const YAML::Node child = Child(node, key, where, false);
-    const std::string path = where.empty() ? key : where + "." + key;
-    if (!child.IsScalar()) Fail("", "'" + path + "' must be a " + TypeName<T>());
-    T value{};
-    try {
-      value = child.as<T>();
-    } catch (const YAML::Exception&) {
-      Fail("", "'" + path + "' must be a " + TypeName<T>() + ", not '" + child.Scalar() + "'");
-    }
-    if constexpr (std::is_floating_point_v<T>) {
-      if (!std::isfinite(value)) Fail("", "'" + path + "' is not a finite number");
-    }
-    return value;
-  }
+  using CalibrationReader::CalibrationReader;
 
   Eigen::VectorXd Vector(const YAML::Node& node, const std::string& key, const std::string& where,
                          int size) const {
@@ -153,17 +119,6 @@ class Reader {
                           const std::string& where) const {
     return Vector(node, key, where, 3);
   }
-
- private:
-  template <typename T>
-  static std::string TypeName() {
-    if constexpr (std::is_same_v<T, bool>) return "boolean";
-    if constexpr (std::is_integral_v<T>) return "whole number";
-    if constexpr (std::is_floating_point_v<T>) return "number";
-    return "string";
-  }
-
-  std::string name_;
 };
 
 std::string Join(const std::string& where, const std::string& key) {
@@ -402,33 +357,19 @@ void WriteDroppedViews(YAML::Emitter& out, const SideCalibration& c) {
 
 // ---------------------------------------------------------------- reading, by section
 
-// The root mapping, checked to be this format at the supported version; the
-// record's versions filled in.
-YAML::Node ReadRoot(const Reader& r, const std::string& text, CalibrationRecord* record) {
-  YAML::Node root;
-  try {
-    root = io::LoadBoundedYaml(text);
-  } catch (const YAML::Exception& e) {
-    r.Fail("", "not valid YAML: " + e.msg + " (line " + std::to_string(e.mark.line + 1) + ")");
-  }
-  if (!root.IsMap()) r.Fail("", "not a calibration file (expected a YAML mapping)");
-  const auto format = r.Get<std::string>(root, "format", "");
-  if (format != kCalibrationFormatName)
-    r.Fail("", "format is '" + format + "', expected '" + kCalibrationFormatName + "'");
-  record->format_version = r.Get<int>(root, "format_version", "");
-  if (record->format_version != kCalibrationFormatVersion)
-    r.Fail("", "format_version " + std::to_string(record->format_version) +
-                   " is not supported (this software reads version " +
-                   std::to_string(kCalibrationFormatVersion) + ")");
-  record->software_version = r.Get<std::string>(root, "software_version", "");
+// The root mapping, its head (format, version, side) checked as
+// calibration_header.h reads it; the record's versions and side filled in.
+YAML::Node ReadRoot(const std::string& text, const std::string& name, CalibrationRecord* record) {
+  YAML::Node root = ParseCalibrationYaml(text, name);
+  const CalibrationHeader header = ReadCalibrationHeader(root, name);
+  record->format_version = header.format_version;
+  record->software_version = header.software_version;
+  record->calibration.side = header.side;
   return root;
 }
 
-// Reads side, image size, manifest hash, pattern and target, each checked.
+// Reads image size, manifest hash, pattern and target, each checked.
 void ReadHeader(const Reader& r, const YAML::Node& root, SideCalibration& c) {
-  const auto side = pattern::ParseSide(r.Get<std::string>(root, "side", ""));
-  if (!side) r.Fail("side", "must be left or right");
-  c.side = *side;
   const YAML::Node image = r.Child(root, "image", "");
   c.width = r.Get<int>(image, "width", "image");
   c.height = r.Get<int>(image, "height", "image");
@@ -683,7 +624,7 @@ std::string CalibrationToYaml(const SideCalibration& c, const std::string& softw
 CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string& name) {
   const Reader r(name);
   CalibrationRecord record;
-  const YAML::Node root = ReadRoot(r, text, &record);
+  const YAML::Node root = ReadRoot(text, name, &record);
   SideCalibration& c = record.calibration;
   ReadHeader(r, root, c);
 
@@ -712,21 +653,11 @@ CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string
 
 void SaveCalibration(const std::filesystem::path& path, const SideCalibration& calibration,
                      const std::string& software_version) {
-  io::WriteFileAtomically(path.string(), CalibrationToYaml(calibration, software_version));
+  WriteFileAtomically(path.string(), CalibrationToYaml(calibration, software_version));
 }
 
 CalibrationRecord LoadCalibration(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw CalibrationFileError(name + ": no such file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw CalibrationFileError(name + ": cannot be opened");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw CalibrationFileError(name + ": read error");
-  if (text.str().empty()) throw CalibrationFileError(name + ": the file is empty");
-  return CalibrationFromYaml(text.str(), name);
+  return CalibrationFromYaml(ReadCalibrationText(path), path.string());
 }
 
 }  // namespace bsls::calibration

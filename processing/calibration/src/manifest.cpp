@@ -5,9 +5,9 @@
 #include <cmath>
 #include <set>
 
-#include "bsls/io/bounded_yaml.h"
-#include "bsls/io/digest.h"
-#include "bsls/io/frame_file.h"
+#include "bsls/common/errors.h"
+#include "bsls/common/sha256.h"
+#include "bsls/config/bounded_yaml.h"
 
 namespace bsls::calibration {
 namespace {
@@ -77,13 +77,13 @@ Manifest LoadManifest(const std::filesystem::path& path) {
   Manifest m;
   m.path = path;
   try {
-    m.sha256 = io::Sha256OfFile(file);
-  } catch (const io::InputError& e) {
+    m.sha256 = Sha256OfFile(file);
+  } catch (const InputError& e) {
     throw ManifestError(e.what());
   }
   YAML::Node root;
   try {
-    root = io::LoadBoundedYamlFile(file);
+    root = LoadBoundedYamlFile(file);
   } catch (const YAML::Exception& e) {
     throw ManifestError(file + ": not valid YAML: " + e.msg + " (line " +
                         std::to_string(e.mark.line + 1) + ")");

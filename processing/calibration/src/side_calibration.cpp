@@ -10,6 +10,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "bsls/common/errors.h"
 #include "bsls/io/frame_file.h"
 #include "point_set_geometry.h"
 
@@ -68,7 +69,7 @@ cv::Mat LoadView(const ManifestView& view, const std::string& name, const io::Fr
   cv::Mat grey;
   try {
     grey = io::LoadGreyFrame(view.image.string(), nullptr, limits);
-  } catch (const io::InputError& e) {
+  } catch (const InputError& e) {
     Throw(CalibrationErrorReason::kUnreadableInput, "calibration: " + std::string(e.what()));
   }
   if (*width == 0) {

@@ -1,9 +1,5 @@
 #include "bsls/io/frame_file.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -14,7 +10,8 @@
 #include <iterator>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <random>
+
+#include "bsls/common/atomic_file.h"
 
 namespace bsls::io {
 namespace {
@@ -147,44 +144,6 @@ cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::stri
   if (grey.depth() == CV_16U) grey.convertTo(grey, CV_8U, 1.0 / 257.0);
   if (conversion) *conversion = conv;
   return grey.isContinuous() ? grey : grey.clone();
-}
-
-void WriteFileAtomically(const std::string& path, std::string_view bytes) {
-  namespace fs = std::filesystem;
-  const fs::path target(path);
-  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::random_device rd;
-  const fs::path temp =
-      folder / ("." + target.filename().string() + ".tmp" + std::to_string(rd() % 1000000));
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
-  if (fd < 0) throw OutputError(path + ": cannot create a temporary file: " + Errno());
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const std::string why = Errno();
-      ::close(fd);
-      ::unlink(temp.c_str());
-      throw OutputError(path + ": write failed: " + why);
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0 || ::close(fd) != 0) {
-    const std::string why = Errno();
-    ::unlink(temp.c_str());
-    throw OutputError(path + ": cannot flush to disk: " + why);
-  }
-  if (::rename(temp.c_str(), target.c_str()) != 0) {
-    const std::string why = Errno();
-    ::unlink(temp.c_str());
-    throw OutputError(path + ": cannot be put in place: " + why);
-  }
-  const int dir = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dir >= 0) {
-    ::fsync(dir);
-    ::close(dir);
-  }
 }
 
 void WritePngAtomically(const std::string& path, const cv::Mat& image) {

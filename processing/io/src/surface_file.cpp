@@ -19,6 +19,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "bsls/common/atomic_file.h"
+
 namespace bsls::io {
 namespace {
 

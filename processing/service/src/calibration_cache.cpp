@@ -3,7 +3,7 @@
 #include <cassert>
 
 #include "bsls/calibration/calibration_file.h"
-#include "bsls/io/digest.h"
+#include "bsls/common/sha256.h"
 
 namespace bsls::processing {
 
@@ -11,9 +11,7 @@ CalibrationCache::CalibrationCache(std::size_t max_entries) : max_entries_(max_e
   assert(max_entries >= 1);
 }
 
-std::string CalibrationCache::IdOf(std::string_view yaml) {
-  return "sha256:" + io::Sha256Hex(yaml);
-}
+std::string CalibrationCache::IdOf(std::string_view yaml) { return "sha256:" + Sha256Hex(yaml); }
 
 std::shared_ptr<const CachedCalibration> CalibrationCache::Put(std::string yaml,
                                                                const std::string& name) {

@@ -15,9 +15,10 @@
 #include "bsls/calibration/calibration_file.h"
 #include "bsls/calibration/calibration_report.h"
 #include "bsls/calibration/manifest.h"
+#include "bsls/common/errors.h"
+#include "bsls/common/sha256.h"
+#include "bsls/config/bounded_yaml.h"
 #include "bsls/decoder/decode_output.h"
-#include "bsls/io/bounded_yaml.h"
-#include "bsls/io/digest.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/measurement/measurement_error.h"
 #include "bsls/rpc/artifacts.h"
@@ -242,8 +243,7 @@ void FillSide(const reconstruction::SideOutcome& o, pattern::Side side, v1::Side
 // capture store hashes them).
 std::string PackedSha256(const cv::Mat& grey) {
   const cv::Mat packed = grey.isContinuous() ? grey : grey.clone();
-  return io::Sha256Hex(
-      std::string_view(reinterpret_cast<const char*>(packed.data), packed.total()));
+  return Sha256Hex(std::string_view(reinterpret_cast<const char*>(packed.data), packed.total()));
 }
 
 // Refuses a manifest whose `image:` entries (at any depth) are not relative
@@ -251,7 +251,7 @@ std::string PackedSha256(const cv::Mat& grey) {
 void ConfineManifestImages(const std::string& yaml) {
   YAML::Node root;
   try {
-    root = io::LoadBoundedYaml(yaml);
+    root = LoadBoundedYaml(yaml);
   } catch (const YAML::Exception&) {
     return;
   }
@@ -674,7 +674,7 @@ Status ProcessingService::Measure(grpc::ServerContext* context, const v1::Measur
         plan.baseline_name = "baseline_ply";
         plan.baseline_params.register_rigidly = !request->baseline_shares_frame();
       }
-    } catch (const io::InputError& e) {
+    } catch (const InputError& e) {
       Refuse(StatusCode::INVALID_ARGUMENT, e.what());
     }
     std::string why;

@@ -1,25 +1,33 @@
 // What both services (bslsd, bsls-processd) do the same way to stay within
-// bounds whatever their callers send: HTTP/2 keep-alive, ping and
-// stream limits set on the gRPC server through channel arguments, read from
-// the same configuration keys under `listen:`, and the allocator discipline
+// bounds whatever their callers send: the connections their Unix socket
+// takes at once, HTTP/2 keep-alive, ping and stream limits set on the gRPC
+// server through channel arguments, both under the same configuration keys
+// of `listen:` (named here with their ranges; each service's configuration
+// reads them with bsls::ReadKeysInRange), and the allocator discipline
 // that gives memory back after a burst of requests or a flood.
 //
-// Thread-safety: ReadHttp2Limits, DumpHttp2Limits and ApplyHttp2Limits are
-// pure; TuneAllocator is called once, from main, before any thread starts;
-// ReturnFreedMemory is safe from any thread.
+// Thread-safety: the key tables and ApplyHttp2Limits are pure; TuneAllocator
+// is called once, from main, before any thread starts; ReturnFreedMemory is
+// safe from any thread.
 #ifndef BSLS_RPC_SERVER_LIMITS_H_
 #define BSLS_RPC_SERVER_LIMITS_H_
 
-#include <yaml-cpp/yaml.h>
-
-#include <set>
-#include <string>
+#include <vector>
 
 namespace grpc {
 class ServerBuilder;
 }
 
 namespace bsls::rpc {
+
+// Connections of a service's Unix socket open at once (handed to gRPC and
+// not yet closed by it), in all and per peer uid; a connection beyond
+// either is closed as soon as it is accepted (rpc::UnixAcceptor), so that
+// one user cannot take every descriptor. TCP connections are gRPC's own.
+struct ConnectionLimits {
+  int max_connections = 128;          // open at once, in all
+  int max_connections_per_user = 32;  // open at once, per peer uid
+};
 
 // The HTTP/2 limits of one server, per connection. Times in milliseconds.
 struct Http2Limits {
@@ -41,16 +49,21 @@ struct Http2Limits {
   int max_concurrent_streams = 100;
 };
 
-// The configuration keys of Http2Limits (for io::OnlyKeys of `listen:`).
-const std::set<std::string>& Http2LimitKeys();
+// One integer configuration key under `listen:` of a limits struct: its
+// name, the member it sets and the range a value must lie in.
+template <typename Limits>
+struct LimitKey {
+  const char* name;
+  int Limits::*member;
+  int min;
+  int max;
+};
 
-// Reads the keys of Http2Limits present in the map `node` (at `where`, e.g.
-// "listen") into `out`; throws io::ConfigKeyError naming the key when a value
-// has the wrong type or lies outside its range.
-void ReadHttp2Limits(const YAML::Node& node, const std::string& where, Http2Limits& out);
+// The keys of ConnectionLimits, in the order --check-config prints them.
+const std::vector<LimitKey<ConnectionLimits>>& ConnectionLimitKeys();
 
-// Writes the keys of `limits` into the open map of `out` (--check-config).
-void DumpHttp2Limits(YAML::Emitter& out, const Http2Limits& limits);
+// The keys of Http2Limits, in the order --check-config prints them.
+const std::vector<LimitKey<Http2Limits>>& Http2LimitKeys();
 
 // Sets `limits` on `builder` as gRPC channel arguments (keep-alive, ping
 // strikes, idle connections, concurrent streams).

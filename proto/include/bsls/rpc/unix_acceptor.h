@@ -32,6 +32,8 @@
 #include <string>
 #include <thread>
 
+#include "bsls/rpc/server_limits.h"
+
 namespace bsls::rpc {
 
 // Where and how the socket is made, and the limits on its connections.
@@ -40,8 +42,7 @@ struct UnixAcceptorOptions {
   mode_t mode = 0660;          // permissions of the socket file
   std::optional<gid_t> group;  // owning group of the socket file (else the process's)
   int backlog = 64;
-  int max_connections = 128;          // open at once, in all
-  int max_connections_per_user = 32;  // open at once, per peer uid
+  ConnectionLimits connections;  // open at once, in all and per peer uid
 };
 
 // Why a socket could not be made.

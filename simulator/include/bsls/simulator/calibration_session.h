@@ -36,7 +36,7 @@
 //
 // Errors: std::invalid_argument naming the field for invalid params, and
 // naming the view and the square when a camera view does not show the whole
-// grid (CalibrationSessionParams::grid_margin_px); bsls::io::OutputError from
+// grid (CalibrationSessionParams::grid_margin_px); bsls::OutputError from
 // WriteCalibrationSession.
 //
 // Thread-safety: pure functions of their arguments; rendering runs rows in
@@ -230,7 +230,7 @@ inline constexpr const char* kSessionTruthName = "truth.json";
 // Writes every view's PNG, then truth.json, then session.yaml (last, so a
 // manifest only exists once everything it lists does) into `folder`, creating
 // it when needed; each file is written atomically. Returns the manifest path.
-// Throws bsls::io::OutputError naming the file.
+// Throws bsls::OutputError naming the file.
 std::filesystem::path WriteCalibrationSession(const CalibrationSession& session,
                                               const std::filesystem::path& folder);
 

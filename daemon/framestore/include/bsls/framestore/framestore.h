@@ -20,7 +20,7 @@
 #include <string_view>
 #include <vector>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 
 namespace bsls::framestore {
 

@@ -25,7 +25,7 @@
 #include <string>
 #include <string_view>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 
 namespace bsls::framestore {
 

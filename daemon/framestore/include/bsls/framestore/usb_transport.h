@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 
 namespace bsls::framestore {
 

@@ -68,13 +68,12 @@ class CaptureDevice {
   // The device now.
   DeviceSnapshot Snapshot() const;
   // Makes `camera` the selected one (previews and single-side grabs follow it).
-  framestore::Status SelectCamera(framestore::Camera camera, Clock::time_point deadline);
+  Status SelectCamera(framestore::Camera camera, Clock::time_point deadline);
   // Sets the gain of every camera.
-  framestore::Status SetGain(int gain, Clock::time_point deadline);
+  Status SetGain(int gain, Clock::time_point deadline);
   // Grabs `sides`: one frame per camera, in camera order. kDeadlineExceeded
   // when `deadline` passes before the device delivered.
-  framestore::Result<std::vector<framestore::GreyFrame>> Grab(GrabSides sides,
-                                                              Clock::time_point deadline);
+  Result<std::vector<framestore::GreyFrame>> Grab(GrabSides sides, Clock::time_point deadline);
 
   // One open preview stream.
   class Preview {
@@ -104,11 +103,10 @@ class CaptureDevice {
   };
   void Loop();
   void Publish(framestore::GreyFrame frame);
-  void NoteResult(const framestore::Status& status);
+  void NoteResult(const Status& status);
   // Runs `work` on the capture thread and waits for it (or the deadline).
   template <typename T>
-  framestore::Result<T> Run(std::function<framestore::Result<T>(framestore::Framestore&)> work,
-                            Clock::time_point deadline);
+  Result<T> Run(std::function<Result<T>(framestore::Framestore&)> work, Clock::time_point deadline);
 
   std::unique_ptr<framestore::Framestore> framestore_;
   DeviceCallbacks callbacks_;

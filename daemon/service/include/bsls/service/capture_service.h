@@ -15,7 +15,7 @@
 #include <functional>
 #include <string>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 #include "bsls/service/capture_device.h"
 #include "bsls/service/event_hub.h"
 #include "bsls/service/processing_queue.h"
@@ -43,9 +43,9 @@ struct ServiceLimits {
 };
 
 // The grpc::StatusCode of a layer error code.
-grpc::StatusCode ToGrpcCode(framestore::ErrorCode code);
+grpc::StatusCode ToGrpcCode(ErrorCode code);
 // A grpc::Status carrying `status`'s code and message.
-grpc::Status ToGrpc(const framestore::Status& status);
+grpc::Status ToGrpc(const Status& status);
 
 class CaptureService final : public v1::CaptureDaemon::Service {
  public:

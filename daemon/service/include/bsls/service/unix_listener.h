@@ -23,7 +23,7 @@
 #include <optional>
 #include <string>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 #include "bsls/rpc/unix_acceptor.h"
 #include "bsls/service/roles.h"
 
@@ -54,11 +54,7 @@ struct UnixListenerOptions {
   mode_t mode = 0660;          // permissions of the socket file
   std::optional<gid_t> group;  // owning group of the socket file (else the daemon's)
   int backlog = 64;
-  // Connections open at once (handed to gRPC and not yet closed by it), in
-  // all and per peer uid; a connection beyond either is closed as soon as
-  // it is accepted, so that one user cannot take every descriptor.
-  int max_connections = 128;
-  int max_connections_per_user = 32;
+  rpc::ConnectionLimits connections;
 };
 
 // bslsd's front door: rpc::UnixAcceptor (limits, descriptor exhaustion,
@@ -68,8 +64,7 @@ class UnixListener {
  public:
   // Binds and listens on options.path (a stale socket file left by a dead
   // daemon is replaced; a live one is kAlreadyExists).
-  static framestore::Result<std::unique_ptr<UnixListener>> Create(
-      const UnixListenerOptions& options);
+  static Result<std::unique_ptr<UnixListener>> Create(const UnixListenerOptions& options);
   ~UnixListener();
   UnixListener(const UnixListener&) = delete;
   UnixListener& operator=(const UnixListener&) = delete;
@@ -91,7 +86,7 @@ class UnixListener {
   // waits a moment before it accepts again instead of spinning.
   std::uint64_t shed() const { return acceptor_->shed(); }
   // Connections closed at once because their user or everyone together had
-  // as many open as allowed (options.max_connections*).
+  // as many open as allowed (options.connections).
   std::uint64_t refused() const { return acceptor_->refused(); }
 
  private:

@@ -15,13 +15,10 @@
 #include <memory>
 #include <string>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 
 namespace bsls::slides {
 
-using framestore::ErrorCode;
-using framestore::Result;
-using framestore::Status;
 using Clock = std::chrono::steady_clock;
 
 class GpioLines {

@@ -21,13 +21,9 @@
 #include <string_view>
 #include <vector>
 
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 
 namespace bsls::store {
-
-using framestore::ErrorCode;
-using framestore::Result;
-using framestore::Status;
 
 // Free space of the filesystem holding a path, in bytes (statvfs(3)).
 struct SpaceInfo {

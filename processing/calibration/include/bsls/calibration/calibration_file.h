@@ -24,23 +24,15 @@
 #define BSLS_CALIBRATION_CALIBRATION_FILE_H_
 
 #include <filesystem>
-#include <stdexcept>
 #include <string>
 
+#include "bsls/calibration/calibration_header.h"
 #include "bsls/calibration/side_calibration.h"
 
 namespace bsls::calibration {
 
-inline constexpr const char* kCalibrationFormatName = "bsls-calibration";
-inline constexpr int kCalibrationFormatVersion = 1;
-
-// A calibration file that cannot be used; what() names the file and the
-// reason (another format or version, not YAML, truncated, a missing key, a
-// wrong type, a non-finite number, an impossible value).
-class CalibrationFileError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+// kCalibrationFormatName, kCalibrationFormatVersion and CalibrationFileError
+// are calibration_header.h's.
 
 // A loaded calibration file: the calibration and who wrote it.
 struct CalibrationRecord {
@@ -59,7 +51,7 @@ std::string CalibrationToYaml(const SideCalibration& calibration,
 CalibrationRecord CalibrationFromYaml(const std::string& text, const std::string& name);
 
 // Writes the file atomically (temporary file, fsync, rename): a reader sees
-// the old file or the whole new one, never part. Throws io::OutputError
+// the old file or the whole new one, never part. Throws OutputError
 // naming the file.
 void SaveCalibration(const std::filesystem::path& path, const SideCalibration& calibration,
                      const std::string& software_version);

@@ -1,28 +1,19 @@
-// Reading frames from image files and writing output files so that a reader
-// never sees them half-written (contracts section 5).
+// Frames in image files: reading PNG and PNM as 8-bit grey, and writing PNG
+// so that a reader never sees it half-written (contracts section 5).
+//
+// Errors: InputError and OutputError (bsls/common/errors.h).
 #ifndef BSLS_IO_FRAME_FILE_H_
 #define BSLS_IO_FRAME_FILE_H_
 
 #include <cstdint>
 #include <opencv2/core.hpp>
-#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "bsls/common/errors.h"
+
 namespace bsls::io {
-
-// An input file that cannot be used; what() names the file and the reason.
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// An output file that could not be written; what() names the file and the reason.
-class OutputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct FrameLimits {
   int min_side = 16;     // px: smaller frames cannot hold the pattern
@@ -55,10 +46,6 @@ cv::Mat LoadGreyFrame(const std::string& path, FrameConversion* conversion = nul
 // error messages.
 cv::Mat DecodeGreyFrame(const std::vector<unsigned char>& bytes, const std::string& name,
                         FrameConversion* conversion = nullptr, const FrameLimits& limits = {});
-
-// Writes bytes to `path` atomically: a temporary file in the same folder,
-// fsync, rename over the target, fsync of the folder. Throws OutputError.
-void WriteFileAtomically(const std::string& path, std::string_view bytes);
 
 // Encodes an image as PNG and writes it atomically. Throws OutputError.
 void WritePngAtomically(const std::string& path, const cv::Mat& image);

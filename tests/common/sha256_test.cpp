@@ -1,13 +1,13 @@
-#include "bsls/io/digest.h"
+#include "bsls/common/sha256.h"
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
-#include "bsls/io/frame_file.h"
+#include "bsls/common/errors.h"
 
-namespace bsls::io {
+namespace bsls {
 namespace {
 
 // FIPS 180-2 test vectors.
@@ -28,6 +28,18 @@ TEST(Sha256, BinaryBytesAndFilesAgree) {
   std::filesystem::remove(path);
 }
 
+TEST(Sha256, PiecesDigestAsTheWhole) {
+  const std::string text = "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq";
+  Sha256 digest;
+  digest.Update(text.substr(0, 5));
+  digest.Update(text.data() + 5, 0);
+  digest.Update(text.substr(5));
+  EXPECT_EQ(digest.HexDigest(), Sha256Hex(text));
+  // Spent: a second digest is an error reported, not undefined behaviour.
+  EXPECT_THROW(digest.HexDigest(), DigestError);
+  EXPECT_THROW(digest.Update("more"), DigestError);
+}
+
 TEST(Sha256, MissingFileNamesIt) {
   try {
     Sha256OfFile("/nonexistent/manifest.yaml");
@@ -38,4 +50,4 @@ TEST(Sha256, MissingFileNamesIt) {
 }
 
 }  // namespace
-}  // namespace bsls::io
+}  // namespace bsls

@@ -1,4 +1,4 @@
-#include "bsls/io/bounded_yaml.h"
+#include "bsls/config/bounded_yaml.h"
 
 #include <yaml-cpp/eventhandler.h>
 
@@ -7,7 +7,7 @@
 #include <iterator>
 #include <sstream>
 
-namespace bsls::io {
+namespace bsls {
 namespace {
 
 // Counts nodes and depth on the parser's events; throws at the first that
@@ -82,4 +82,4 @@ YAML::Node LoadBoundedYamlFile(const std::string& path, const YamlLimits& limits
   return LoadBoundedYaml(text, limits);
 }
 
-}  // namespace bsls::io
+}  // namespace bsls

@@ -1,8 +1,8 @@
-// io::LoadBoundedYaml on what a hostile or careless client sends: aliases
+// LoadBoundedYaml on what a hostile or careless client sends: aliases
 // that make a tree contain itself or grow 8x per level, deep nesting, too
 // many nodes, an oversized file; and documents of the project's own shape,
 // which load as yaml-cpp loads them.
-#include "bsls/io/bounded_yaml.h"
+#include "bsls/config/bounded_yaml.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <fstream>
 #include <string>
 
-namespace bsls::io {
+namespace bsls {
 namespace {
 
 // The message of the ParserException `text` raises, or "" when it loads.
@@ -94,4 +94,4 @@ TEST(BoundedYaml, FilesAreBoundedBeforeTheyAreRead) {
 }
 
 }  // namespace
-}  // namespace bsls::io
+}  // namespace bsls

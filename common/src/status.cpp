@@ -1,6 +1,6 @@
-#include "bsls/framestore/status.h"
+#include "bsls/common/status.h"
 
-namespace bsls::framestore {
+namespace bsls {
 
 std::string_view ToString(ErrorCode code) {
   switch (code) {
@@ -32,7 +32,7 @@ std::string_view ToString(ErrorCode code) {
 
 std::string Status::ToString() const {
   if (ok()) return "ok";
-  return std::string(framestore::ToString(code_)) + ": " + message_;
+  return std::string(bsls::ToString(code_)) + ": " + message_;
 }
 
-}  // namespace bsls::framestore
+}  // namespace bsls

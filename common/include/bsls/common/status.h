@@ -1,10 +1,12 @@
-// The error type of the framestore layer: a code the gRPC layer maps one to
-// one onto a grpc::StatusCode, and a message that names the input or the
-// port/state and the reason. No exceptions cross this layer's interfaces.
+// The error type of the layers that report errors as values (the daemon's
+// framestore, store, slides and service layers, bslsd): a code the gRPC
+// layer maps one to one onto a grpc::StatusCode, and a message that names
+// the input or the port/state and the reason. No exceptions cross the
+// interfaces of those layers.
 //
 // Thread-safety: Status and Result are values.
-#ifndef BSLS_FRAMESTORE_STATUS_H_
-#define BSLS_FRAMESTORE_STATUS_H_
+#ifndef BSLS_COMMON_STATUS_H_
+#define BSLS_COMMON_STATUS_H_
 
 #include <cassert>
 #include <optional>
@@ -12,7 +14,7 @@
 #include <string_view>
 #include <utility>
 
-namespace bsls::framestore {
+namespace bsls {
 
 // What went wrong, in the vocabulary of gRPC status codes (same meanings).
 enum class ErrorCode {
@@ -94,6 +96,6 @@ class Result {
   Status status_;
 };
 
-}  // namespace bsls::framestore
+}  // namespace bsls
 
-#endif  // BSLS_FRAMESTORE_STATUS_H_
+#endif  // BSLS_COMMON_STATUS_H_

@@ -17,15 +17,15 @@
 // YAML::BadFile for a file that cannot be read.
 //
 // Thread-safety: pure functions (and the file).
-#ifndef BSLS_IO_BOUNDED_YAML_H_
-#define BSLS_IO_BOUNDED_YAML_H_
+#ifndef BSLS_CONFIG_BOUNDED_YAML_H_
+#define BSLS_CONFIG_BOUNDED_YAML_H_
 
 #include <yaml-cpp/yaml.h>
 
 #include <cstddef>
 #include <string>
 
-namespace bsls::io {
+namespace bsls {
 
 struct YamlLimits {
   int max_depth = 32;                 // nested sequences and mappings
@@ -41,6 +41,6 @@ YAML::Node LoadBoundedYaml(const std::string& text, const YamlLimits& limits = {
 // is larger than limits.max_bytes.
 YAML::Node LoadBoundedYamlFile(const std::string& path, const YamlLimits& limits = {});
 
-}  // namespace bsls::io
+}  // namespace bsls
 
-#endif  // BSLS_IO_BOUNDED_YAML_H_
+#endif  // BSLS_CONFIG_BOUNDED_YAML_H_

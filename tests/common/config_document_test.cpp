@@ -1,6 +1,6 @@
 // The configuration document behind bslsd's and bsls-processd's settings:
 // the file with "key.path=value" overrides on top.
-#include "bsls/io/config_document.h"
+#include "bsls/config/config_document.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-namespace bsls::io {
+namespace bsls {
 namespace {
 
 // The key and message of the ConfigKeyError that `overrides` cause ("" and
@@ -47,4 +47,4 @@ TEST(ConfigDocument, AnOverrideInsideAValueNamesTheKey) {
 }
 
 }  // namespace
-}  // namespace bsls::io
+}  // namespace bsls

@@ -1,10 +1,10 @@
-#include "bsls/io/config_document.h"
+#include "bsls/config/config_document.h"
 
 #include <filesystem>
 
-#include "bsls/io/bounded_yaml.h"
+#include "bsls/config/bounded_yaml.h"
 
-namespace bsls::io {
+namespace bsls {
 
 YAML::Node LoadConfigDocument(const std::optional<std::string>& path,
                               const std::vector<std::string>& overrides) {
@@ -82,4 +82,4 @@ void OnlyKeys(const YAML::Node& node, const std::string& where,
   }
 }
 
-}  // namespace bsls::io
+}  // namespace bsls

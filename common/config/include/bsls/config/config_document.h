@@ -4,8 +4,8 @@
 // keys are errors, so a typo never silently keeps a default.
 //
 // Thread-safety: pure functions (and the file).
-#ifndef BSLS_IO_CONFIG_DOCUMENT_H_
-#define BSLS_IO_CONFIG_DOCUMENT_H_
+#ifndef BSLS_CONFIG_CONFIG_DOCUMENT_H_
+#define BSLS_CONFIG_CONFIG_DOCUMENT_H_
 
 #include <yaml-cpp/yaml.h>
 
@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-namespace bsls::io {
+namespace bsls {
 
 // A configuration that cannot be used: `key` (dotted, or "" for the whole
 // file) and the reason; what() is "<key> <reason>".
@@ -71,6 +71,23 @@ void ReadKeyInRange(const YAML::Node& parent, const std::string& where, const ch
   }
 }
 
-}  // namespace bsls::io
+// ReadKeyInRange of each key of `keys` into `object`: each key has `name`,
+// `member` (a pointer to a member of Object), `min` and `max` (e.g.
+// rpc::Http2LimitKeys()). Keys are read in the order of `keys`.
+template <typename Object, typename Keys>
+void ReadKeysInRange(const YAML::Node& parent, const std::string& where, const Keys& keys,
+                     Object& object) {
+  for (const auto& key : keys)
+    ReadKeyInRange(parent, where, key.name, object.*(key.member), key.min, key.max);
+}
 
-#endif  // BSLS_IO_CONFIG_DOCUMENT_H_
+// Writes each key of `keys` (as for ReadKeysInRange) with its value in
+// `object` into the open map of `out`, in the order of `keys`.
+template <typename Object, typename Keys>
+void DumpKeys(YAML::Emitter& out, const Keys& keys, const Object& object) {
+  for (const auto& key : keys) out << YAML::Key << key.name << YAML::Value << object.*(key.member);
+}
+
+}  // namespace bsls
+
+#endif  // BSLS_CONFIG_CONFIG_DOCUMENT_H_
