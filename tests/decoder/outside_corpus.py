@@ -179,14 +179,20 @@ def calibrate_sides(bsls, corpus, work):
     return out
 
 
-def score_frame_calibrated(bsls, obj, side, folder, work, calibration):
-    """One frame processed with its side's calibration: labels with absolute
-    rows and the surface, scored against the truth."""
-    truth_path = os.path.join(folder, "truth.json")
-    with open(truth_path) as f:
+def frame_row(obj, side, folder):
+    """The frame's truth and the start of its row: name, object, side and
+    whether it must be refused."""
+    with open(os.path.join(folder, "truth.json")) as f:
         truth = json.load(f)
     row = {"frame": f"{obj}/{side}", "object": obj, "side": side,
            "expect_failure": truth.get("expect_failure", "")}
+    return truth, row
+
+
+def score_frame_calibrated(bsls, obj, side, folder, work, calibration):
+    """One frame processed with its side's calibration: labels with absolute
+    rows and the surface, scored against the truth."""
+    truth, row = frame_row(obj, side, folder)
     if not calibration[side]:
         row.update(refused=True, exit=-1, reason="side not calibrated: " + calibration[side + "_why"])
         return row
@@ -215,14 +221,11 @@ def score_frame_calibrated(bsls, obj, side, folder, work, calibration):
 
 
 def score_frame(bsls, obj, side, folder, work):
+    truth, row = frame_row(obj, side, folder)
     truth_path = os.path.join(folder, "truth.json")
-    with open(truth_path) as f:
-        truth = json.load(f)
     out = os.path.join(work, f"{obj}_{side}.json")
     proc = run([bsls, "process", os.path.join(folder, "image.png"), "--side", side,
                 "--junctions", out])
-    row = {"frame": f"{obj}/{side}", "object": obj, "side": side,
-           "expect_failure": truth.get("expect_failure", "")}
     if proc.returncode != 0:
         row.update(refused=True, exit=proc.returncode, reason=proc.stderr.strip()[-200:])
         return row
