@@ -43,17 +43,17 @@ ExtractionResult ExtractFeatures(const cv::Mat& grey, const ExtractionParams& pa
     // this one thins (the same image either way).
     std::future<cv::Mat> smoothing;
     if (params.recentre && cv::getNumThreads() > 1)
-      smoothing = std::async(std::launch::async, [&grey, &params] {
-        return internal::RecentreSmoothing(grey, params.recentre_params, false);
+      smoothing = std::async(std::launch::async, [&grey, &params, &cancel] {
+        return internal::RecentreSmoothing(grey, params.recentre_params, false, cancel);
       });
     internal::PaddedBinary skeleton(result.mask);
     internal::ZhangSuenThinInPlace(&skeleton, params.zhang_suen, cancel);
     internal::MakeOnePixelWideInPlace(&skeleton, params.t_junctions, cancel);
     if (params.recentre) {
-      const cv::Mat smoothed =
-          smoothing.valid() ? smoothing.get()
-                            : internal::RecentreSmoothing(grey, params.recentre_params, true);
-      internal::RecentreOnRidgeInPlace(&skeleton, smoothed, params.recentre_params);
+      const cv::Mat smoothed = smoothing.valid() ? smoothing.get()
+                                                 : internal::RecentreSmoothing(
+                                                       grey, params.recentre_params, true, cancel);
+      internal::RecentreOnRidgeInPlace(&skeleton, smoothed, params.recentre_params, cancel);
       cancel.ThrowIfRequested("the re-centring on ridges");
     }
     internal::PruneSpursInPlace(&skeleton, params.spurs);

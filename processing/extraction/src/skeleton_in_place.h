@@ -23,15 +23,22 @@ void ZhangSuenThinInPlace(PaddedBinary* img, const ZhangSuenParams& params,
 void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions,
                              const Cancellation& cancel = {});
 
+// Skeleton pixels RecentreOnRidgeInPlace looks at between two questions to
+// its Cancellation.
+constexpr int kRecentrePixelsPerQuestion = 4096;
+
 // The grey image (CV_8UC1) smoothed as RecentreOnRidge reads it, CV_32FC1 in a
 // buffer laid out like a PaddedBinary of its size, its frame -infinity: band by
-// band on OpenCV's thread pool, or all on the calling thread (the same values).
-cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel);
+// band on OpenCV's thread pool, or on the calling thread (the same values);
+// asks `cancel` before every band (throws Cancelled after the bands).
+cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel,
+                          const Cancellation& cancel = {});
 
 // RecentreOnRidge (thinning.h) on *img, reading `smoothed`: RecentreSmoothing
-// of the grey image, of the image's size.
+// of the grey image, of the image's size; asks `cancel` every
+// kRecentrePixelsPerQuestion pixels it looks at.
 void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
-                            const RecentreParams& params);
+                            const RecentreParams& params, const Cancellation& cancel = {});
 
 // PruneSpurs (pruning.h) on *img.
 void PruneSpursInPlace(PaddedBinary* img, const SpurPruneParams& params);

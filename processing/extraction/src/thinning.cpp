@@ -501,7 +501,8 @@ void MakeOnePixelWideInPlace(PaddedBinary* img, TJunctionShape t_junctions,
   }
 }
 
-cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel) {
+cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, bool in_parallel,
+                          const Cancellation& cancel) {
   // The frame holds -infinity: nothing beyond the image is ever brighter.
   cv::Mat smoothed(grey.rows + 2, grey.cols + 2, CV_32F);
   const float never = -std::numeric_limits<float>::infinity();
@@ -511,18 +512,38 @@ cv::Mat RecentreSmoothing(const cv::Mat& grey, const RecentreParams& params, boo
   smoothed.col(grey.cols + 1).setTo(never);
   cv::Mat inner = smoothed(cv::Rect(1, 1, grey.cols, grey.rows));
   const int half = static_cast<int>(std::ceil(3.0 * params.sigma));
-  if (in_parallel)
-    GaussianBandsInto(grey, params.sigma, half, &inner);
-  else
-    GaussianInto(grey, params.sigma, half, &inner);  // the same values (bands.h)
+  // Band by band (on a ROI the filter reads the rows beyond it, so the values
+  // are those of the whole image at once); once the caller asks to stop, the
+  // bands left skip their work and the stage stops after.
+  const auto band = [&](int y0, int y1) {
+    cv::Mat rows = inner.rowRange(y0, y1);
+    GaussianInto(grey.rowRange(y0, y1), params.sigma, half, &rows);
+  };
+  if (in_parallel) {
+    ForEachBand(grey.rows, [&](int y0, int y1) {
+      if (!cancel.Requested()) band(y0, y1);
+    });
+  } else {
+    for (int y0 = 0; y0 < grey.rows && !cancel.Requested(); y0 += kBandRows)
+      band(y0, std::min(grey.rows, y0 + kBandRows));
+  }
+  cancel.ThrowIfRequested("the smoothing for the re-centring");
   return smoothed;
 }
 
 // The passes of RecentreOnRidge on the padded buffer, pixels addressed by
 // buffer index (no division per look-up).
 void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
-                            const RecentreParams& params) {
+                            const RecentreParams& params, const Cancellation& cancel) {
   const int rows = img->Rows(), cols = img->Cols();
+  // Asked every kRecentrePixelsPerQuestion skeleton pixels looked at (a pass
+  // over an 8 Mpx frame's skeleton takes some 40 ms on one core).
+  int until_question = kRecentrePixelsPerQuestion;
+  const auto ask = [&until_question, &cancel] {
+    if (--until_question > 0) return;
+    until_question = kRecentrePixelsPerQuestion;
+    cancel.ThrowIfRequested("the re-centring on ridges");
+  };
   CV_Assert(smoothed.type() == CV_32F && smoothed.rows == rows + 2 && smoothed.cols == cols + 2 &&
             smoothed.isContinuous());
   const std::ptrdiff_t stride = static_cast<std::ptrdiff_t>(img->Stride());
@@ -540,6 +561,7 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
   {
     const int c = params.junction_clearance;
     for (size_t i : pixels) {
+      ask();
       if (std::popcount(img->CodeOf(i)) < 3) continue;
       const int x = img->X(i), y = img->Y(i);
       for (int yy = std::max(0, y - c); yy <= std::min(rows - 1, y + c); ++yy)
@@ -553,6 +575,7 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
     for (size_t t : targets) moved[t] = 0;
     targets.clear();
     for (size_t pu : pixels) {
+      ask();
       const std::ptrdiff_t p = static_cast<std::ptrdiff_t>(pu);
       if (!set(p) || moved[pu] || near_junction[pu]) continue;
       int nb[2] = {0, 0};  // neighbour numbers (into kDx, kDy, around)
