@@ -293,6 +293,9 @@ Status Validate(const Config& config) {
   if (config.listen.connections.max_connections_per_user >
       config.listen.connections.max_connections)
     return fail("listen.max_connections_per_user is above listen.max_connections");
+  if (config.listen.connections.max_tcp_connections_per_peer >
+      config.listen.connections.max_tcp_connections)
+    return fail("listen.max_tcp_connections_per_peer is above listen.max_tcp_connections");
   if (config.listen.unix_socket.empty() && config.listen.tcp.empty())
     return fail("listen.unix_socket and listen.tcp are both empty: nobody could connect");
   if (!config.listen.tcp.empty() &&

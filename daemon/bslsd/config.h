@@ -47,7 +47,7 @@ struct ListenConfig {
   // Permissions of the socket file; world-writable modes (o+w) are refused:
   // any local user could then call the daemon.
   int socket_mode = 0660;
-  rpc::ConnectionLimits connections;  // of the Unix socket
+  rpc::ConnectionLimits connections;  // of the Unix socket and of TCP
   rpc::Http2Limits http2;             // keep-alive, pings, idle connections, streams
   std::string tcp;                    // "host:port" with mutual TLS; "" : no TCP (the default)
   std::string tls_certificate;        // PEM files, required with tcp

@@ -117,10 +117,10 @@ Status StartProcessing(service::ProcessingQueue& queue) {
 }
 
 // Sets `builder` up to serve `service` with config.listen's limits and, when
-// it names a TCP address, to listen there with mutual TLS (the port bound
-// written to `tcp_port` when the server starts); kInvalidArgument when the
-// TLS files are unusable.
-Status ConfigureServer(const Config& config, grpc::Service* service, int* tcp_port,
+// it names a TCP address, binds it into *tcp with mutual TLS (its connections
+// within listen.max_tcp_connections*); kInvalidArgument when the TLS files
+// are unusable, kUnavailable when the address cannot be bound.
+Status ConfigureServer(const Config& config, grpc::Service* service, rpc::TcpListener* tcp,
                        grpc::ServerBuilder& builder) {
   builder.SetMaxReceiveMessageSize(config.listen.max_receive_message_bytes);
   builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
@@ -140,7 +140,14 @@ Status ConfigureServer(const Config& config, grpc::Service* service, int* tcp_po
     } catch (const rpc::TlsFileError& e) {
       return Status(ErrorCode::kInvalidArgument, e.what());
     }
-    builder.AddListeningPort(config.listen.tcp, tls, tcp_port);
+    rpc::TcpAcceptorOptions options;
+    options.address = config.listen.tcp;
+    options.connections = config.listen.connections;
+    try {
+      *tcp = rpc::ListenTcp(options, tls, builder);
+    } catch (const std::runtime_error& e) {
+      return Status(ErrorCode::kUnavailable, e.what());
+    }
   }
   return Status();
 }
@@ -207,10 +214,14 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
       config.limits, BSLS_VERSION, d->processing_.get());
 
   grpc::ServerBuilder builder;
-  if (Status configured = ConfigureServer(config, d->service_.get(), &d->tcp_port_, builder);
+  if (Status configured = ConfigureServer(config, d->service_.get(), &d->tcp_, builder);
       !configured.ok())
     return configured;
   d->server_ = builder.BuildAndStart();
+  if (d->server_ && d->tcp_.acceptor) {
+    d->tcp_port_ = d->tcp_.acceptor->port();
+    d->tcp_.Start();
+  }
   if (!d->server_ || (!config.listen.tcp.empty() && d->tcp_port_ == 0))
     return Status(ErrorCode::kUnavailable,
                   "the gRPC server could not start" +
@@ -234,6 +245,7 @@ void Daemon::Drain() {
   drained_ = true;
   if (service_) service_->BeginDrain();
   if (listener_) listener_->Stop();
+  tcp_.Stop();
   // The call under way is cancelled; its capture stays pending for the next start.
   if (processing_) processing_->Stop();
   events_.Close();

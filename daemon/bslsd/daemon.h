@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "backends.h"
+#include "bsls/rpc/tcp_acceptor.h"
 #include "bsls/service/capture_device.h"
 #include "bsls/service/capture_service.h"
 #include "bsls/service/event_hub.h"
@@ -74,6 +75,7 @@ class Daemon {
   std::unique_ptr<service::CaptureService> service_;
   std::unique_ptr<grpc::Server> server_;
   std::unique_ptr<service::UnixListener> listener_;
+  rpc::TcpListener tcp_;  // TCP connections, accepted here and handed to server_
   int tcp_port_ = 0;
   bool drained_ = false;
 };

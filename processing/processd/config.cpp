@@ -91,6 +91,9 @@ void Validate(const Config& c) {
   if (l.connections.max_connections_per_user > l.connections.max_connections)
     throw ConfigError(
         "configuration: listen.max_connections_per_user is above listen.max_connections");
+  if (l.connections.max_tcp_connections_per_peer > l.connections.max_tcp_connections)
+    throw ConfigError(
+        "configuration: listen.max_tcp_connections_per_peer is above listen.max_tcp_connections");
   static const std::set<std::string> levels = {"trace", "debug", "info", "warn", "error", "off"};
   if (!levels.count(c.log_level))
     throw ConfigError("configuration: log_level '" + c.log_level +

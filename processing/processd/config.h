@@ -31,7 +31,7 @@ struct ListenConfig {
   std::string tls_client_ca;
   int max_receive_message_bytes = 40 << 20;  // two 4096^2 frames and their request
   int max_send_message_bytes = 5 << 20;      // artifacts travel in 1 MiB chunks
-  rpc::ConnectionLimits connections;         // of the Unix socket (TCP is gRPC's own)
+  rpc::ConnectionLimits connections;         // of the Unix socket and of TCP
   rpc::Http2Limits http2;  // keep-alive, pings, idle connections, streams (same keys)
 };
 

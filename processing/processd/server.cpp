@@ -52,11 +52,15 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     rpc::TlsFiles tls{config.listen.tls_client_ca, config.listen.tls_certificate,
                       config.listen.tls_key,       "listen.tls_client_ca",
                       "listen.tls_certificate",    "listen.tls_key"};
-    builder.AddListeningPort(config.listen.tcp,
-                             config.listen.plaintext_loopback
-                                 ? grpc::InsecureServerCredentials()
-                                 : rpc::MutualTlsServerCredentials(tls),
-                             &s->tcp_port_);
+    rpc::TcpAcceptorOptions tcp;
+    tcp.address = config.listen.tcp;
+    tcp.connections = config.listen.connections;
+    s->tcp_ =
+        rpc::ListenTcp(tcp,
+                       config.listen.plaintext_loopback ? grpc::InsecureServerCredentials()
+                                                        : rpc::MutualTlsServerCredentials(tls),
+                       builder);
+    s->tcp_port_ = s->tcp_.acceptor->port();
   }
   s->server_ = builder.BuildAndStart();
   if (!s->server_ || (!config.listen.tcp.empty() && s->tcp_port_ == 0))
@@ -65,6 +69,7 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
         (config.listen.tcp.empty() ? std::string() : " on TCP " + config.listen.tcp) +
         (config.listen.unix_socket.empty() ? std::string()
                                            : " (socket " + config.listen.unix_socket + ")"));
+  if (s->tcp_.acceptor) s->tcp_.Start();
   if (s->acceptor_) {
     grpc::Server* server = s->server_.get();
     s->acceptor_->Start(
@@ -88,6 +93,7 @@ void Server::Drain() {
   if (service_) service_->BeginDrain();
   // No new connections; the socket file goes if it still is the one made here.
   if (acceptor_) acceptor_->Stop();
+  tcp_.Stop();
   if (server_) {
     // Work under way stops at its next stage; wait for that (at most the
     // drain timeout), then shut down at once: gRPC's own deadline would also

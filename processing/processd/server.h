@@ -16,6 +16,7 @@
 #include <utility>
 
 #include "bsls/processing/processing_service.h"
+#include "bsls/rpc/tcp_acceptor.h"
 #include "bsls/rpc/unix_acceptor.h"
 #include "config.h"
 
@@ -50,6 +51,9 @@ class Server {
   // The Unix socket: its connections are accepted here (within the
   // listen.max_connections* limits) and handed to server_.
   std::unique_ptr<rpc::UnixAcceptor> acceptor_;
+  // TCP: its connections are accepted here (within the
+  // listen.max_tcp_connections* limits) and handed to server_.
+  rpc::TcpListener tcp_;
   int tcp_port_ = 0;
   bool drained_ = false;
 };

@@ -8,7 +8,9 @@ namespace bsls::rpc {
 const std::vector<LimitKey<ConnectionLimits>>& ConnectionLimitKeys() {
   static const std::vector<LimitKey<ConnectionLimits>> keys = {
       {"max_connections", &ConnectionLimits::max_connections, 1, 65536},
-      {"max_connections_per_user", &ConnectionLimits::max_connections_per_user, 1, 65536}};
+      {"max_connections_per_user", &ConnectionLimits::max_connections_per_user, 1, 65536},
+      {"max_tcp_connections", &ConnectionLimits::max_tcp_connections, 1, 65536},
+      {"max_tcp_connections_per_peer", &ConnectionLimits::max_tcp_connections_per_peer, 1, 65536}};
   return keys;
 }
 
@@ -20,7 +22,8 @@ const std::vector<LimitKey<Http2Limits>>& Http2LimitKeys() {
       {"min_ping_interval_ms", &Http2Limits::min_ping_interval_ms, 1000, kDay},
       {"max_ping_strikes", &Http2Limits::max_ping_strikes, 1, 100},
       {"max_connection_idle_ms", &Http2Limits::max_connection_idle_ms, 100, kDay},
-      {"max_concurrent_streams", &Http2Limits::max_concurrent_streams, 1, 10000}};
+      {"max_concurrent_streams", &Http2Limits::max_concurrent_streams, 1, 10000},
+      {"handshake_timeout_ms", &Http2Limits::handshake_timeout_ms, 100, 120000}};
   return keys;
 }
 
@@ -32,6 +35,7 @@ void ApplyHttp2Limits(const Http2Limits& limits, grpc::ServerBuilder& builder) {
   builder.AddChannelArgument(GRPC_ARG_HTTP2_MAX_PING_STRIKES, limits.max_ping_strikes);
   builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS, limits.max_connection_idle_ms);
   builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, limits.max_concurrent_streams);
+  builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, limits.handshake_timeout_ms);
 }
 
 void TuneAllocator() {

@@ -202,6 +202,84 @@ TEST_F(ProcessdServer, UnixConnectionsBeyondTheLimitsAreClosedAtOnce) {
   EXPECT_FALSE(fs::exists(config.listen.unix_socket));
 }
 
+// TCP connections are limited per peer address and in all
+// (listen.max_tcp_connections*); connections beyond are closed at once while
+// another address is still let in, and the service answers after.
+TEST_F(ProcessdServer, TcpConnectionsBeyondTheLimitsAreClosedAtOnce) {
+  Config config;
+  config.listen.unix_socket = "";
+  config.listen.tcp = "127.0.0.1:0";
+  config.listen.plaintext_loopback = true;
+  config.listen.connections.max_tcp_connections = 3;
+  config.listen.connections.max_tcp_connections_per_peer = 2;
+  config.workers = 1;
+  auto server = Server::Start(config, "test");
+  const int port = server->tcp_port();
+  ASSERT_GT(port, 0);
+  std::vector<int> open;
+  for (int i = 0; i < 2; ++i) open.push_back(testing::ConnectTcpFrom("127.0.0.1", port));
+  for (int fd : open) {
+    ASSERT_GE(fd, 0);
+    EXPECT_FALSE(testing::ClosedWithin(fd, 300)) << "a connection within the address's share";
+  }
+  const int beyond_share = testing::ConnectTcpFrom("127.0.0.1", port);
+  EXPECT_TRUE(testing::ClosedWithin(beyond_share, 2000))
+      << "the address's third connection stayed open";
+  ::close(beyond_share);
+  open.push_back(testing::ConnectTcpFrom("127.0.0.2", port));
+  EXPECT_FALSE(testing::ClosedWithin(open.back(), 300)) << "another address was not let in";
+  const int beyond_total = testing::ConnectTcpFrom("127.0.0.3", port);
+  EXPECT_TRUE(testing::ClosedWithin(beyond_total, 2000))
+      << "a connection beyond the total stayed open";
+  ::close(beyond_total);
+  for (int fd : open) ::close(fd);
+  // Once they are gone, the service answers again.
+  std::shared_ptr<grpc::Channel> channel =
+      grpc::CreateChannel("127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials());
+  v1::ServerInfo info;
+  grpc::Status status;
+  for (int attempt = 0; attempt < 20 && !(status = Info(channel, &info)).ok(); ++attempt)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_TRUE(status.ok()) << status.error_message();
+  server->Drain();
+}
+
+// A peer that opens a TCP connection and never begins the TLS handshake
+// holds its slot only until listen.handshake_timeout_ms: the server closes
+// it, and a client of the same address is served after.
+TEST_F(ProcessdServer, ATcpPeerThatNeverShakesHandsIsClosedAfterTheHandshakeTimeout) {
+  testing::TestPki pki(dir_ / "pki", "clinic");
+  const testing::PemFiles server_files = pki.Issue("localhost", true);
+  const testing::PemFiles analyst = pki.Issue("analyst");
+  ASSERT_TRUE(pki.ok());
+  Config config;
+  config.listen.unix_socket = "";
+  config.listen.tcp = "127.0.0.1:0";
+  config.listen.tls_certificate = server_files.certificate;
+  config.listen.tls_key = server_files.key;
+  config.listen.tls_client_ca = pki.ca();
+  config.listen.connections.max_tcp_connections_per_peer = 1;
+  config.listen.http2.handshake_timeout_ms = 1000;
+  auto server = Server::Start(config, "test");
+  const int port = server->tcp_port();
+  const int silent = testing::ConnectTcpFrom("127.0.0.1", port);
+  ASSERT_GE(silent, 0);
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_FALSE(testing::ClosedWithin(silent, 500)) << "closed before the handshake timeout";
+  EXPECT_TRUE(testing::ClosedWithin(silent, 4000)) << "a silent peer kept its connection";
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_LT(seconds, 4.0);
+  ::close(silent);
+  processing::ClientOptions good;
+  good.target = "127.0.0.1:" + std::to_string(port);
+  good.tls = {pki.ca(), analyst.certificate, analyst.key};
+  v1::ServerInfo info;
+  const grpc::Status ok = Info(processing::OpenProcessingChannel(good), &info);
+  EXPECT_TRUE(ok.ok()) << ok.error_message();
+  server->Drain();
+}
+
 // One instance per socket: a second server on a socket that a live one
 // serves refuses to start and leaves it alone; a stale socket file (its
 // server gone) is replaced; a server removes only the socket file it made.

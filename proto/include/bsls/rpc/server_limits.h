@@ -20,13 +20,16 @@ class ServerBuilder;
 
 namespace bsls::rpc {
 
-// Connections of a service's Unix socket open at once (handed to gRPC and
-// not yet closed by it), in all and per peer uid; a connection beyond
-// either is closed as soon as it is accepted (rpc::UnixAcceptor), so that
-// one user cannot take every descriptor. TCP connections are gRPC's own.
+// Connections open at once (handed to gRPC and not yet closed by it): of a
+// service's Unix socket in all and per peer uid (rpc::UnixAcceptor), of its
+// TCP listener in all and per peer address (rpc::TcpAcceptor); a connection
+// beyond a limit is closed as soon as it is accepted, so that one user or
+// one machine cannot take every descriptor.
 struct ConnectionLimits {
-  int max_connections = 128;          // open at once, in all
-  int max_connections_per_user = 32;  // open at once, per peer uid
+  int max_connections = 128;              // Unix socket, in all
+  int max_connections_per_user = 32;      // Unix socket, per peer uid
+  int max_tcp_connections = 128;          // TCP, in all
+  int max_tcp_connections_per_peer = 32;  // TCP, per peer address
 };
 
 // The HTTP/2 limits of one server, per connection. Times in milliseconds.
@@ -47,6 +50,10 @@ struct Http2Limits {
   int max_connection_idle_ms = 300000;
   // Calls open at once on one connection; more wait for one to end.
   int max_concurrent_streams = 100;
+  // A connection whose handshake (TLS, HTTP/2 preface) is not done within
+  // this is closed: a peer that connects and sends nothing holds its
+  // descriptor and connection slot this long at most (gRPC's default: 120 s).
+  int handshake_timeout_ms = 10000;
 };
 
 // One integer configuration key under `listen:` of a limits struct: its
@@ -66,7 +73,7 @@ const std::vector<LimitKey<ConnectionLimits>>& ConnectionLimitKeys();
 const std::vector<LimitKey<Http2Limits>>& Http2LimitKeys();
 
 // Sets `limits` on `builder` as gRPC channel arguments (keep-alive, ping
-// strikes, idle connections, concurrent streams).
+// strikes, idle connections, concurrent streams, handshake deadline).
 void ApplyHttp2Limits(const Http2Limits& limits, grpc::ServerBuilder& builder);
 
 // Sets glibc's allocator for a long-running server: blocks of 256 KiB and

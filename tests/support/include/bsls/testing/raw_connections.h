@@ -1,10 +1,12 @@
-// Raw connections to a service's Unix socket for the connection-limit tests:
-// made as another effective uid (SO_PEERCRED gives the server
-// the euid of the connecting process), and whether the server closes one
-// at once (header only).
+// Raw connections for the connection-limit tests: to a service's Unix
+// socket made as another effective uid (SO_PEERCRED gives the server the
+// euid of the connecting process), to its TCP port from one of the loopback
+// addresses, and whether the server closes one at once (header only).
 #ifndef BSLS_TESTING_RAW_CONNECTIONS_H_
 #define BSLS_TESTING_RAW_CONNECTIONS_H_
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
 #include <sys/un.h>
@@ -12,6 +14,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -32,6 +35,27 @@ inline int ConnectUnixAs(uid_t uid, const std::string& path) {
   if (uid != 0 && ::seteuid(0) != 0) std::abort();  // the test cannot go on as another user
   if (!connected) {
     if (fd >= 0) ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// A TCP connection to 127.0.0.1:`port` made from the loopback address
+// `source` (127.0.0.1, 127.0.0.2...: every 127/8 address is the machine's
+// own, so one machine can be several peers), or -1.
+inline int ConnectTcpFrom(const std::string& source, int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return -1;
+  sockaddr_in from{};
+  from.sin_family = AF_INET;
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<std::uint16_t>(port));
+  if (::inet_pton(AF_INET, source.c_str(), &from.sin_addr) != 1 ||
+      ::inet_pton(AF_INET, "127.0.0.1", &to.sin_addr) != 1 ||
+      ::bind(fd, reinterpret_cast<const sockaddr*>(&from), sizeof(from)) != 0 ||
+      ::connect(fd, reinterpret_cast<const sockaddr*>(&to), sizeof(to)) != 0) {
+    ::close(fd);
     return -1;
   }
   return fd;
