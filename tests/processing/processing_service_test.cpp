@@ -15,6 +15,7 @@
 #include "bsls/io/surface_file.h"
 #include "bsls/simulator/calibration_session.h"
 #include "hostile_frame.h"
+#include "raw_calls.h"
 #include "service_fixture.h"
 
 namespace bsls::processing::test {
@@ -626,6 +627,86 @@ TEST(ProcessingService, CalibrateDropsAViewThatGivesNothing) {
   EXPECT_NE(message.find("screen_z080.png (screen view 3"), std::string::npos) << message;
   EXPECT_EQ(message.find(scratch.string()), std::string::npos) << message;
   EXPECT_TRUE(ScratchIsEmpty(scratch));
+  fs::remove_all(scratch);
+}
+
+// A message inside the Calibrate upload that is not a CalibrateRequest is
+// refused with INVALID_ARGUMENT naming the message, wherever it comes: gRPC's
+// typed reader took it for the upload's end, so the files sent before it
+// were calibrated as if they were the whole upload (or the first message
+// read as "no manifest").
+TEST(ProcessingService, AMalformedMessageInTheCalibrateUploadIsRefusedByNumber) {
+  const fs::path scratch =
+      fs::path(::testing::TempDir()) / ("scratch-malformed-" + std::to_string(getpid()));
+  fs::create_directories(scratch);
+  ProcessingServiceOptions options;
+  options.scratch_dir = scratch;
+  options.software_version = "test";
+  // On a Unix socket, not the in-process channel: there a reply is sent only
+  // once the other side reads, and the raw client reads after its upload.
+  ProcessingService service(options);
+  const std::string socket =
+      (scratch.parent_path() / ("malformed-" + std::to_string(getpid()))).string() + ".sock";
+  grpc::ServerBuilder builder;
+  builder.SetMaxReceiveMessageSize(40 << 20);
+  builder.AddListeningPort("unix:" + socket, grpc::InsecureServerCredentials());
+  builder.RegisterService(&service);
+  const std::unique_ptr<grpc::Server> server = builder.BuildAndStart();
+  ASSERT_NE(server, nullptr);
+  std::string manifest;
+  const std::vector<UploadFile> files =
+      SessionFiles(calibration::testing::SessionFolder(SessionKind::kRightClean), &manifest);
+  ASSERT_FALSE(files.empty());
+  const auto serialized = [](const v1::CalibrateRequest& part) {
+    std::string bytes;
+    EXPECT_TRUE(part.SerializeToString(&bytes));
+    return bytes;
+  };
+  v1::CalibrateRequest manifest_part;
+  manifest_part.mutable_manifest()->set_yaml(manifest);
+  // Every file of the session, whole, each in one message.
+  std::vector<std::string> upload = {serialized(manifest_part)};
+  for (const UploadFile& f : files) {
+    v1::CalibrateRequest part;
+    part.mutable_file()->set_path(f.path);
+    part.mutable_file()->set_data(f.bytes);
+    part.mutable_file()->set_last(true);
+    upload.push_back(serialized(part));
+  }
+  const std::string not_a_message(kNotAMessage, sizeof kNotAMessage - 1);
+  grpc::ChannelArguments args;
+  args.SetMaxSendMessageSize(40 << 20);
+  grpc::GenericStub stub(
+      grpc::CreateCustomChannel("unix:" + socket, grpc::InsecureChannelCredentials(), args));
+  // First, after the manifest, and between files (the upload complete but
+  // for the file after it) and after the last file.
+  for (std::size_t at : {std::size_t{0}, std::size_t{1}, upload.size() - 1, upload.size()}) {
+    RawCall call;
+    call.method = "/bsls.v1.Processing/Calibrate";
+    call.messages.assign(upload.begin(), upload.begin() + static_cast<std::ptrdiff_t>(at));
+    call.messages.push_back(not_a_message);
+    call.messages.insert(call.messages.end(), upload.begin() + static_cast<std::ptrdiff_t>(at),
+                         upload.end());
+    call.deadline_ms = 60000;
+    const RawOutcome outcome = SendRaw(stub, call);
+    EXPECT_EQ(outcome.code, StatusCode::INVALID_ARGUMENT) << "at " << at << ": " << outcome.message;
+    EXPECT_NE(outcome.message.find("message " + std::to_string(at + 1) +
+                                   " of the upload (6 bytes) "
+                                   "is not a bsls.v1.CalibrateRequest message"),
+              std::string::npos)
+        << "at " << at << ": " << outcome.message;
+  }
+  EXPECT_TRUE(ScratchIsEmpty(scratch));
+  // The same upload without the bad message calibrates.
+  RawCall whole;
+  whole.method = "/bsls.v1.Processing/Calibrate";
+  whole.messages = upload;
+  whole.deadline_ms = 60000;
+  const RawOutcome outcome = SendRaw(stub, whole);
+  EXPECT_EQ(outcome.code, StatusCode::OK) << outcome.message;
+  EXPECT_EQ(service.Stats().busy, 0);
+  service.BeginDrain();
+  server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(5));
   fs::remove_all(scratch);
 }
 

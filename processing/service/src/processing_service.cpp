@@ -1,5 +1,7 @@
 #include "bsls/processing/processing_service.h"
 
+#include <google/protobuf/descriptor.h>
+#include <grpcpp/support/method_handler.h>
 #include <spdlog/spdlog.h>
 #include <stdlib.h>
 #include <yaml-cpp/yaml.h>
@@ -292,11 +294,49 @@ Status CheckManifestMessage(const v1::CalibrateRequest& first, std::size_t max_m
   return Status::OK;
 }
 
+// The Calibrate stream with its messages parsed here rather than by gRPC,
+// which ends the reads at a message that does not parse as it does at the
+// client's half-close, so that the handler cannot tell them apart.
+class UploadStream {
+ public:
+  explicit UploadStream(grpc::ServerReaderWriter<grpc::ByteBuffer, grpc::ByteBuffer>* raw)
+      : raw_(raw) {}
+
+  // The upload's next message into *part; false at the upload's end; refuses
+  // (INVALID_ARGUMENT naming its number and size) bytes that are not a
+  // CalibrateRequest.
+  bool Read(v1::CalibrateRequest* part) {
+    grpc::ByteBuffer bytes;
+    if (!raw_->Read(&bytes)) return false;
+    ++messages_;
+    const std::size_t size = bytes.Length();
+    if (!grpc::SerializationTraits<v1::CalibrateRequest>::Deserialize(&bytes, part).ok())
+      Refuse(StatusCode::INVALID_ARGUMENT,
+             "Calibrate: message " + std::to_string(messages_) + " of the upload (" +
+                 std::to_string(size) + " bytes) is not a " +
+                 v1::CalibrateRequest::descriptor()->full_name() + " message");
+    return true;
+  }
+
+  // Sends `event` to the caller; false when the call is over.
+  bool Write(const v1::WorkEvent& event) {
+    grpc::ByteBuffer bytes;
+    bool own = false;
+    if (!grpc::SerializationTraits<v1::WorkEvent>::Serialize(event, &bytes, &own).ok())
+      return false;
+    return raw_->Write(bytes);
+  }
+
+ private:
+  grpc::ServerReaderWriter<grpc::ByteBuffer, grpc::ByteBuffer>* raw_;
+  int messages_ = 0;  // read so far
+};
+
 // The upload: every file in order, chunk by chunk, within the limits,
 // written under `folder`; refused (INVALID_ARGUMENT naming the file, INTERNAL
 // when the scratch folder fails) otherwise.
-void ReceiveUploadFiles(grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream,
-                        const fs::path& folder, const ProcessingServiceOptions& options,
+void ReceiveUploadFiles(UploadStream* stream, const fs::path& folder,
+                        const ProcessingServiceOptions& options,
                         const session::WorkObserver& observer) {
   std::map<fs::path, std::uint64_t> sizes;  // bytes received so far, by file
   std::map<fs::path, bool> complete;
@@ -306,8 +346,11 @@ void ReceiveUploadFiles(grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateReq
   v1::CalibrateRequest part;
   while (stream->Read(&part)) {
     observer.CheckCancelled("the upload's end");
-    if (part.part_case() != v1::CalibrateRequest::kFile)
+    if (part.part_case() == v1::CalibrateRequest::kManifest)
       Refuse(StatusCode::INVALID_ARGUMENT, "Calibrate: a second manifest in the upload");
+    if (part.part_case() != v1::CalibrateRequest::kFile)
+      Refuse(StatusCode::INVALID_ARGUMENT,
+             "Calibrate: a message of the upload with neither a manifest nor a file chunk");
     const v1::FileChunk& chunk = part.file();
     const fs::path path = UploadPath(chunk.path());
     const std::string name = "file " + chunk.path();
@@ -450,6 +493,20 @@ ProcessingService::ProcessingService(ProcessingServiceOptions options)
       pool_(options_.workers, options_.queue),
       calibrations_(options_.calibration_cache_entries) {
   if (options_.replica.empty()) options_.replica = DefaultReplicaName();
+  // Calibrate's messages are parsed by CalibrateUpload, not by gRPC. The
+  // generated service adds its methods in the .proto's order.
+  const int calibrate = google::protobuf::DescriptorPool::generated_pool()
+                            ->FindServiceByName(v1::Processing::service_full_name())
+                            ->FindMethodByName("Calibrate")
+                            ->index();
+  MarkMethodStreamed(calibrate,
+                     new grpc::internal::BidiStreamingHandler<ProcessingService, grpc::ByteBuffer,
+                                                              grpc::ByteBuffer>(
+                         [](ProcessingService* service, grpc::ServerContext* context,
+                            grpc::ServerReaderWriter<grpc::ByteBuffer, grpc::ByteBuffer>* stream) {
+                           return service->CalibrateUpload(context, stream);
+                         },
+                         this));
 }
 
 void ProcessingService::BeginDrain() { draining_ = true; }
@@ -695,14 +752,21 @@ Status ProcessingService::Measure(grpc::ServerContext* context, const v1::Measur
   });
 }
 
-Status ProcessingService::Calibrate(
+Status ProcessingService::CalibrateUpload(
     grpc::ServerContext* context,
-    grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream) {
+    grpc::ServerReaderWriter<grpc::ByteBuffer, grpc::ByteBuffer>* raw) {
+  UploadStream stream_parsed(raw);
+  UploadStream* stream = &stream_parsed;
   const Emit emit = [stream](const v1::WorkEvent& e) { return stream->Write(e); };
   // The manifest comes first: without it there is nothing to queue for.
   v1::CalibrateRequest first;
-  if (!stream->Read(&first))
-    return Status(StatusCode::INVALID_ARGUMENT, "Calibrate: the upload ended before the manifest");
+  try {
+    if (!stream->Read(&first))
+      return Status(StatusCode::INVALID_ARGUMENT,
+                    "Calibrate: the upload ended before the manifest");
+  } catch (const Refusal& r) {
+    return r.status;
+  }
   if (Status refused = CheckManifestMessage(first, options_.max_manifest_bytes); !refused.ok())
     return refused;
 

@@ -65,9 +65,13 @@ class ProcessingService final : public v1::Processing::Service {
                                   grpc::ServerWriter<v1::WorkEvent>* writer) override;
   grpc::Status Measure(grpc::ServerContext* context, const v1::MeasureRequest* request,
                        grpc::ServerWriter<v1::WorkEvent>* writer) override;
-  grpc::Status Calibrate(
+  // Calibrate's handler (the constructor puts it in the generated one's
+  // place): the upload's messages arrive as bytes and are parsed here, so
+  // that one that is not a CalibrateRequest is refused with INVALID_ARGUMENT
+  // naming it (gRPC's typed reader shows it as the upload's end).
+  grpc::Status CalibrateUpload(
       grpc::ServerContext* context,
-      grpc::ServerReaderWriter<v1::WorkEvent, v1::CalibrateRequest>* stream) override;
+      grpc::ServerReaderWriter<grpc::ByteBuffer, grpc::ByteBuffer>* stream);
   grpc::Status PutCalibration(grpc::ServerContext* context,
                               const v1::PutCalibrationRequest* request,
                               v1::CalibrationInfo* response) override;
