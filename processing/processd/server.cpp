@@ -55,6 +55,8 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     rpc::TcpAcceptorOptions tcp;
     tcp.address = config.listen.tcp;
     tcp.connections = config.listen.connections;
+    // Plain TCP: a name that also resolves to a network address is refused.
+    tcp.loopback_only = config.listen.plaintext_loopback;
     s->tcp_ =
         rpc::ListenTcp(tcp,
                        config.listen.plaintext_loopback ? grpc::InsecureServerCredentials()

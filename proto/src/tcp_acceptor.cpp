@@ -1,26 +1,23 @@
 #include "bsls/rpc/tcp_acceptor.h"
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <netdb.h>
 #include <netinet/in.h>
 #include <netinet/tcp.h>
-#include <poll.h>
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <stdexcept>
+
+#include "acceptor.h"
 
 namespace bsls::rpc {
 namespace {
-
-// How long the accept loop waits after shedding a connection for want of
-// descriptors (EMFILE, ENFILE), before it accepts again.
-constexpr int kDescriptorBackoffMs = 50;
 
 std::string Errno(const std::string& what) { return what + ": " + std::strerror(errno); }
 
@@ -48,6 +45,97 @@ std::string PeerAddress(int fd) {
   return ::inet_ntop(peer.ss_family, bytes, text, sizeof(text)) != nullptr ? text : "";
 }
 
+// The port of `address` (IPv4 or IPv6).
+int PortOf(const sockaddr_storage& address) {
+  return ntohs(address.ss_family == AF_INET6
+                   ? reinterpret_cast<const sockaddr_in6*>(&address)->sin6_port
+                   : reinterpret_cast<const sockaddr_in*>(&address)->sin_port);
+}
+
+// Sets the port of `address` (IPv4 or IPv6).
+void SetPort(sockaddr_storage* address, int port) {
+  const auto network = htons(static_cast<std::uint16_t>(port));
+  if (address->ss_family == AF_INET6)
+    reinterpret_cast<sockaddr_in6*>(address)->sin6_port = network;
+  else
+    reinterpret_cast<sockaddr_in*>(address)->sin_port = network;
+}
+
+// "127.0.0.1:PORT" or "[::1]:PORT".
+std::string AddressText(const sockaddr_storage& address) {
+  char text[INET6_ADDRSTRLEN] = {};
+  const bool v6 = address.ss_family == AF_INET6;
+  const void* bytes =
+      v6 ? static_cast<const void*>(&reinterpret_cast<const sockaddr_in6*>(&address)->sin6_addr)
+         : static_cast<const void*>(&reinterpret_cast<const sockaddr_in*>(&address)->sin_addr);
+  ::inet_ntop(address.ss_family, bytes, text, sizeof(text));
+  const std::string port = std::to_string(PortOf(address));
+  return v6 ? "[" + std::string(text) + "]:" + port : std::string(text) + ":" + port;
+}
+
+// Whether `address` is a loopback address (127/8, ::1).
+bool IsLoopback(const sockaddr_storage& address) {
+  if (address.ss_family == AF_INET6)
+    return IN6_IS_ADDR_LOOPBACK(&reinterpret_cast<const sockaddr_in6*>(&address)->sin6_addr);
+  return (ntohl(reinterpret_cast<const sockaddr_in*>(&address)->sin_addr.s_addr) >> 24) == 127;
+}
+
+// The distinct IPv4 and IPv6 addresses `host` (empty: the wildcard) and
+// `port` resolve to, in the resolver's order; "" or the resolver's reason.
+std::string Resolve(const std::string& host, const std::string& port,
+                    std::vector<sockaddr_storage>* addresses) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  if (const int rc =
+          ::getaddrinfo(host.empty() ? nullptr : host.c_str(), port.c_str(), &hints, &found);
+      rc != 0)
+    return ::gai_strerror(rc);
+  const std::unique_ptr<addrinfo, void (*)(addrinfo*)> owned(found, ::freeaddrinfo);
+  for (const addrinfo* entry = found; entry != nullptr; entry = entry->ai_next) {
+    if ((entry->ai_family != AF_INET && entry->ai_family != AF_INET6) ||
+        entry->ai_addrlen > sizeof(sockaddr_storage))
+      continue;
+    sockaddr_storage address{};
+    std::memcpy(&address, entry->ai_addr, entry->ai_addrlen);
+    const bool seen = std::any_of(addresses->begin(), addresses->end(), [&](const auto& known) {
+      return AddressText(known) == AddressText(address);
+    });
+    if (!seen) addresses->push_back(address);
+  }
+  return addresses->empty() ? "no IPv4 or IPv6 address" : "";
+}
+
+// A socket bound to `address` and listening, or -1 with `why` set.
+// `v6_only`: an IPv6 socket takes no IPv4 connections (the IPv4 addresses
+// have sockets of their own).
+int BindOne(const sockaddr_storage& address, bool v6_only, int backlog, std::string* why) {
+  const int fd = ::socket(address.ss_family, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+  if (fd < 0) {
+    *why = Errno("socket");
+    return -1;
+  }
+  const int on = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof(on));
+  if (address.ss_family == AF_INET6 && v6_only &&
+      ::setsockopt(fd, IPPROTO_IPV6, IPV6_V6ONLY, &on, sizeof(on)) != 0) {
+    *why = Errno("IPV6_V6ONLY");
+    ::close(fd);
+    return -1;
+  }
+  const socklen_t length =
+      address.ss_family == AF_INET6 ? sizeof(sockaddr_in6) : sizeof(sockaddr_in);
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), length) != 0 ||
+      ::listen(fd, backlog) != 0) {
+    *why = Errno("bind/listen");
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
 // The port `fd` is bound to.
 int BoundPort(int fd) {
   sockaddr_storage bound{};
@@ -57,10 +145,21 @@ int BoundPort(int fd) {
                                            : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
 }
 
+// A TCP connection's peer, named by its address; nullopt when it cannot
+// be read. Small frames go out at once, as with gRPC's own listener.
+std::optional<Peer> PeerOfTcpConnection(int fd) {
+  Peer peer;
+  peer.name = PeerAddress(fd);
+  if (peer.name.empty()) return std::nullopt;
+  const int on = 1;
+  ::setsockopt(fd, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));
+  return peer;
+}
+
 }  // namespace
 
-TcpAcceptor::TcpAcceptor(TcpAcceptorOptions options, int fd, int port)
-    : options_(std::move(options)), fd_(fd), port_(port) {}
+TcpAcceptor::TcpAcceptor(std::unique_ptr<Acceptor> core, int port, std::vector<std::string> bound)
+    : core_(std::move(core)), port_(port), bound_(std::move(bound)) {}
 
 std::unique_ptr<TcpAcceptor> TcpAcceptor::Create(const TcpAcceptorOptions& options,
                                                  std::string* error) {
@@ -71,134 +170,63 @@ std::unique_ptr<TcpAcceptor> TcpAcceptor::Create(const TcpAcceptorOptions& optio
   };
   std::string host, port;
   if (!SplitAddress(address, &host, &port)) return fail("not HOST:PORT");
-  addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
-  hints.ai_socktype = SOCK_STREAM;
-  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
-  addrinfo* found = nullptr;
-  if (const int rc =
-          ::getaddrinfo(host.empty() ? nullptr : host.c_str(), port.c_str(), &hints, &found);
-      rc != 0)
-    return fail(::gai_strerror(rc));
-  const std::unique_ptr<addrinfo, void (*)(addrinfo*)> owned(found, ::freeaddrinfo);
-  const int fd = ::socket(found->ai_family, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
-  if (fd < 0) return fail(Errno("socket"));
-  const int on = 1;
-  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &on, sizeof(on));
-  if (::bind(fd, found->ai_addr, found->ai_addrlen) != 0 || ::listen(fd, options.backlog) != 0) {
-    const std::string why = Errno("bind/listen");
-    ::close(fd);
-    return fail(why);
+  std::vector<sockaddr_storage> addresses;
+  if (const std::string why = Resolve(host, port, &addresses); !why.empty()) return fail(why);
+  const bool both_families = std::any_of(addresses.begin(), addresses.end(),
+                                         [](const auto& a) { return a.ss_family == AF_INET; }) &&
+                             std::any_of(addresses.begin(), addresses.end(),
+                                         [](const auto& a) { return a.ss_family == AF_INET6; });
+  std::vector<int> listeners;
+  std::vector<std::string> bound, failed;
+  int chosen = 0;  // the port of the first socket bound, for the others when asked for 0
+  for (sockaddr_storage& each : addresses) {
+    if (options.loopback_only && !IsLoopback(each)) {
+      for (const int fd : listeners) ::close(fd);
+      return fail("resolves to " + AddressText(each) + ", which is not a loopback address");
+    }
+    if (chosen != 0) SetPort(&each, chosen);
+    std::string why;
+    const int fd = BindOne(each, both_families, options.backlog, &why);
+    if (fd < 0) {
+      failed.push_back(AddressText(each) + ": " + why);
+      continue;
+    }
+    if (chosen == 0) chosen = BoundPort(fd);
+    listeners.push_back(fd);
+    SetPort(&each, chosen);
+    bound.push_back(AddressText(each));
   }
-  std::unique_ptr<TcpAcceptor> acceptor(new TcpAcceptor(options, fd, BoundPort(fd)));
-  if (::pipe2(acceptor->wake_, O_CLOEXEC) != 0) return fail(Errno("pipe"));
-  acceptor->spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-  if (acceptor->spare_ < 0) return fail(Errno("open /dev/null"));
-  return acceptor;
+  std::string all_failed;
+  for (const std::string& line : failed) all_failed += (all_failed.empty() ? "" : "; ") + line;
+  if (listeners.empty()) return fail(all_failed);
+  if (!failed.empty())
+    spdlog::warn("TCP address '{}': listening on {} of its {} addresses; not on {}", address,
+                 bound.size(), addresses.size(), all_failed);
+  AcceptLimits limits{options.connections.max_tcp_connections, "listen.max_tcp_connections",
+                      options.connections.max_tcp_connections_per_peer,
+                      "listen.max_tcp_connections_per_peer"};
+  std::string why;
+  std::unique_ptr<Acceptor> core = Acceptor::Create(std::move(listeners), "tcp:" + address,
+                                                    std::move(limits), PeerOfTcpConnection, &why);
+  if (!core) return fail(why);
+  return std::unique_ptr<TcpAcceptor>(new TcpAcceptor(std::move(core), chosen, std::move(bound)));
 }
 
-TcpAcceptor::~TcpAcceptor() {
-  Stop();
-  if (fd_ >= 0) ::close(fd_);
-  for (int& end : wake_)
-    if (end >= 0) ::close(end);
-  if (spare_ >= 0) ::close(spare_);
-}
+TcpAcceptor::~TcpAcceptor() { Stop(); }
 
 void TcpAcceptor::Start(HandOver hand_over) {
-  thread_ = std::thread([this, hand_over = std::move(hand_over)] { AcceptLoop(hand_over); });
+  core_->Start([hand_over = std::move(hand_over)](int fd, int listener_fd, const Peer&) {
+    hand_over(fd, listener_fd);
+  });
 }
 
-void TcpAcceptor::Stop() {
-  if (!thread_.joinable()) return;
-  const char byte = 0;
-  [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
-  thread_.join();
-}
+void TcpAcceptor::Stop() { core_->Stop(); }
 
-void TcpAcceptor::AcceptLoop(const HandOver& hand_over) {
-  for (;;) {
-    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
-      if (errno == EINTR) continue;
-      return;
-    }
-    if (fds[1].revents != 0) return;
-    const int connection = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-    if (connection < 0) {
-      if ((errno == EMFILE || errno == ENFILE) && !ShedAndWait()) return;
-      continue;  // EAGAIN, ECONNABORTED: try the next one
-    }
-    const std::string peer = PeerAddress(connection);
-    struct stat socket_file {};
-    if (peer.empty() || ::fstat(connection, &socket_file) != 0) {
-      ::close(connection);
-      continue;
-    }
-    ForgetClosed();
-    if (const std::string why = OverLimit(peer); !why.empty()) {
-      ::close(connection);
-      ++refused_;
-      LogRefusal(peer, why);
-      continue;
-    }
-    const int on = 1;  // as gRPC's own listener does: no Nagle delay on small frames
-    ::setsockopt(connection, IPPROTO_TCP, TCP_NODELAY, &on, sizeof(on));
-    handed_[connection] = {socket_file.st_ino, peer};
-    ++accepted_;
-    hand_over(connection, fd_);
-  }
-}
+std::uint64_t TcpAcceptor::accepted() const { return core_->accepted(); }
 
-bool TcpAcceptor::ShedAndWait() {
-  // Out of descriptors: the waiting connection would keep poll awake and
-  // the loop spinning. Shed it through the spare descriptor, then wait.
-  if (spare_ >= 0) {
-    ::close(spare_);
-    const int shed = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
-    if (shed >= 0) {
-      ::close(shed);
-      ++shed_;
-    }
-    spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-  }
-  pollfd wake = {wake_[0], POLLIN, 0};
-  return ::poll(&wake, 1, kDescriptorBackoffMs) <= 0;
-}
+std::uint64_t TcpAcceptor::shed() const { return core_->shed(); }
 
-void TcpAcceptor::ForgetClosed() {
-  for (auto it = handed_.begin(); it != handed_.end();) {
-    struct stat now {};
-    const bool same =
-        ::fstat(it->first, &now) == 0 && S_ISSOCK(now.st_mode) && now.st_ino == it->second.inode;
-    it = same ? std::next(it) : handed_.erase(it);
-  }
-}
-
-std::string TcpAcceptor::OverLimit(const std::string& peer) const {
-  const ConnectionLimits& limits = options_.connections;
-  if (static_cast<int>(handed_.size()) >= limits.max_tcp_connections)
-    return std::to_string(handed_.size()) +
-           " TCP connections are open (listen.max_tcp_connections " +
-           std::to_string(limits.max_tcp_connections) + ")";
-  int mine = 0;
-  for (const auto& [fd, handed] : handed_) mine += handed.peer == peer ? 1 : 0;
-  if (mine >= limits.max_tcp_connections_per_peer)
-    return "the address has " + std::to_string(mine) +
-           " connections open (listen.max_tcp_connections_per_peer " +
-           std::to_string(limits.max_tcp_connections_per_peer) + ")";
-  return "";
-}
-
-void TcpAcceptor::LogRefusal(const std::string& peer, const std::string& why) {
-  ++refused_unlogged_;
-  const auto now = std::chrono::steady_clock::now();
-  if (now - last_refusal_log_ < std::chrono::seconds(1)) return;
-  spdlog::warn("refused {} TCP connection(s) on {} since the last report; the last from {}: {}",
-               refused_unlogged_, options_.address, peer, why);
-  refused_unlogged_ = 0;
-  last_refusal_log_ = now;
-}
+std::uint64_t TcpAcceptor::refused() const { return core_->refused(); }
 
 void TcpListener::Start() {
   grpc::experimental::ExternalConnectionAcceptor* grpc_end = to_grpc.get();

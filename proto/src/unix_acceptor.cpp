@@ -1,23 +1,18 @@
 #include "bsls/rpc/unix_acceptor.h"
 
-#include <fcntl.h>
-#include <poll.h>
-#include <spdlog/spdlog.h>
 #include <sys/stat.h>
 #include <sys/un.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
+#include "acceptor.h"
 #include "bsls/rpc/unix_socket.h"
 
 namespace bsls::rpc {
 namespace {
-
-// How long the accept loop waits after shedding a connection for want of
-// descriptors (EMFILE, ENFILE), before it accepts again.
-constexpr int kDescriptorBackoffMs = 50;
 
 std::string Errno(const std::string& what) { return what + ": " + std::strerror(errno); }
 
@@ -28,10 +23,21 @@ std::optional<std::pair<dev_t, ino_t>> FileId(const std::string& path) {
   return std::make_pair(st.st_dev, st.st_ino);
 }
 
+// A Unix-socket connection's peer: its credentials, named by uid.
+std::optional<Peer> PeerOfUnixConnection(int fd) {
+  Peer peer;
+  socklen_t length = sizeof(peer.credentials);
+  if (::getsockopt(fd, SOL_SOCKET, SO_PEERCRED, &peer.credentials, &length) != 0)
+    return std::nullopt;
+  peer.name = "uid " + std::to_string(peer.credentials.uid);
+  return peer;
+}
+
 }  // namespace
 
-UnixAcceptor::UnixAcceptor(UnixAcceptorOptions options, int fd)
-    : options_(std::move(options)), fd_(fd) {}
+UnixAcceptor::UnixAcceptor(UnixAcceptorOptions options, std::unique_ptr<Acceptor> core,
+                           std::optional<std::pair<dev_t, ino_t>> socket_file)
+    : options_(std::move(options)), core_(std::move(core)), socket_file_(socket_file) {}
 
 std::unique_ptr<UnixAcceptor> UnixAcceptor::Create(const UnixAcceptorOptions& options,
                                                    UnixAcceptorError* error) {
@@ -49,21 +55,23 @@ std::unique_ptr<UnixAcceptor> UnixAcceptor::Create(const UnixAcceptorOptions& op
 
   if (const std::string taken = ClaimUnixSocketPath(options.path); !taken.empty())
     return fail(UnixAcceptorError::Kind::kTaken, "socket path: " + taken);
-  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
+  int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0);
   if (fd < 0) return fail(UnixAcceptorError::Kind::kSystem, Errno("socket(AF_UNIX)"));
-  std::unique_ptr<UnixAcceptor> acceptor(new UnixAcceptor(options, fd));
+  // Closed on a failure until the accept loop owns it.
+  const std::unique_ptr<int, void (*)(int*)> owned(&fd, [](int* open) {
+    if (*open >= 0) ::close(*open);
+  });
   // The file is created with the umask applied; permissions are set next,
   // before anyone is accepted.
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0)
     return fail(errno == EACCES ? UnixAcceptorError::Kind::kPermissionDenied
                                 : UnixAcceptorError::Kind::kSystem,
                 Errno("bind " + options.path));
-  acceptor->socket_file_ = FileId(options.path);
+  const std::optional<std::pair<dev_t, ino_t>> socket_file = FileId(options.path);
   // From here on a failure removes the socket file bound above (while it is
   // that file), so that no stale file is left for the next start to find.
   const auto fail_bound = [&](UnixAcceptorError::Kind kind, std::string message) {
-    if (acceptor->socket_file_ && FileId(options.path) == acceptor->socket_file_)
-      ::unlink(options.path.c_str());
+    if (socket_file && FileId(options.path) == socket_file) ::unlink(options.path.c_str());
     return fail(kind, std::move(message));
   };
   if (::chmod(options.path.c_str(), options.mode) != 0 ||
@@ -72,115 +80,35 @@ std::unique_ptr<UnixAcceptor> UnixAcceptor::Create(const UnixAcceptorOptions& op
                       Errno("setting owner/mode of " + options.path));
   if (::listen(fd, options.backlog) != 0)
     return fail_bound(UnixAcceptorError::Kind::kSystem, Errno("listen " + options.path));
-  if (::pipe2(acceptor->wake_, O_CLOEXEC) != 0)
-    return fail_bound(UnixAcceptorError::Kind::kSystem, Errno("pipe"));
-  acceptor->spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-  if (acceptor->spare_ < 0)
-    return fail_bound(UnixAcceptorError::Kind::kSystem, Errno("open /dev/null"));
-  return acceptor;
+  AcceptLimits limits{options.connections.max_connections, "listen.max_connections",
+                      options.connections.max_connections_per_user,
+                      "listen.max_connections_per_user"};
+  std::string why;
+  std::unique_ptr<Acceptor> core = Acceptor::Create({std::exchange(fd, -1)}, "unix:" + options.path,
+                                                    std::move(limits), PeerOfUnixConnection, &why);
+  if (!core) return fail_bound(UnixAcceptorError::Kind::kSystem, options.path + ": " + why);
+  return std::unique_ptr<UnixAcceptor>(new UnixAcceptor(options, std::move(core), socket_file));
 }
 
-UnixAcceptor::~UnixAcceptor() {
-  Stop();
-  if (fd_ >= 0) ::close(fd_);
-  for (int& end : wake_)
-    if (end >= 0) ::close(end);
-  if (spare_ >= 0) ::close(spare_);
-}
+UnixAcceptor::~UnixAcceptor() { Stop(); }
 
 void UnixAcceptor::Start(HandOver hand_over) {
-  thread_ = std::thread([this, hand_over = std::move(hand_over)] { AcceptLoop(hand_over); });
+  core_->Start([hand_over = std::move(hand_over)](int fd, int, const Peer& peer) {
+    hand_over(fd, peer.credentials);
+  });
 }
 
 void UnixAcceptor::Stop() {
-  if (!thread_.joinable()) return;
-  const char byte = 0;
-  [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
-  thread_.join();
+  if (!core_->Stop()) return;
   // Only the file made here: another instance may have replaced a socket
   // it found stale.
   if (socket_file_ && FileId(options_.path) == socket_file_) ::unlink(options_.path.c_str());
 }
 
-void UnixAcceptor::AcceptLoop(const HandOver& hand_over) {
-  for (;;) {
-    pollfd fds[2] = {{fd_, POLLIN, 0}, {wake_[0], POLLIN, 0}};
-    if (::poll(fds, 2, -1) < 0) {
-      if (errno == EINTR) continue;
-      return;
-    }
-    if (fds[1].revents != 0) return;
-    const int connection = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC | SOCK_NONBLOCK);
-    if (connection < 0) {
-      if (errno == EMFILE || errno == ENFILE) {
-        // Out of descriptors: the waiting connection would keep poll awake
-        // and this loop spinning. Shed it through the spare descriptor,
-        // then wait a moment (or for Stop).
-        if (spare_ >= 0) {
-          ::close(spare_);
-          const int shed = ::accept4(fd_, nullptr, nullptr, SOCK_CLOEXEC);
-          if (shed >= 0) {
-            ::close(shed);
-            ++shed_;
-          }
-          spare_ = ::open("/dev/null", O_RDONLY | O_CLOEXEC);
-        }
-        pollfd wake = {wake_[0], POLLIN, 0};
-        if (::poll(&wake, 1, kDescriptorBackoffMs) > 0) return;
-      }
-      continue;  // EAGAIN, ECONNABORTED: try the next one
-    }
-    ucred credentials{};
-    socklen_t length = sizeof(credentials);
-    struct stat socket_file {};
-    if (::getsockopt(connection, SOL_SOCKET, SO_PEERCRED, &credentials, &length) != 0 ||
-        ::fstat(connection, &socket_file) != 0) {
-      ::close(connection);
-      continue;
-    }
-    ForgetClosed();
-    if (const std::string why = OverLimit(credentials.uid); !why.empty()) {
-      ::close(connection);
-      ++refused_;
-      LogRefusal(credentials.uid, why);
-      continue;
-    }
-    handed_[connection] = {socket_file.st_ino, credentials.uid};
-    ++accepted_;
-    hand_over(connection, credentials);
-  }
-}
+std::uint64_t UnixAcceptor::accepted() const { return core_->accepted(); }
 
-void UnixAcceptor::ForgetClosed() {
-  for (auto it = handed_.begin(); it != handed_.end();) {
-    struct stat now {};
-    const bool same =
-        ::fstat(it->first, &now) == 0 && S_ISSOCK(now.st_mode) && now.st_ino == it->second.inode;
-    it = same ? std::next(it) : handed_.erase(it);
-  }
-}
+std::uint64_t UnixAcceptor::shed() const { return core_->shed(); }
 
-std::string UnixAcceptor::OverLimit(uid_t uid) const {
-  if (static_cast<int>(handed_.size()) >= options_.connections.max_connections)
-    return std::to_string(handed_.size()) + " connections are open (listen.max_connections " +
-           std::to_string(options_.connections.max_connections) + ")";
-  int mine = 0;
-  for (const auto& [fd, handed] : handed_) mine += handed.uid == uid ? 1 : 0;
-  if (mine >= options_.connections.max_connections_per_user)
-    return "the user has " + std::to_string(mine) +
-           " connections open (listen.max_connections_per_user " +
-           std::to_string(options_.connections.max_connections_per_user) + ")";
-  return "";
-}
-
-void UnixAcceptor::LogRefusal(uid_t uid, const std::string& why) {
-  ++refused_unlogged_;
-  const auto now = std::chrono::steady_clock::now();
-  if (now - last_refusal_log_ < std::chrono::seconds(1)) return;
-  spdlog::warn("refused {} connection(s) on {} since the last report; the last of uid {}: {}",
-               refused_unlogged_, options_.path, uid, why);
-  refused_unlogged_ = 0;
-  last_refusal_log_ = now;
-}
+std::uint64_t UnixAcceptor::refused() const { return core_->refused(); }
 
 }  // namespace bsls::rpc

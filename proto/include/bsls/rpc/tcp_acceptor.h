@@ -2,7 +2,16 @@
 // accepts its TCP connections itself and hands each to its gRPC server
 // through grpc::experimental::ExternalConnectionAcceptor, which runs the
 // TLS handshake (or none, for plain loopback) as if gRPC had accepted it.
-// What gRPC 1.51 does not do is done before:
+// Like gRPC's own listener, it binds every address the host name resolves
+// to ("localhost" may be both ::1 and 127.0.0.1), all on one port (the one
+// the first picked when the address gives port 0); an address that cannot be
+// bound is logged and skipped, as gRPC did, and only when none can be bound
+// is the listener refused. Where the name resolves to IPv4 and IPv6
+// addresses both, the IPv6 sockets are IPv6 only, so that the wildcard
+// (":PORT": 0.0.0.0 and ::) binds twice instead of colliding; "[::]:PORT"
+// alone stays dual-stack.
+// What gRPC 1.51 does not do is done before (the accept loop shared with
+// rpc::UnixAcceptor, proto/src/acceptor.h):
 //  - connections open at once, in all and per peer address
 //    (listen.max_tcp_connections, listen.max_tcp_connections_per_peer);
 //    one beyond either is closed as soon as it is accepted, and refusals
@@ -12,9 +21,7 @@
 //    instead of spinning.
 // A peer that opens a connection and never finishes the handshake holds its
 // slot only until gRPC's handshake deadline (listen.handshake_timeout_ms,
-// rpc::Http2Limits) closes it. gRPC closes a connection without telling:
-// the acceptor recognises a handed-over descriptor by its socket's inode and
-// forgets those that no longer are that socket.
+// rpc::Http2Limits) closes it.
 //
 // Thread-safety: Create, Start and Stop from one thread; the counters from
 // any thread. The hand-over function runs on the accept thread.
@@ -22,39 +29,40 @@
 #define BSLS_RPC_TCP_ACCEPTOR_H_
 
 #include <grpcpp/server_builder.h>
-#include <sys/types.h>
 
-#include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
 #include <string>
-#include <thread>
+#include <vector>
 
 #include "bsls/rpc/server_limits.h"
 
 namespace bsls::rpc {
+
+class Acceptor;
 
 // Where the socket listens and the limits on its connections.
 struct TcpAcceptorOptions {
   std::string address;  // HOST:PORT or [IPv6]:PORT; port 0 picks a free one
   int backlog = 64;
   ConnectionLimits connections;  // max_tcp_connections, max_tcp_connections_per_peer
+  // Refuse to listen when the host resolves to any address that is not
+  // loopback (plain TCP: a name must not open it to the network).
+  bool loopback_only = false;
 };
 
 class TcpAcceptor {
  public:
   // Takes a connection (the descriptor is its own from then on) and the
-  // listening socket's descriptor.
+  // descriptor of the listening socket it came through.
   using HandOver = std::function<void(int fd, int listener_fd)>;
 
-  // Binds and listens on options.address (the first address it resolves
-  // to); nullptr with `error` naming the address and the reason when it
-  // cannot.
+  // Binds and listens on every address options.address resolves to (see
+  // above); nullptr with `error` naming the address and the reason when it
+  // cannot bind any, or when options.loopback_only and one is not loopback.
   static std::unique_ptr<TcpAcceptor> Create(const TcpAcceptorOptions& options, std::string* error);
-  // Stops (see Stop) and closes the socket.
+  // Stops (see Stop) and closes the sockets.
   ~TcpAcceptor();
   TcpAcceptor(const TcpAcceptor&) = delete;
   TcpAcceptor& operator=(const TcpAcceptor&) = delete;
@@ -67,45 +75,22 @@ class TcpAcceptor {
 
   // The port listened on (the one picked when the address gave 0).
   int port() const { return port_; }
+  // The addresses listened on, as "127.0.0.1:PORT" and "[::1]:PORT".
+  const std::vector<std::string>& bound() const { return bound_; }
   // Connections handed over so far.
-  std::uint64_t accepted() const { return accepted_; }
+  std::uint64_t accepted() const;
   // Connections shed for want of descriptors (EMFILE, ENFILE).
-  std::uint64_t shed() const { return shed_; }
+  std::uint64_t shed() const;
   // Connections closed at once because their peer address or everyone
   // together had as many open as allowed.
-  std::uint64_t refused() const { return refused_; }
+  std::uint64_t refused() const;
 
  private:
-  // A connection handed over: its socket's inode and its peer's address.
-  struct Handed {
-    ino_t inode;
-    std::string peer;
-  };
+  TcpAcceptor(std::unique_ptr<Acceptor> core, int port, std::vector<std::string> bound);
 
-  TcpAcceptor(TcpAcceptorOptions options, int fd, int port);
-  void AcceptLoop(const HandOver& hand_over);
-  // Sheds the waiting connection through the spare descriptor and waits a
-  // moment; false when Stop was asked meanwhile.
-  bool ShedAndWait();
-  // Forgets the connections closed since (accept thread only).
-  void ForgetClosed();
-  // Why one more connection from `peer` would exceed a limit ("" when it would not).
-  std::string OverLimit(const std::string& peer) const;
-  // Logs a refusal, at most once a second with the count since the last line.
-  void LogRefusal(const std::string& peer, const std::string& why);
-
-  TcpAcceptorOptions options_;
-  int fd_ = -1;
+  std::unique_ptr<Acceptor> core_;  // the accept loop and its limits
   int port_ = 0;
-  int wake_[2] = {-1, -1};  // a pipe that wakes the accept loop to stop
-  int spare_ = -1;          // /dev/null, given up to shed a connection at EMFILE
-  std::thread thread_;
-  std::atomic<std::uint64_t> accepted_{0};
-  std::atomic<std::uint64_t> shed_{0};
-  std::atomic<std::uint64_t> refused_{0};
-  std::map<int, Handed> handed_;  // by descriptor; accept thread only
-  std::uint64_t refused_unlogged_ = 0;
-  std::chrono::steady_clock::time_point last_refusal_log_{};
+  std::vector<std::string> bound_;
 };
 
 // A server's TCP listener: the acceptor and gRPC's end of the hand-over.

@@ -2,7 +2,8 @@
 // service accepts its local connections itself and hands each to its gRPC
 // server (grpc::AddInsecureChannelFromFd), so that what gRPC does not do is
 // done before: the peer's credentials (SO_PEERCRED) for bslsd's roles, and
-// limits no caller can get around:
+// limits no caller can get around (the accept loop shared with
+// rpc::TcpAcceptor, proto/src/acceptor.h):
 //  - connections open at once, in all and per peer uid; one beyond either
 //    is closed as soon as it is accepted (gRPC 1.51 has no such limit);
 //  - out of descriptors (EMFILE, ENFILE), the waiting caller is shed
@@ -10,9 +11,6 @@
 //    instead of spinning;
 //  - one live instance per socket (rpc::ClaimUnixSocketPath), and the
 //    socket file is removed on Stop only while it is the one made here.
-// gRPC closes a connection without telling: the acceptor recognises a
-// handed-over descriptor by its socket's inode and forgets those that no
-// longer are that socket.
 //
 // Thread-safety: Create, Start and Stop from one thread; the counters from
 // any thread. The hand-over function runs on the accept thread.
@@ -22,19 +20,18 @@
 #include <sys/socket.h>
 #include <sys/types.h>
 
-#include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
-#include <thread>
+#include <utility>
 
 #include "bsls/rpc/server_limits.h"
 
 namespace bsls::rpc {
+
+class Acceptor;
 
 // Where and how the socket is made, and the limits on its connections.
 struct UnixAcceptorOptions {
@@ -78,41 +75,20 @@ class UnixAcceptor {
   // The socket path.
   const std::string& path() const { return options_.path; }
   // Connections handed over so far.
-  std::uint64_t accepted() const { return accepted_; }
+  std::uint64_t accepted() const;
   // Connections shed for want of descriptors (EMFILE, ENFILE).
-  std::uint64_t shed() const { return shed_; }
+  std::uint64_t shed() const;
   // Connections closed at once because their user or everyone together had
   // as many open as allowed.
-  std::uint64_t refused() const { return refused_; }
+  std::uint64_t refused() const;
 
  private:
-  // A connection handed over: its socket's inode and its peer's uid.
-  struct Handed {
-    ino_t inode;
-    uid_t uid;
-  };
-
-  UnixAcceptor(UnixAcceptorOptions options, int fd);
-  void AcceptLoop(const HandOver& hand_over);
-  // Forgets the connections closed since (accept thread only).
-  void ForgetClosed();
-  // Why one more connection of `uid` would exceed a limit ("" when it would not).
-  std::string OverLimit(uid_t uid) const;
-  // Logs a refusal, at most once a second with the count since the last line.
-  void LogRefusal(uid_t uid, const std::string& why);
+  UnixAcceptor(UnixAcceptorOptions options, std::unique_ptr<Acceptor> core,
+               std::optional<std::pair<dev_t, ino_t>> socket_file);
 
   UnixAcceptorOptions options_;
-  int fd_ = -1;
-  int wake_[2] = {-1, -1};  // a pipe that wakes the accept loop to stop
-  int spare_ = -1;          // /dev/null, given up to shed a connection at EMFILE
+  std::unique_ptr<Acceptor> core_;                      // the accept loop and its limits
   std::optional<std::pair<dev_t, ino_t>> socket_file_;  // the file Create made
-  std::thread thread_;
-  std::atomic<std::uint64_t> accepted_{0};
-  std::atomic<std::uint64_t> shed_{0};
-  std::atomic<std::uint64_t> refused_{0};
-  std::map<int, Handed> handed_;  // by descriptor; accept thread only
-  std::uint64_t refused_unlogged_ = 0;
-  std::chrono::steady_clock::time_point last_refusal_log_{};
 };
 
 }  // namespace bsls::rpc
