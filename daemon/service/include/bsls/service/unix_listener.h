@@ -3,7 +3,10 @@
 // (rpc::UnixAcceptor, which also limits them): it reads the peer's uid with
 // SO_PEERCRED, maps it to a role, remembers the caller under the
 // connection's gRPC peer name ("fd:<n>") and only then hands the socket to
-// the gRPC server (grpc::AddInsecureChannelFromFd).
+// the gRPC server (grpc::AddInsecureChannelFromFd) through rpc::Http2Guard,
+// which lets the frames that make gRPC work without bound (new streams,
+// resets, pings) through at a limited rate, so that a rapid-reset or ping
+// flood cannot grow the daemon's memory.
 //
 // A connection's file descriptor stays open until gRPC has finished every
 // call on it (the transport owns the endpoint, each call holds the
@@ -24,6 +27,7 @@
 #include <string>
 
 #include "bsls/common/status.h"
+#include "bsls/rpc/http2_guard.h"
 #include "bsls/rpc/unix_acceptor.h"
 #include "bsls/service/roles.h"
 
@@ -55,6 +59,7 @@ struct UnixListenerOptions {
   std::optional<gid_t> group;  // owning group of the socket file (else the daemon's)
   int backlog = 64;
   rpc::ConnectionLimits connections;
+  rpc::Http2GuardLimits http2_guard;  // frames that make gRPC work, per second
 };
 
 // bslsd's front door: rpc::UnixAcceptor (limits, descriptor exhaustion,
@@ -70,7 +75,7 @@ class UnixListener {
   UnixListener& operator=(const UnixListener&) = delete;
 
   // Starts accepting: each connection's caller is recorded in `registry`
-  // with its role from `policy`, then given to `server`. All three must
+  // with its role from `policy`, then given to `server` through the guard. All three must
   // outlive Stop().
   void Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy);
   // Stops accepting (connections already handed over stay with gRPC) and
@@ -88,10 +93,15 @@ class UnixListener {
   // Connections closed at once because their user or everyone together had
   // as many open as allowed (options.connections).
   std::uint64_t refused() const { return acceptor_->refused(); }
+  // Times a connection spent its budget of costly HTTP/2 frames and waited.
+  std::uint64_t throttled() const { return guard_->throttled(); }
 
  private:
-  explicit UnixListener(std::unique_ptr<rpc::UnixAcceptor> acceptor);
+  UnixListener(std::unique_ptr<rpc::Http2Guard> guard, std::unique_ptr<rpc::UnixAcceptor> acceptor);
 
+  // In this order: the accept thread, which hands connections to the guard,
+  // stops before the guard goes.
+  std::unique_ptr<rpc::Http2Guard> guard_;
   std::unique_ptr<rpc::UnixAcceptor> acceptor_;
 };
 
