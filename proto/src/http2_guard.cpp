@@ -58,6 +58,12 @@ bool ReadSome(int fd, std::string* bytes) {
   return true;
 }
 
+// Whether the side polled in `fd` has gone while its bytes are not being
+// read (its buffer is full): a read would find its end, poll would not wait.
+bool HungUp(const pollfd& fd) {
+  return (fd.revents & (POLLHUP | POLLERR | POLLNVAL)) != 0 && (fd.events & POLLIN) == 0;
+}
+
 }  // namespace
 
 // One relayed connection.
@@ -161,7 +167,8 @@ void Http2Guard::Relay() {
     std::size_t kept = 0;
     for (std::size_t i = 0; i < links_.size(); ++i) {
       const bool active = fds[2 * i].revents != 0 || fds[2 * i + 1].revents != 0;
-      if ((active || links_[i]->waiting) && !Pump(*links_[i])) {
+      if (HungUp(fds[2 * i]) || HungUp(fds[2 * i + 1]) ||
+          ((active || links_[i]->waiting) && !Pump(*links_[i]))) {
         links_[i].reset();  // closes both ends
         --relayed_;
         continue;
