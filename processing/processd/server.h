@@ -1,7 +1,8 @@
 // bsls-processd assembled: the processing service on a gRPC server with its
 // size caps, the health service, and the listeners of the configuration (a
 // Unix socket for this machine, accepted by rpc::UnixAcceptor within the
-// connection limits; TCP with mutual TLS or plain on loopback).
+// connection limits and relayed through rpc::Http2Guard; TCP with mutual
+// TLS or plain on loopback).
 // main() wraps it with signals and systemd notification; the tests and the
 // benchmark start replicas in-process through the same class.
 #ifndef BSLS_PROCESSD_SERVER_H_
@@ -16,6 +17,7 @@
 #include <utility>
 
 #include "bsls/processing/processing_service.h"
+#include "bsls/rpc/http2_guard.h"
 #include "bsls/rpc/tcp_acceptor.h"
 #include "bsls/rpc/unix_acceptor.h"
 #include "config.h"
@@ -49,7 +51,10 @@ class Server {
   std::unique_ptr<processing::ProcessingService> service_;
   std::unique_ptr<grpc::Server> server_;
   // The Unix socket: its connections are accepted here (within the
-  // listen.max_connections* limits) and handed to server_.
+  // listen.max_connections* limits) and handed to server_ through guard_
+  // (new streams, resets and pings at a bounded rate: rpc::Http2Guard).
+  // guard_ is declared first so that the accept thread stops before it goes.
+  std::unique_ptr<rpc::Http2Guard> guard_;
   std::unique_ptr<rpc::UnixAcceptor> acceptor_;
   // TCP: its connections are accepted here (within the
   // listen.max_tcp_connections* limits) and handed to server_.
