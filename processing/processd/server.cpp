@@ -44,12 +44,10 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     socket.path = config.listen.unix_socket;
     socket.mode = 0660;
     socket.connections = config.listen.connections;
+    socket.http2_guard = rpc::Http2GuardLimits{};  // new streams, resets, pings at a bounded rate
     rpc::UnixAcceptorError error;
     s->acceptor_ = rpc::UnixAcceptor::Create(socket, &error);
     if (!s->acceptor_) throw std::runtime_error("listen.unix_socket: " + error.message);
-    std::string why;
-    s->guard_ = rpc::Http2Guard::Create(rpc::Http2GuardLimits{}, &why);
-    if (!s->guard_) throw std::runtime_error("listen.unix_socket: " + why);
   }
   if (!config.listen.tcp.empty()) {
     rpc::TlsFiles tls{config.listen.tls_client_ca, config.listen.tls_certificate,
@@ -77,17 +75,8 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
   if (s->tcp_.acceptor) s->tcp_.Start();
   if (s->acceptor_) {
     grpc::Server* server = s->server_.get();
-    rpc::Http2Guard* guard = s->guard_.get();
-    guard->Start();
-    s->acceptor_->Start([server, guard](int client, const ucred& peer) {
-      std::string error;
-      const int fd = guard->Guard(client, &error);
-      if (fd < 0) {
-        spdlog::warn("closed a connection of uid {}: {}", peer.uid, error);
-        return;
-      }
-      grpc::AddInsecureChannelFromFd(server, fd);
-    });
+    s->acceptor_->Start(
+        [server](int fd, const ucred&) { grpc::AddInsecureChannelFromFd(server, fd); });
   }
   spdlog::info(
       "serving: {} workers, {} queue places{}{}", options.workers, options.queue,

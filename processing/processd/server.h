@@ -17,7 +17,6 @@
 #include <utility>
 
 #include "bsls/processing/processing_service.h"
-#include "bsls/rpc/http2_guard.h"
 #include "bsls/rpc/tcp_acceptor.h"
 #include "bsls/rpc/unix_acceptor.h"
 #include "config.h"
@@ -51,10 +50,8 @@ class Server {
   std::unique_ptr<processing::ProcessingService> service_;
   std::unique_ptr<grpc::Server> server_;
   // The Unix socket: its connections are accepted here (within the
-  // listen.max_connections* limits) and handed to server_ through guard_
-  // (new streams, resets and pings at a bounded rate: rpc::Http2Guard).
-  // guard_ is declared first so that the accept thread stops before it goes.
-  std::unique_ptr<rpc::Http2Guard> guard_;
+  // listen.max_connections* limits) and handed to server_ through its
+  // rpc::Http2Guard (new streams, resets and pings at a bounded rate).
   std::unique_ptr<rpc::UnixAcceptor> acceptor_;
   // TCP: its connections are accepted here (within the
   // listen.max_tcp_connections* limits) and handed to server_.

@@ -99,8 +99,13 @@ bool Acceptor::AcceptOne(int listener, const HandOver& hand_over) {
     return true;
   }
   handed_[connection] = {socket_file.st_ino, peer->name};
+  if (!hand_over(connection, listener, *peer)) {
+    handed_.erase(connection);
+    ++shed_;
+    pollfd wake = {wake_[0], POLLIN, 0};
+    return ::poll(&wake, 1, kDescriptorBackoffMs) <= 0;
+  }
   ++accepted_;
-  hand_over(connection, listener, *peer);
   return true;
 }
 

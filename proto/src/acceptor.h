@@ -52,8 +52,10 @@ class Acceptor {
   // The peer of an accepted connection; nullopt closes the connection.
   using NamePeer = std::function<std::optional<Peer>(int fd)>;
   // Takes a connection (the descriptor is its own from then on), the
-  // listening socket it came through and its peer.
-  using HandOver = std::function<void(int fd, int listener_fd, const Peer& peer)>;
+  // listening socket it came through and its peer; false when it had to
+  // close the connection for want of descriptors (the loop then backs off
+  // as at EMFILE and counts it shed).
+  using HandOver = std::function<bool(int fd, int listener_fd, const Peer& peer)>;
 
   // Accepts on `listeners` (bound, listening, non-blocking; owned from here
   // on, closed by the destructor or when Create fails), named `where` in

@@ -217,6 +217,7 @@ TcpAcceptor::~TcpAcceptor() { Stop(); }
 void TcpAcceptor::Start(HandOver hand_over) {
   core_->Start([hand_over = std::move(hand_over)](int fd, int listener_fd, const Peer&) {
     hand_over(fd, listener_fd);
+    return true;
   });
 }
 

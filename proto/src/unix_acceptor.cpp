@@ -35,9 +35,13 @@ std::optional<Peer> PeerOfUnixConnection(int fd) {
 
 }  // namespace
 
-UnixAcceptor::UnixAcceptor(UnixAcceptorOptions options, std::unique_ptr<Acceptor> core,
+UnixAcceptor::UnixAcceptor(UnixAcceptorOptions options, std::unique_ptr<Http2Guard> guard,
+                           std::unique_ptr<Acceptor> core,
                            std::optional<std::pair<dev_t, ino_t>> socket_file)
-    : options_(std::move(options)), core_(std::move(core)), socket_file_(socket_file) {}
+    : options_(std::move(options)),
+      guard_(std::move(guard)),
+      core_(std::move(core)),
+      socket_file_(socket_file) {}
 
 std::unique_ptr<UnixAcceptor> UnixAcceptor::Create(const UnixAcceptorOptions& options,
                                                    UnixAcceptorError* error) {
@@ -87,15 +91,30 @@ std::unique_ptr<UnixAcceptor> UnixAcceptor::Create(const UnixAcceptorOptions& op
   std::unique_ptr<Acceptor> core = Acceptor::Create({std::exchange(fd, -1)}, "unix:" + options.path,
                                                     std::move(limits), PeerOfUnixConnection, &why);
   if (!core) return fail_bound(UnixAcceptorError::Kind::kSystem, options.path + ": " + why);
-  return std::unique_ptr<UnixAcceptor>(new UnixAcceptor(options, std::move(core), socket_file));
+  std::unique_ptr<Http2Guard> guard;
+  if (options.http2_guard) {
+    guard = Http2Guard::Create(*options.http2_guard, &why);
+    if (!guard) return fail_bound(UnixAcceptorError::Kind::kSystem, options.path + ": " + why);
+  }
+  return std::unique_ptr<UnixAcceptor>(
+      new UnixAcceptor(options, std::move(guard), std::move(core), socket_file));
 }
 
 UnixAcceptor::~UnixAcceptor() { Stop(); }
 
 void UnixAcceptor::Start(HandOver hand_over) {
-  core_->Start([hand_over = std::move(hand_over)](int fd, int, const Peer& peer) {
-    hand_over(fd, peer.credentials);
-  });
+  if (guard_) guard_->Start();
+  core_->Start(
+      [hand_over = std::move(hand_over), guard = guard_.get()](int client, int, const Peer& peer) {
+        int fd = client;
+        if (guard) {
+          std::string ignored;  // the only reason: no descriptors for the socket pair
+          fd = guard->Guard(client, &ignored);
+          if (fd < 0) return false;
+        }
+        hand_over(fd, peer.credentials);
+        return true;
+      });
 }
 
 void UnixAcceptor::Stop() {

@@ -3,7 +3,6 @@
 #include <grpcpp/server.h>
 #include <grpcpp/server_posix.h>
 #include <pwd.h>
-#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 
 #include <vector>
@@ -40,9 +39,8 @@ std::string UserName(uid_t uid) {
 
 }  // namespace
 
-UnixListener::UnixListener(std::unique_ptr<rpc::Http2Guard> guard,
-                           std::unique_ptr<rpc::UnixAcceptor> acceptor)
-    : guard_(std::move(guard)), acceptor_(std::move(acceptor)) {}
+UnixListener::UnixListener(std::unique_ptr<rpc::UnixAcceptor> acceptor)
+    : acceptor_(std::move(acceptor)) {}
 
 Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOptions& options) {
   rpc::UnixAcceptorOptions socket;
@@ -51,6 +49,7 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
   socket.group = options.group;
   socket.backlog = options.backlog;
   socket.connections = options.connections;
+  socket.http2_guard = options.http2_guard;
   rpc::UnixAcceptorError error;
   std::unique_ptr<rpc::UnixAcceptor> acceptor = rpc::UnixAcceptor::Create(socket, &error);
   if (!acceptor) {
@@ -66,23 +65,13 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
     }
     return Status(ErrorCode::kUnavailable, error.message);
   }
-  std::string why;
-  std::unique_ptr<rpc::Http2Guard> guard = rpc::Http2Guard::Create(options.http2_guard, &why);
-  if (!guard) return Status(ErrorCode::kUnavailable, options.path + ": " + why);
-  return std::unique_ptr<UnixListener>(new UnixListener(std::move(guard), std::move(acceptor)));
+  return std::unique_ptr<UnixListener>(new UnixListener(std::move(acceptor)));
 }
 
 UnixListener::~UnixListener() { Stop(); }
 
 void UnixListener::Start(grpc::Server* server, PeerRegistry* registry, const RolePolicy* policy) {
-  guard_->Start();
-  acceptor_->Start([server, registry, policy, guard = guard_.get()](int client, const ucred& peer) {
-    std::string error;
-    const int fd = guard->Guard(client, &error);
-    if (fd < 0) {
-      spdlog::warn("closed a connection of uid {}: {}", peer.uid, error);
-      return;
-    }
+  acceptor_->Start([server, registry, policy](int fd, const ucred& peer) {
     Caller caller;
     caller.uid = peer.uid;
     caller.name = UserName(peer.uid);

@@ -9,6 +9,10 @@
 //  - out of descriptors (EMFILE, ENFILE), the waiting caller is shed
 //    through a descriptor kept spare for it and the loop waits a moment
 //    instead of spinning;
+//  - optionally (UnixAcceptorOptions::http2_guard), each connection relayed
+//    through rpc::Http2Guard, which lets the frames that make gRPC work
+//    without bound (new streams, resets, pings) through at a bounded rate;
+//    when its socket pair cannot be had the connection is shed as at EMFILE;
 //  - one live instance per socket (rpc::ClaimUnixSocketPath), and the
 //    socket file is removed on Stop only while it is the one made here.
 //
@@ -27,6 +31,7 @@
 #include <string>
 #include <utility>
 
+#include "bsls/rpc/http2_guard.h"
 #include "bsls/rpc/server_limits.h"
 
 namespace bsls::rpc {
@@ -40,6 +45,9 @@ struct UnixAcceptorOptions {
   std::optional<gid_t> group;  // owning group of the socket file (else the process's)
   int backlog = 64;
   ConnectionLimits connections;  // open at once, in all and per peer uid
+  // When set, each connection is relayed through rpc::Http2Guard with these
+  // budgets (gRPC gets the guard's end; three descriptors per connection).
+  std::optional<Http2GuardLimits> http2_guard;
 };
 
 // Why a socket could not be made.
@@ -83,10 +91,13 @@ class UnixAcceptor {
   std::uint64_t refused() const;
 
  private:
-  UnixAcceptor(UnixAcceptorOptions options, std::unique_ptr<Acceptor> core,
-               std::optional<std::pair<dev_t, ino_t>> socket_file);
+  UnixAcceptor(UnixAcceptorOptions options, std::unique_ptr<Http2Guard> guard,
+               std::unique_ptr<Acceptor> core, std::optional<std::pair<dev_t, ino_t>> socket_file);
 
   UnixAcceptorOptions options_;
+  // In this order: the accept loop, which hands connections to the guard,
+  // stops before the guard goes.
+  std::unique_ptr<Http2Guard> guard_;                   // null without options.http2_guard
   std::unique_ptr<Acceptor> core_;                      // the accept loop and its limits
   std::optional<std::pair<dev_t, ino_t>> socket_file_;  // the file Create made
 };

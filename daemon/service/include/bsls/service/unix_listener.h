@@ -27,7 +27,6 @@
 #include <string>
 
 #include "bsls/common/status.h"
-#include "bsls/rpc/http2_guard.h"
 #include "bsls/rpc/unix_acceptor.h"
 #include "bsls/service/roles.h"
 
@@ -59,7 +58,8 @@ struct UnixListenerOptions {
   std::optional<gid_t> group;  // owning group of the socket file (else the daemon's)
   int backlog = 64;
   rpc::ConnectionLimits connections;
-  rpc::Http2GuardLimits http2_guard;  // frames that make gRPC work, per second
+  // Each connection relayed through rpc::Http2Guard with these budgets.
+  std::optional<rpc::Http2GuardLimits> http2_guard = rpc::Http2GuardLimits{};
 };
 
 // bslsd's front door: rpc::UnixAcceptor (limits, descriptor exhaustion,
@@ -93,15 +93,10 @@ class UnixListener {
   // Connections closed at once because their user or everyone together had
   // as many open as allowed (options.connections).
   std::uint64_t refused() const { return acceptor_->refused(); }
-  // Times a connection spent its budget of costly HTTP/2 frames and waited.
-  std::uint64_t throttled() const { return guard_->throttled(); }
 
  private:
-  UnixListener(std::unique_ptr<rpc::Http2Guard> guard, std::unique_ptr<rpc::UnixAcceptor> acceptor);
+  explicit UnixListener(std::unique_ptr<rpc::UnixAcceptor> acceptor);
 
-  // In this order: the accept thread, which hands connections to the guard,
-  // stops before the guard goes.
-  std::unique_ptr<rpc::Http2Guard> guard_;
   std::unique_ptr<rpc::UnixAcceptor> acceptor_;
 };
 
