@@ -45,6 +45,16 @@ class ProcessdServer : public ::testing::Test {
     return v1::Processing::NewStub(channel)->GetServerInfo(&context, {}, info);
   }
 
+  // Info asked every 100 ms until it answers OK or 20 tries have failed;
+  // the last status.
+  static grpc::Status InfoWithin2Seconds(const std::shared_ptr<grpc::Channel>& channel) {
+    v1::ServerInfo info;
+    grpc::Status status;
+    for (int attempt = 0; attempt < 20 && !(status = Info(channel, &info)).ok(); ++attempt)
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    return status;
+  }
+
   fs::path dir_;
 };
 
@@ -193,10 +203,7 @@ TEST_F(ProcessdServer, UnixConnectionsBeyondTheLimitsAreClosedAtOnce) {
   // Once they are gone, the service answers again.
   std::shared_ptr<grpc::Channel> channel =
       grpc::CreateChannel("unix:" + config.listen.unix_socket, grpc::InsecureChannelCredentials());
-  v1::ServerInfo info;
-  grpc::Status status;
-  for (int attempt = 0; attempt < 20 && !(status = Info(channel, &info)).ok(); ++attempt)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const grpc::Status status = InfoWithin2Seconds(channel);
   EXPECT_TRUE(status.ok()) << status.error_message();
   server->Drain();
   EXPECT_FALSE(fs::exists(config.listen.unix_socket));
@@ -236,10 +243,7 @@ TEST_F(ProcessdServer, TcpConnectionsBeyondTheLimitsAreClosedAtOnce) {
   // Once they are gone, the service answers again.
   std::shared_ptr<grpc::Channel> channel =
       grpc::CreateChannel("127.0.0.1:" + std::to_string(port), grpc::InsecureChannelCredentials());
-  v1::ServerInfo info;
-  grpc::Status status;
-  for (int attempt = 0; attempt < 20 && !(status = Info(channel, &info)).ok(); ++attempt)
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  const grpc::Status status = InfoWithin2Seconds(channel);
   EXPECT_TRUE(status.ok()) << status.error_message();
   server->Drain();
 }
