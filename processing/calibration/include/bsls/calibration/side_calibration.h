@@ -79,7 +79,7 @@ struct SideCalibrationParams {
   // must be unset: the offsets come from the cross views. The skeleton
   // chain: its junctions lie closer to the truth (docs/decoding.md, "Which
   // chain"), and the projector's model is fitted to them.
-  decoder::DecodeParams decode = decoder::SkeletonChainParams();
+  decoder::DecodeParams decode;
   StripeFitParams stripes;       // step 3, both plane models
   CrossParams cross;             // step 4
   ProjectorMatrixParams matrix;  // step 5
