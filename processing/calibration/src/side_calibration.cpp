@@ -388,7 +388,6 @@ std::optional<ScreenViewReport> SideCalibrationRun::ScreenStripePoints(
 // line-centre sample onto its screen.
 std::vector<decoder::DecodeResult> SideCalibrationRun::DecodeScreenViews() {
   decoder::DecodeParams decode = params_.decode;
-  if (getenv("BSLS_CAL_SKEL")) decode.chain = decoder::DecodeChain::kSkeleton;  // TEMP
   decode.spec = manifest_.pattern;
   std::vector<decoder::DecodeResult> decoded;  // one per used screen view
   double centre_sum2 = 0.0, centre_dof = 0.0;

@@ -406,8 +406,9 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p, con
 
 // The first step of RefineJunction: the line's fit and the segment columns
 // to measure (the segment's ends skipped, where the lines' light biases it).
-internal::JunctionPlan PlanJunction(const LineCentres& line, const interpretation::LabelledJunction& j,
-                          const DecodeParams& params, int n_binning) {
+internal::JunctionPlan PlanJunction(const LineCentres& line,
+                                    const interpretation::LabelledJunction& j,
+                                    const DecodeParams& params, int n_binning) {
   const double y0 = j.position.y;
   internal::JunctionPlan plan;
   // The line as x(y): sub-pixel centres, or where a steep or crowded line has
@@ -593,7 +594,8 @@ void PlaceJunctions(const cv::Mat& grey,
       d.kind = j.kind;
       d.interpolated = j.interpolated;
       d.position = j.position;
-      if (auto refined = internal::RefineJunction(plans[i], columns, j.position.y, subpixel, n)) d.position = *refined;
+      if (auto refined = internal::RefineJunction(plans[i], columns, j.position.y, subpixel, n))
+        d.position = *refined;
     }
   });
 }

@@ -32,7 +32,6 @@ struct JunctionPlan {
   std::vector<cv::Point> columns;  // (column, approximate row) of each centre to measure
 };
 
-
 // Sub-pixel centres of segment columns, measured once each (a segment is
 // seen from both its junctions over nearly the same columns): `keys` sorted
 // (x, then y), `centres` the column centre measured for each.

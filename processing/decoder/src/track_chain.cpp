@@ -76,7 +76,7 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
     const extraction::RidgePoint& p = rp[pts[i]];
     // A centre far from its ridge point took another stripe's light (a
     // neighbour crowding in, a segment nearby): dropped.
-    const auto x = getenv("BSLS_RIDGE") ? extraction::RidgeCentreInRow(grey, p.y, p.x) : extraction::StripeCentreInRow(grey, p.y, p.x, params.centre);
+    const auto x = extraction::RidgeCentreInRow(grey, p.y, p.x);
     if (x && std::abs(*x - p.x) <= tp.max_centre_shift) c.measured[i] = *x;
   }
   // A centre its neighbours' curve misses by more than max_centre_residual
@@ -159,8 +159,7 @@ void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
 
 // The measured centres of `line` within `reach` rows of row y0, as
 // (row - y0, x) pairs.
-std::vector<std::pair<double, double>> CentresNear(const TrackCentres& line, double y0,
-                                                   int reach) {
+std::vector<std::pair<double, double>> CentresNear(const TrackCentres& line, double y0, int reach) {
   std::vector<std::pair<double, double>> out;
   for (int r = static_cast<int>(std::ceil(y0 - reach)); r <= y0 + reach; ++r)
     if (const double x = line.Measured(r); !std::isnan(x)) out.emplace_back(r - y0, x);
@@ -171,11 +170,14 @@ std::vector<std::pair<double, double>> CentresNear(const TrackCentres& line, dou
 // j fits (junction_placement.h). The line: its measured centres within
 // junction_fit_rows of the junction (the rows beside its junctions were
 // never measured), or where too few, its ridge points clear of the
-// junction. The segment: its column ridge points from the line outwards,
-// those within junction_clearance of the line left out, and its last two
-// columns (where the far line's light biases them); they end where the
-// track turns steeper than 45 degrees over three columns (it runs on into
-// a line there).
+// junction. The segment: its first track_chain.segment_columns column
+// ridge points from the line outwards, those within junction_clearance of
+// the line left out, and never its last two columns (where the far line's
+// light biases them); they end where the track turns steeper than 45
+// degrees over three columns (it runs on into a line there). The columns
+// are measured by RidgeCentreInColumn: StripeCentreInColumn, or more
+// columns, moved junctions beside the outside corpus's noses 2.5-3.7 px
+// (docs/decoding.md, "Which chain").
 JunctionPlan PlanTrackJunction(const interpretation::TrackNetwork& net, int j,
                                const TrackCentres& line, const DecodeParams& params) {
   const interpretation::TrackJunction& junction = net.junctions[j];
@@ -203,7 +205,8 @@ JunctionPlan PlanTrackJunction(const interpretation::TrackNetwork& net, int j,
   auto outward = [&](int k) -> const extraction::RidgePoint& {
     return cp[seg[junction.segment_left ? n - 1 - k : k]];
   };
-  for (int k = 0; k < n - 2 && static_cast<int>(plan.columns.size()) < (getenv("BSLS_SC") ? atoi(getenv("BSLS_SC")) : params.segment_fit_columns);
+  for (int k = 0;
+       k < n - 2 && static_cast<int>(plan.columns.size()) < params.track_chain.segment_columns;
        ++k) {
     const extraction::RidgePoint& q = outward(k);
     if (!plan.columns.empty() && k >= 3) {
@@ -528,7 +531,7 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
   cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
       const auto [x, y] = columns.keys[i];
-      columns.centres[i] = extraction::StripeCentreInColumn(working, x, y, params.centre);
+      columns.centres[i] = extraction::RidgeCentreInColumn(working, x, y);
     }
   });
   const int q_offset = params.q_offset.value_or(0);
@@ -541,7 +544,7 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
       d.q = labels.v[j] + q_offset;
       d.kind = net.junctions[j].kind;
       std::optional<cv::Point2d> at;
-      if (!getenv("BSLS_NOREF") && StraightThrough(plans[i], params))
+      if (StraightThrough(plans[i], params))
         at = RefineJunction(plans[i], columns, net.junctions[j].position.y, params, 1);
       if (!at)
         at = PlaceJunction(working, net, j, centres[net.junctions[j].line], plans[i], columns,
@@ -588,8 +591,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     }
   });
 
-  result->junctions = PlaceTrackJunctions(working, net, labels, centres, params, scale,
-                                          &result->label_conflicts);
+  result->junctions =
+      PlaceTrackJunctions(working, net, labels, centres, params, scale, &result->label_conflicts);
   result->unlabelled = UnlabelledJunctions(net, labels, scale);
   result->lines = DecodedLines(labelled, labels, centres, working.rows, scale);
   result->times.subpixel_ms = MsSince(t);

@@ -39,7 +39,7 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
   // quick one for labels alone.
   const bool surface = params.reconstruct && !std::holds_alternative<std::monostate>(geometry);
   decoder::DecodeParams decode = params.decode;
-  decode.chain = decoder::DecodeChain::kTracks;
+  decode.chain = surface ? decoder::DecodeChain::kSkeleton : decoder::DecodeChain::kTracks;
   decode.chain = *decoder::ChainFor(params.chain, decode, nullptr);  // checked by IsValid
   SideOutcome outcome;
   outcome.decode = decoder::Decode(grey, side, decode, cancel);
