@@ -13,6 +13,7 @@
 
 #include "bsls/geometry/curve_fit.h"
 #include "centres_ahead.h"
+#include "junction_placement.h"
 #include "track_chain.h"
 #include "working_resolution.h"
 
@@ -403,26 +404,13 @@ LineCentres MeasureLine(const cv::Mat& grey, const cv::Mat& skeleton, int p, con
   return out;
 }
 
-// What placing a junction needs besides its segment's centres: the line
-// near the junction as x = a + b (y - y0) through `vertical` ((y - y0, x)
-// pairs), and the segment's skeleton pixels whose column centres are fitted.
-struct JunctionPlan {
-  bool ok = false;  // false: the line has too few centres near the junction
-  double a = 0.0, b = 0.0;
-  std::vector<std::pair<double, double>> vertical;
-  // The line's measured centres twice as far each side (empty where the fit
-  // fell back to the skeleton): a fold's branch curving into it is fitted
-  // over these.
-  std::vector<std::pair<double, double>> wide;
-  std::vector<cv::Point> columns;  // (column, approximate row) of each centre to measure
-};
-
 // The first step of RefineJunction: the line's fit and the segment columns
 // to measure (the segment's ends skipped, where the lines' light biases it).
-JunctionPlan PlanJunction(const LineCentres& line, const interpretation::LabelledJunction& j,
-                          const DecodeParams& params, int n_binning) {
+internal::JunctionPlan PlanJunction(const LineCentres& line,
+                                    const interpretation::LabelledJunction& j,
+                                    const DecodeParams& params, int n_binning) {
   const double y0 = j.position.y;
-  JunctionPlan plan;
+  internal::JunctionPlan plan;
   // The line as x(y): sub-pixel centres, or where a steep or crowded line has
   // too few of them, its skeleton (within a pixel of the centre).
   plan.vertical = RowsNear(line.clear, y0, params.junction_fit_rows, 0.0);
@@ -457,139 +445,6 @@ JunctionPlan PlanJunction(const LineCentres& line, const interpretation::Labelle
     plan.columns.push_back(s);
   }
   return plan;
-}
-
-// Sub-pixel centres of segment columns, measured once each: `keys` sorted
-// (x, then y), `centres` the StripeCentreInColumn answer for each.
-struct ColumnCentres {
-  std::vector<std::pair<int, int>> keys;
-  std::vector<std::optional<double>> centres;
-
-  const std::optional<double>& At(cv::Point p) const {
-    const auto it = std::lower_bound(keys.begin(), keys.end(), std::make_pair(p.x, p.y));
-    return centres[static_cast<size_t>(it - keys.begin())];
-  }
-};
-
-// Drops from `columns` ((x, y) pairs) the one furthest from the line fitted
-// through the others when it lies more than `max_residual` from it.
-void DropWorstColumn(std::vector<std::pair<double, double>>& columns, double max_residual) {
-  double c, e;
-  if (!FitLine(columns, &c, &e)) return;
-  const auto residual = [&](const std::pair<double, double>& p) {
-    return std::abs(p.second - c - e * p.first);
-  };
-  const auto worst =
-      std::max_element(columns.begin(), columns.end(),
-                       [&](const auto& l, const auto& r) { return residual(l) < residual(r); });
-  std::vector<std::pair<double, double>> others(columns.begin(), worst);
-  others.insert(others.end(), worst + 1, columns.end());
-  if (FitLine(others, &c, &e) && residual(*worst) > max_residual) columns = std::move(others);
-}
-
-// The junction where the line's centre curve meets the segment's: the line's
-// measured centres near the junction fitted as x(y), the segment's centres
-// measured column by column along its skeleton (plan.columns, from `columns`)
-// and fitted as y(x). An interpolated junction, or one whose segment cannot be
-// measured, is placed on the line's fit at its row. nullopt when the line has
-// too few centres near it.
-std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const ColumnCentres& columns,
-                                          const interpretation::LabelledJunction& j,
-                                          const DecodeParams& params, int n) {
-  if (!plan.ok) return std::nullopt;
-  // How far from the skeleton's junction row the meeting point may lie.
-  const double reach = params.junction_clearance + 1.0 * n;
-  const double y0 = j.position.y;
-  const double a = plan.a, b = plan.b;
-  const std::vector<std::pair<double, double>>& vertical = plan.vertical;
-  double y = y0;
-  if (!plan.columns.empty()) {
-    // The segment as y(x): centres column by column along its skeleton, or the
-    // skeleton itself.
-    std::vector<std::pair<double, double>> measured, skeleton;  // (x - a, y)
-    for (const cv::Point& s : plan.columns) {
-      skeleton.push_back({s.x - a, static_cast<double>(s.y)});
-      if (const std::optional<double>& cy = columns.At(s)) measured.push_back({s.x - a, *cy});
-    }
-    double c, e;
-    // A column far off the line through the others is dropped: where a line
-    // leans towards the segment's side below or above the junction, its
-    // light reaches into the column profiles nearest to it (one in a short
-    // segment of 5 columns moved the chin's corner junctions 4 px).
-    if (measured.size() >= 4) DropWorstColumn(measured, 2.0 * params.max_centre_residual);
-    const bool fitted = (measured.size() >= 2 && FitLine(measured, &c, &e)) ||
-                        (skeleton.size() >= 2 && FitLine(skeleton, &c, &e));
-    if (fitted) {
-      // Where x = a' + b' (y - y0) meets y = c + e (x - a):
-      //   y = (c + e (a' - a) - e b' y0) / (1 - e b').
-      auto meet = [&](double a2, double b2, double* out) {
-        const double den = 1.0 - e * b2;
-        if (std::abs(den) < 1e-6) return false;
-        *out = (c + e * (a2 - a) - e * b2 * y0) / den;
-        return std::abs(*out - y0) <= reach;
-      };
-      // Where the parabola x = k0 + k1 t + k2 t^2 (t = y - y0) meets the
-      // segment: e k2 t^2 + (e k1 - 1) t + c + e (k0 - a) - y0 = 0; the root
-      // nearer t = 0, in the form that stays exact as e k2 -> 0.
-      auto meet_curve = [&](const Quadratic& k, cv::Point2d* out) {
-        const double qa = e * k[2], qb = e * k[1] - 1.0, qc = c + e * (k[0] - a) - y0;
-        const double disc = qb * qb - 4 * qa * qc;
-        if (disc < 0) return false;
-        const double t = 2 * qc / (-qb + std::copysign(std::sqrt(disc), -qb));
-        if (std::abs(t) > reach) return false;
-        *out = cv::Point2d(k[0] + k[1] * t + k[2] * t * t, y0 + t);
-        return true;
-      };
-      std::vector<std::pair<double, double>> upper, lower;
-      for (const auto& v : vertical) (v.first < 0 ? upper : lower).push_back(v);
-      double au, bu, al, bl, yu, yl, ya;
-      const bool branches = upper.size() >= 2 && lower.size() >= 2 && FitLine(upper, &au, &bu) &&
-                            FitLine(lower, &al, &bl);
-      // A line folding near its junction (nose, lips): the branches above and
-      // below meet the segment each on its own. A segment coming from the
-      // fold's open side runs into the branch at its row first: the meeting
-      // point nearer its side (the other one lies on the far branch's
-      // extension beyond the tip), where that branch, curving into the fold,
-      // is fitted as a parabola over twice the rows when it has them. A
-      // segment coming at the tip from outside, or branches meeting it within
-      // fold_tip_spread of each other, meet the fold at its tip: the junction
-      // lies between the meeting points.
-      if (branches && std::abs(bu - bl) > params.fold_slope_change) {
-        if (meet(au, bu, &yu) && meet(al, bl, &yl)) {
-          const double xu = au + bu * (yu - y0), xl = al + bl * (yl - y0);
-          double side = 0.0;  // > 0: the segment comes from the right
-          for (const cv::Point& s : plan.columns) side += s.x - a;
-          const bool tip_right = bu > bl;
-          if ((side > 0) == tip_right || std::abs(xu - xl) <= params.fold_tip_spread)
-            return cv::Point2d(0.5 * (xu + xl), 0.5 * (yu + yl));
-          const bool entered_upper = (side > 0) == (xu > xl);
-          std::vector<std::pair<double, double>> branch;
-          for (const auto& v : plan.wide)
-            if ((v.first < 0) == entered_upper) branch.push_back(v);
-          cv::Point2d curved;
-          if (Quadratic k; FitParabola(branch, &k) && meet_curve(k, &curved)) return curved;
-          return entered_upper ? cv::Point2d(xu, yu) : cv::Point2d(xl, yl);
-        }
-      } else if (Quadratic k; branches && FitParabola(vertical, &k)) {
-        // A line curving smoothly through it: its centres on both sides as a
-        // parabola.
-        if (cv::Point2d curved; meet_curve(k, &curved)) return curved;
-      } else if (!branches && std::min(upper.size(), lower.size()) == 1) {
-        // A line with a single measured row on one side within reach (where
-        // the nose wing hides a few rows of it next to the junction): its
-        // centres on the other side, over twice the rows, as a parabola: a
-        // line bending into the junction runs past a straight fit's meeting
-        // point, and the lone row is no guide to a fold.
-        std::vector<std::pair<double, double>> one_side;
-        for (const auto& v : plan.wide)
-          if ((v.first < 0) == (upper.size() >= 2)) one_side.push_back(v);
-        cv::Point2d curved;
-        if (Quadratic q; FitParabola(one_side, &q) && meet_curve(q, &curved)) return curved;
-      }
-      if (meet(a, b, &ya)) y = ya;
-    }
-  }
-  return cv::Point2d(a + b * (y - y0), y);
 }
 
 // The sub-pixel stage's lengths for a frame binned n x n for extraction and
@@ -717,17 +572,12 @@ void PlaceJunctions(const cv::Mat& grey,
                     const std::vector<interpretation::LabelledJunction>& junctions,
                     const std::map<int, LineCentres>& centres, const internal::CentresAhead& ahead,
                     const DecodeParams& subpixel, int n, int q_offset, DecodeResult* result) {
-  std::vector<JunctionPlan> plans(junctions.size());
+  std::vector<internal::JunctionPlan> plans(junctions.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(junctions.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i)
       plans[i] = PlanJunction(centres.at(junctions[i].p), junctions[i], subpixel, n);
   });
-  ColumnCentres columns;
-  for (const JunctionPlan& plan : plans)
-    for (const cv::Point& c : plan.columns) columns.keys.emplace_back(c.x, c.y);
-  std::sort(columns.keys.begin(), columns.keys.end());
-  columns.keys.erase(std::unique(columns.keys.begin(), columns.keys.end()), columns.keys.end());
-  columns.centres.resize(columns.keys.size());
+  internal::ColumnCentres columns = internal::ColumnCentres::Wanted(plans);
   cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
       const auto [x, y] = columns.keys[i];
@@ -744,7 +594,8 @@ void PlaceJunctions(const cv::Mat& grey,
       d.kind = j.kind;
       d.interpolated = j.interpolated;
       d.position = j.position;
-      if (auto refined = RefineJunction(plans[i], columns, j, subpixel, n)) d.position = *refined;
+      if (auto refined = internal::RefineJunction(plans[i], columns, j.position.y, subpixel, n))
+        d.position = *refined;
     }
   });
 }

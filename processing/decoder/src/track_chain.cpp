@@ -11,6 +11,7 @@
 #include "bsls/extraction/stripe_centre.h"
 #include "bsls/extraction/stripe_pitch.h"
 #include "bsls/geometry/curve_fit.h"
+#include "junction_placement.h"
 #include "working_resolution.h"
 
 namespace bsls::decoder::internal {
@@ -156,10 +157,86 @@ void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
   }
 }
 
+// The measured centres of `line` within `reach` rows of row y0, as
+// (row - y0, x) pairs.
+std::vector<std::pair<double, double>> CentresNear(const TrackCentres& line, double y0, int reach) {
+  std::vector<std::pair<double, double>> out;
+  for (int r = static_cast<int>(std::ceil(y0 - reach)); r <= y0 + reach; ++r)
+    if (const double x = line.Measured(r); !std::isnan(x)) out.emplace_back(r - y0, x);
+  return out;
+}
+
+// Thesis 5.2, as the skeleton chain plans it: what placing track junction
+// j fits (junction_placement.h). The line: its measured centres within
+// junction_fit_rows of the junction (the rows beside its junctions were
+// never measured), or where too few, its ridge points clear of the
+// junction. The segment: its first track_chain.segment_columns column
+// ridge points from the line outwards, those within junction_clearance of
+// the line left out, and never its last two columns (where the far line's
+// light biases them); they end where the track turns steeper than 45
+// degrees over three columns (it runs on into a line there). The columns
+// are measured by RidgeCentreInColumn: StripeCentreInColumn, or more
+// columns, moved junctions beside the outside corpus's noses 2.5-3.7 px
+// (docs/decoding.md, "Which chain").
+JunctionPlan PlanTrackJunction(const interpretation::TrackNetwork& net, int j,
+                               const TrackCentres& line, const DecodeParams& params) {
+  const interpretation::TrackJunction& junction = net.junctions[j];
+  const double y0 = junction.position.y;
+  const int fit = params.junction_fit_rows;
+  JunctionPlan plan;
+  plan.vertical = CentresNear(line, y0, fit);
+  if (plan.vertical.size() >= 3 && FitLine(plan.vertical, &plan.a, &plan.b)) {
+    plan.wide = CentresNear(line, y0, 2 * fit);
+  } else {
+    plan.vertical.clear();
+    for (int k : net.lines[junction.line].points) {
+      const extraction::RidgePoint& q = net.rows.points[k];
+      const double t = q.y - y0;
+      if (std::abs(t) <= fit && std::abs(t) > params.junction_clearance)
+        plan.vertical.emplace_back(t, q.x);
+    }
+    if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) return plan;
+  }
+  plan.ok = true;
+  const auto& seg = net.segments[junction.segment].points;
+  const auto& cp = net.columns.points;  // x: image row, y: image column
+  const int n = static_cast<int>(seg.size());
+  // The segment's k-th column ridge point counted from the line.
+  auto outward = [&](int k) -> const extraction::RidgePoint& {
+    return cp[seg[junction.segment_left ? n - 1 - k : k]];
+  };
+  for (int k = 0;
+       k < n - 2 && static_cast<int>(plan.columns.size()) < params.track_chain.segment_columns;
+       ++k) {
+    const extraction::RidgePoint& q = outward(k);
+    if (!plan.columns.empty() && k >= 3) {
+      const extraction::RidgePoint& back = outward(k - 3);
+      if (std::abs(q.x - back.x) > std::abs(q.y - back.y)) break;
+    }
+    if (std::abs(q.y - plan.a) <= params.junction_clearance) continue;
+    plan.columns.emplace_back(q.y, static_cast<int>(std::lround(q.x)));
+  }
+  return plan;
+}
+
+// Whether the plan's line runs straight on through its junction: measured
+// on both sides, with slopes that differ by at most fold_slope_change
+// (else it folds there, or turns too steep for its track beyond, and
+// PlaceJunction meets the segment with the track itself).
+bool StraightThrough(const JunctionPlan& plan, const DecodeParams& params) {
+  if (!plan.ok) return false;
+  std::vector<std::pair<double, double>> above, below;
+  for (const auto& v : plan.vertical) (v.first < 0 ? above : below).push_back(v);
+  double a0, b0, a1, b1;
+  return FitLine(above, &a0, &b0) && FitLine(below, &a1, &b1) &&
+         std::abs(b0 - b1) <= params.fold_slope_change;
+}
+
 // Where junction j lies: the segment's centres near the line fitted as a
 // straight line y(x) and met with the line's centres fitted as x(y).
 cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwork& net, int j,
-                          const TrackCentres& line, const DecodeParams& params) {
+                          const TrackCentres& line, const JunctionPlan& plan,
+                          const ColumnCentres& measured, const DecodeParams& params) {
   const interpretation::TrackJunction& junction = net.junctions[j];
   cv::Point2d at = junction.position;
   const int fit_rows = params.junction_fit_rows;
@@ -192,8 +269,13 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
     for (size_t i = 0; i < seg.size() && static_cast<int>(columns.size()) < want; ++i) take(seg[i]);
   }
   double a, b;  // the segment: y = a + b (x - x_ref)
-  if (!FitLine(columns, &a, &b)) return at;
   const double x_ref = at.x;
+  if (double c, e; plan.ok && FitMeasuredSegment(plan, measured, params, &c, &e)) {
+    a = c + e * (x_ref - plan.a);
+    b = e;
+  } else if (!FitLine(columns, &a, &b)) {
+    return at;
+  }
   // Where the line folds at the junction (its slope above and below differs
   // by more than fold_slope_change: the side of the nose, the lips) no one
   // curve fits both branches, and where it has centres on one side only (it
@@ -429,6 +511,50 @@ std::vector<DecodedLine> DecodedLines(const std::vector<int>& labelled,
   return lines;
 }
 
+// The labelled junctions of the network, one per label (JunctionPerLabel),
+// placed (thesis 5.2) in the full frame: planned, their segments' columns
+// measured once each, and placed, each step in parallel.
+std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
+                                                 const interpretation::TrackNetwork& net,
+                                                 const interpretation::TrackLabels& labels,
+                                                 const std::vector<TrackCentres>& centres,
+                                                 const DecodeParams& params,
+                                                 const WorkingScale& scale, int* conflicts) {
+  const std::vector<int> placed = JunctionPerLabel(net, labels, conflicts);
+  const cv::Range all(0, static_cast<int>(placed.size()));
+  std::vector<JunctionPlan> plans(placed.size());
+  cv::parallel_for_(all, [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i)
+      plans[i] = PlanTrackJunction(net, placed[i], centres[net.junctions[placed[i]].line], params);
+  });
+  ColumnCentres columns = ColumnCentres::Wanted(plans);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const auto [x, y] = columns.keys[i];
+      columns.centres[i] = extraction::RidgeCentreInColumn(working, x, y);
+    }
+  });
+  const int q_offset = params.q_offset.value_or(0);
+  std::vector<DecodedJunction> junctions(placed.size());
+  cv::parallel_for_(all, [&](const cv::Range& r) {
+    for (int i = r.start; i < r.end; ++i) {
+      const int j = placed[i];
+      DecodedJunction& d = junctions[i];
+      d.p = labels.p[j];
+      d.q = labels.v[j] + q_offset;
+      d.kind = net.junctions[j].kind;
+      std::optional<cv::Point2d> at;
+      if (StraightThrough(plans[i], params))
+        at = RefineJunction(plans[i], columns, net.junctions[j].position.y, params, 1);
+      if (!at)
+        at = PlaceJunction(working, net, j, centres[net.junctions[j].line], plans[i], columns,
+                           params);
+      d.position = scale.ToFull(*at);
+    }
+  });
+  return junctions;
+}
+
 }  // namespace
 
 void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
@@ -465,21 +591,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     }
   });
 
-  // Junctions, placed in parallel.
-  const int q_offset = params.q_offset.value_or(0);
-  const std::vector<int> placed = JunctionPerLabel(net, labels, &result->label_conflicts);
-  result->junctions.resize(placed.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(placed.size())), [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i) {
-      const int j = placed[i];
-      DecodedJunction& d = result->junctions[i];
-      d.p = labels.p[j];
-      d.q = labels.v[j] + q_offset;
-      d.kind = net.junctions[j].kind;
-      d.position =
-          scale.ToFull(PlaceJunction(working, net, j, centres[net.junctions[j].line], params));
-    }
-  });
+  result->junctions =
+      PlaceTrackJunctions(working, net, labels, centres, params, scale, &result->label_conflicts);
   result->unlabelled = UnlabelledJunctions(net, labels, scale);
   result->lines = DecodedLines(labelled, labels, centres, working.rows, scale);
   result->times.subpixel_ms = MsSince(t);

@@ -76,10 +76,10 @@ struct SideCalibrationParams {
   TargetDetectParams target;       // step 1, per camera view
   CameraCalibrationParams camera;  // step 1
   // Step 2. Its spec is replaced by the manifest's pattern and its q_offset
-  // must be unset: the offsets come from the cross views. The skeleton
-  // chain: its junctions lie closer to the truth (docs/decoding.md, "Which
-  // chain"), and the projector's model is fitted to them.
-  decoder::DecodeParams decode = decoder::SkeletonChainParams();
+  // must be unset: the offsets come from the cross views. The decoder's
+  // default chain, as for labels and surfaces (docs/decoding.md, "Which
+  // chain").
+  decoder::DecodeParams decode;
   StripeFitParams stripes;       // step 3, both plane models
   CrossParams cross;             // step 4
   ProjectorMatrixParams matrix;  // step 5
