@@ -110,12 +110,13 @@ void ExpectMemoryBackAfterFloods(const std::string& service, ChildProcess& proce
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(answers()) << service;
   std::this_thread::sleep_for(seconds(11));
   const auto connect = [&socket] { return ConnectUnixAs(0, socket); };
-  for (const auto& [name, batch] : Floods(path)) {
+  for (const auto& flood : Floods(path)) {
+    const auto& [name, batch] = flood;
     SCOPED_TRACE(service + ", " + name);
     const long before = processing::test::ResidentKib(pid);
     h2::FloodCounts counts;
     const long peak = PeakRssWhile(
-        pid, [&] { counts = h2::Flood(connect, batch, kFloodConnections, kFloodTime); });
+        pid, [&] { counts = h2::Flood(connect, flood.second, kFloodConnections, kFloodTime); });
     const long after = SettledRss(pid, before);
     std::printf(
         "%s, %s: %ld connections, %ld frames sent, %ld ping acks, %ld GOAWAYs, %ld KiB read; "
