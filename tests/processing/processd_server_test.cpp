@@ -45,6 +45,18 @@ class ProcessdServer : public ::testing::Test {
     return v1::Processing::NewStub(channel)->GetServerInfo(&context, {}, info);
   }
 
+  // A configuration serving mutual TLS alone, on 127.0.0.1 at a free port,
+  // with `server` as its certificate and `pki`'s CA for its clients.
+  static Config TlsOnLoopback(const testing::PemFiles& server, const testing::TestPki& pki) {
+    Config config;
+    config.listen.unix_socket = "";
+    config.listen.tcp = "127.0.0.1:0";
+    config.listen.tls_certificate = server.certificate;
+    config.listen.tls_key = server.key;
+    config.listen.tls_client_ca = pki.ca();
+    return config;
+  }
+
   // Info asked every 100 ms until it answers OK or 20 tries have failed;
   // the last status.
   static grpc::Status InfoWithin2Seconds(const std::shared_ptr<grpc::Channel>& channel) {
@@ -256,12 +268,7 @@ TEST_F(ProcessdServer, ATcpPeerThatNeverShakesHandsIsClosedAfterTheHandshakeTime
   const testing::PemFiles server_files = pki.Issue("localhost", true);
   const testing::PemFiles analyst = pki.Issue("analyst");
   ASSERT_TRUE(pki.ok());
-  Config config;
-  config.listen.unix_socket = "";
-  config.listen.tcp = "127.0.0.1:0";
-  config.listen.tls_certificate = server_files.certificate;
-  config.listen.tls_key = server_files.key;
-  config.listen.tls_client_ca = pki.ca();
+  Config config = TlsOnLoopback(server_files, pki);
   config.listen.connections.max_tcp_connections_per_peer = 1;
   config.listen.http2.handshake_timeout_ms = 1000;
   auto server = Server::Start(config, "test");
@@ -336,12 +343,7 @@ TEST_F(ProcessdServer, TcpServesOnlyMutualTlsClientsOfItsCa) {
   testing::TestPki rogue(dir_ / "pki", "rogue");
   const testing::PemFiles forged = rogue.Issue("analyst");
   ASSERT_TRUE(pki.ok() && rogue.ok());
-  Config config;
-  config.listen.unix_socket = "";
-  config.listen.tcp = "127.0.0.1:0";
-  config.listen.tls_certificate = server_files.certificate;
-  config.listen.tls_key = server_files.key;
-  config.listen.tls_client_ca = pki.ca();
+  Config config = TlsOnLoopback(server_files, pki);
   auto server = Server::Start(config, "test");
   const std::string target = "127.0.0.1:" + std::to_string(server->tcp_port());
 
