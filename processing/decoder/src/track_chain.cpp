@@ -249,31 +249,35 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
     return FitAtZero(near);
   };
   if (auto x = line_x(at.y)) at.x = *x;
-  // The segment's columns nearest the line, clear of its light.
-  const auto& seg = net.segments[junction.segment].points;
-  const auto& cp = net.columns.points;  // x: image row, y: image column
-  Samples columns;
-  const int clearance = params.junction_clearance;
-  auto take = [&](int k) {
-    const extraction::RidgePoint& p = cp[k];
-    if (std::abs(p.y - at.x) <= clearance) return;
-    if (auto y = extraction::RidgeCentreInColumn(grey, p.y, p.x))
-      columns.emplace_back(p.y - at.x, *y);
+  // The segment: the plan's measured columns, or where they give no fit,
+  // its columns nearest the line, clear of its light.
+  auto fit_nearest_columns = [&](double* a, double* b) {
+    const auto& seg = net.segments[junction.segment].points;
+    const auto& cp = net.columns.points;  // x: image row, y: image column
+    Samples columns;
+    auto take = [&](int k) {
+      const extraction::RidgePoint& p = cp[k];
+      if (std::abs(p.y - at.x) <= params.junction_clearance) return;
+      if (auto y = extraction::RidgeCentreInColumn(grey, p.y, p.x))
+        columns.emplace_back(p.y - at.x, *y);
+    };
+    const int want = params.track_chain.segment_columns;
+    if (junction.segment_left) {
+      for (int i = static_cast<int>(seg.size()) - 1;
+           i >= 0 && static_cast<int>(columns.size()) < want; --i)
+        take(seg[i]);
+    } else {
+      for (size_t i = 0; i < seg.size() && static_cast<int>(columns.size()) < want; ++i)
+        take(seg[i]);
+    }
+    return FitLine(columns, a, b);
   };
-  const int want = params.track_chain.segment_columns;
-  if (junction.segment_left) {
-    for (int i = static_cast<int>(seg.size()) - 1;
-         i >= 0 && static_cast<int>(columns.size()) < want; --i)
-      take(seg[i]);
-  } else {
-    for (size_t i = 0; i < seg.size() && static_cast<int>(columns.size()) < want; ++i) take(seg[i]);
-  }
   double a, b;  // the segment: y = a + b (x - x_ref)
   const double x_ref = at.x;
   if (double c, e; plan.ok && FitMeasuredSegment(plan, measured, params, &c, &e)) {
     a = c + e * (x_ref - plan.a);
     b = e;
-  } else if (!FitLine(columns, &a, &b)) {
+  } else if (!fit_nearest_columns(&a, &b)) {
     return at;
   }
   // Where the line folds at the junction (its slope above and below differs
