@@ -626,23 +626,32 @@ TEST_F(Bslsd, AMalformedRequestIsInvalidArgumentWithAMessage) {
 TEST_F(Bslsd, AUsersConnectionsBeyondItsShareAreClosedAtOnce) {
   Start("connections", kSimulatedSlides,
         {"--set", "listen.max_connections_per_user=3", "--set", "listen.max_connections=100"});
-  // The start-up probe's connection goes first.
-  std::this_thread::sleep_for(milliseconds(500));
-  std::vector<int> open;
-  int closed = 0;
-  for (int i = 0; i < 5; ++i) {
-    const int fd = ConnectUnixAs(0, daemon_->socket().string());
-    ASSERT_GE(fd, 0);
-    if (ClosedWithin(fd, 1000)) {
-      ++closed;
-      ::close(fd);
-    } else {
-      open.push_back(fd);
+  // The start-up probe's connection closes in its own time (gRPC lets a
+  // channel's connection go asynchronously), so a round may find it still
+  // counted: rounds repeat until one sees the whole share free. No round
+  // may ever hold more than the share.
+  std::size_t most_open = 0;
+  bool whole_share_seen = false;
+  for (int round = 0; round < 10 && !whole_share_seen; ++round) {
+    std::this_thread::sleep_for(milliseconds(500));
+    std::vector<int> open;
+    int closed = 0;
+    for (int i = 0; i < 5; ++i) {
+      const int fd = ConnectUnixAs(0, daemon_->socket().string());
+      ASSERT_GE(fd, 0);
+      if (ClosedWithin(fd, 1000)) {
+        ++closed;
+        ::close(fd);
+      } else {
+        open.push_back(fd);
+      }
     }
+    most_open = std::max(most_open, open.size());
+    whole_share_seen = open.size() == 3u && closed == 2;
+    for (int fd : open) ::close(fd);
   }
-  EXPECT_EQ(open.size(), 3u) << daemon_->Log();
-  EXPECT_EQ(closed, 2);
-  for (int fd : open) ::close(fd);
+  EXPECT_LE(most_open, 3u) << daemon_->Log();
+  EXPECT_TRUE(whole_share_seen) << daemon_->Log();
   grpc::Status answered;
   v1::DeviceStatus status;
   for (int attempt = 0; attempt < 50; ++attempt) {
