@@ -95,6 +95,7 @@ void ParseListen(const YAML::Node& node, ListenConfig& out) {
       "max_send_message_bytes"};
   for (const auto& key : rpc::ConnectionLimitKeys()) keys.insert(key.name);
   for (const auto& key : rpc::Http2LimitKeys()) keys.insert(key.name);
+  for (const auto& key : rpc::Http2GuardLimitKeys()) keys.insert(key.name);
   OnlyKeys(node, "listen", keys);
   if (!node) return;
   Read(node, "listen", "unix_socket", out.unix_socket);
@@ -114,6 +115,7 @@ void ParseListen(const YAML::Node& node, ListenConfig& out) {
   }
   ReadKeysInRange(node, "listen", rpc::ConnectionLimitKeys(), out.connections);
   ReadKeysInRange(node, "listen", rpc::Http2LimitKeys(), out.http2);
+  ReadKeysInRange(node, "listen", rpc::Http2GuardLimitKeys(), out.guard);
   Read(node, "listen", "tcp", out.tcp);
   Read(node, "listen", "tls_certificate", out.tls_certificate);
   Read(node, "listen", "tls_key", out.tls_key);
@@ -296,6 +298,8 @@ Status Validate(const Config& config) {
   if (config.listen.connections.max_tcp_connections_per_peer >
       config.listen.connections.max_tcp_connections)
     return fail("listen.max_tcp_connections_per_peer is above listen.max_tcp_connections");
+  if (const std::string why = rpc::Http2GuardLimitsError(config.listen.guard); !why.empty())
+    return fail(why);
   if (config.listen.unix_socket.empty() && config.listen.tcp.empty())
     return fail("listen.unix_socket and listen.tcp are both empty: nobody could connect");
   if (!config.listen.tcp.empty() &&
@@ -404,6 +408,7 @@ std::string Dump(const Config& config) {
   out << YAML::Key << "socket_mode" << YAML::Value << YAML::DoubleQuoted << mode;
   DumpKeys(out, rpc::ConnectionLimitKeys(), config.listen.connections);
   DumpKeys(out, rpc::Http2LimitKeys(), config.listen.http2);
+  DumpKeys(out, rpc::Http2GuardLimitKeys(), config.listen.guard);
   out << YAML::Key << "tcp" << YAML::Value << config.listen.tcp;
   out << YAML::Key << "tls_certificate" << YAML::Value << config.listen.tls_certificate;
   out << YAML::Key << "tls_key" << YAML::Value << config.listen.tls_key;

@@ -49,6 +49,9 @@ struct ListenConfig {
   int socket_mode = 0660;
   rpc::ConnectionLimits connections;  // of the Unix socket and of TCP
   rpc::Http2Limits http2;             // keep-alive, pings, idle connections, streams
+  // The Unix socket's frame budgets (rpc::Http2Guard: new streams, resets,
+  // pings, settings per second), per connection and in all.
+  rpc::Http2GuardLimits guard;
   std::string tcp;                    // "host:port" with mutual TLS; "" : no TCP (the default)
   std::string tls_certificate;        // PEM files, required with tcp
   std::string tls_key;

@@ -160,6 +160,7 @@ Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& co
   options.path = config.listen.unix_socket;
   options.mode = static_cast<mode_t>(config.listen.socket_mode);
   options.connections = config.listen.connections;
+  options.http2_guard = config.listen.guard;
   const std::string& group = config.listen.socket_group;
   if (!group.empty()) {
     if (group.find_first_not_of("0123456789") == std::string::npos && group.size() <= 9) {

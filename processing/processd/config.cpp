@@ -24,6 +24,7 @@ Config Parse(const YAML::Node& root) {
       "tls_key",     "tls_client_ca", "max_receive_message_bytes", "max_send_message_bytes"};
   for (const auto& key : rpc::ConnectionLimitKeys()) listen_keys.insert(key.name);
   for (const auto& key : rpc::Http2LimitKeys()) listen_keys.insert(key.name);
+  for (const auto& key : rpc::Http2GuardLimitKeys()) listen_keys.insert(key.name);
   OnlyKeys(listen, "listen", listen_keys);
   if (listen) {
     ListenConfig& l = c.listen;
@@ -39,6 +40,7 @@ Config Parse(const YAML::Node& root) {
                    1 << 30);
     ReadKeysInRange(listen, "listen", rpc::ConnectionLimitKeys(), l.connections);
     ReadKeysInRange(listen, "listen", rpc::Http2LimitKeys(), l.http2);
+    ReadKeysInRange(listen, "listen", rpc::Http2GuardLimitKeys(), l.guard);
   }
   ReadKeyInRange(root, "", "workers", c.workers, 0, 256);
   ReadKeyInRange(root, "", "queue", c.queue, -1, 4096);
@@ -94,6 +96,8 @@ void Validate(const Config& c) {
   if (l.connections.max_tcp_connections_per_peer > l.connections.max_tcp_connections)
     throw ConfigError(
         "configuration: listen.max_tcp_connections_per_peer is above listen.max_tcp_connections");
+  if (const std::string why = rpc::Http2GuardLimitsError(l.guard); !why.empty())
+    throw ConfigError("configuration: " + why);
   static const std::set<std::string> levels = {"trace", "debug", "info", "warn", "error", "off"};
   if (!levels.count(c.log_level))
     throw ConfigError("configuration: log_level '" + c.log_level +
@@ -123,6 +127,7 @@ std::string Dump(const Config& c) {
   out << YAML::Key << "max_send_message_bytes" << YAML::Value << c.listen.max_send_message_bytes;
   DumpKeys(out, rpc::ConnectionLimitKeys(), c.listen.connections);
   DumpKeys(out, rpc::Http2LimitKeys(), c.listen.http2);
+  DumpKeys(out, rpc::Http2GuardLimitKeys(), c.listen.guard);
   out << YAML::EndMap;
   out << YAML::Key << "workers" << YAML::Value << Workers(c);
   out << YAML::Key << "queue" << YAML::Value << Queue(c);

@@ -33,6 +33,8 @@ struct ListenConfig {
   int max_send_message_bytes = 5 << 20;      // artifacts travel in 1 MiB chunks
   rpc::ConnectionLimits connections;         // of the Unix socket and of TCP
   rpc::Http2Limits http2;  // keep-alive, pings, idle connections, streams (same keys)
+  // The Unix socket's frame budgets (rpc::Http2Guard), per connection and in all.
+  rpc::Http2GuardLimits guard;
 };
 
 struct Config {

@@ -44,7 +44,7 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     socket.path = config.listen.unix_socket;
     socket.mode = 0660;
     socket.connections = config.listen.connections;
-    socket.http2_guard = rpc::Http2GuardLimits{};  // new streams, resets, pings at a bounded rate
+    socket.http2_guard = config.listen.guard;  // new streams, resets, pings at a bounded rate
     rpc::UnixAcceptorError error;
     s->acceptor_ = rpc::UnixAcceptor::Create(socket, &error);
     if (!s->acceptor_) throw std::runtime_error("listen.unix_socket: " + error.message);

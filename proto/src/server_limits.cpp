@@ -27,6 +27,23 @@ const std::vector<LimitKey<Http2Limits>>& Http2LimitKeys() {
   return keys;
 }
 
+const std::vector<LimitKey<Http2GuardLimits>>& Http2GuardLimitKeys() {
+  static const std::vector<LimitKey<Http2GuardLimits>> keys = {
+      {"guard_frames_per_second", &Http2GuardLimits::frames_per_second, 1, 1000000},
+      {"guard_burst", &Http2GuardLimits::burst, 1, 1000000},
+      {"guard_total_frames_per_second", &Http2GuardLimits::total_frames_per_second, 1, 1000000},
+      {"guard_total_burst", &Http2GuardLimits::total_burst, 1, 1000000}};
+  return keys;
+}
+
+std::string Http2GuardLimitsError(const Http2GuardLimits& guard) {
+  if (guard.frames_per_second > guard.total_frames_per_second)
+    return "listen.guard_frames_per_second is above listen.guard_total_frames_per_second";
+  if (guard.burst > guard.total_burst)
+    return "listen.guard_burst is above listen.guard_total_burst";
+  return {};
+}
+
 void ApplyHttp2Limits(const Http2Limits& limits, grpc::ServerBuilder& builder) {
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, limits.keepalive_time_ms);
   builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, limits.keepalive_timeout_ms);

@@ -733,6 +733,28 @@ TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
   EXPECT_EQ(code, 0) << output;
 }
 
+// The guard's frame budgets are keys of `listen:`: out of range or a
+// connection's budget above the total is refused naming the keys.
+TEST(BslsdConfig, GuardBudgetsAreBoundedKeys) {
+  const fs::path dir = MakeDaemonDir("guard_keys");
+  const fs::path config = WriteDaemonConfig(dir);
+  const std::string check = std::string(BSLSD_PATH) + " --check-config --config " + config.string();
+  {
+    const auto [code, output] = RunCommand(check + " --set listen.guard_frames_per_second=0");
+    EXPECT_EQ(code, 78) << output;
+    EXPECT_NE(output.find("listen.guard_frames_per_second"), std::string::npos) << output;
+  }
+  {
+    const auto [code, output] = RunCommand(check + " --set listen.guard_burst=5000");
+    EXPECT_EQ(code, 78) << output;
+    EXPECT_NE(output.find("listen.guard_burst is above listen.guard_total_burst"),
+              std::string::npos)
+        << output;
+  }
+  const auto [code, output] = RunCommand(check + " --set listen.guard_frames_per_second=50");
+  EXPECT_EQ(code, 0) << output;
+}
+
 // bslsd reads the head of each calibration file (format, version, side):
 // a file of the other side, or of another format, stops the start with the
 // key and the reason, before anything is served.

@@ -149,6 +149,56 @@ TEST(BslsdHttp2Flood, MemoryReturnsWithin20PercentAfterPingAndRapidResetFloods) 
   EXPECT_EQ(daemon.Terminate(seconds(10)), 0) << daemon.Log();
 }
 
+// PING acknowledgements bslsd sends within `window` for 100 PINGs written at
+// once on one connection of its Unix socket, started with `args`. The ping
+// strikes are raised so that they do not close the connection first.
+long PingAcksWithin(const std::string& name, std::vector<std::string> args,
+                    std::chrono::milliseconds window) {
+  const fs::path dir = MakeDaemonDir(name);
+  for (const char* key : {"listen.max_ping_strikes=100", "listen.min_ping_interval_ms=1000"}) {
+    args.push_back("--set");
+    args.push_back(key);
+  }
+  // This test's user may call GetStatus (viewer: the start-up probe), whoever runs it.
+  DaemonProcess daemon(
+      dir,
+      WriteDaemonConfig(dir, "roles:\n  viewer: ['" + std::to_string(::geteuid()) + "']\n"),
+      args, seconds(60));
+  EXPECT_TRUE(daemon.ready()) << daemon.Log();
+  if (!daemon.ready()) return -1;
+  const int fd = ConnectUnixAs(0, daemon.socket().string());
+  EXPECT_GE(fd, 0);
+  std::string pings = h2::Preface();
+  for (int i = 0; i < 100; ++i) pings += h2::Ping(static_cast<std::uint64_t>(i));
+  EXPECT_EQ(::send(fd, pings.data(), pings.size(), MSG_NOSIGNAL), static_cast<ssize_t>(pings.size()));
+  h2::FloodCounts counts;
+  std::string pending;
+  const auto until = std::chrono::steady_clock::now() + window;
+  while (std::chrono::steady_clock::now() < until && h2::ReadAnswers(fd, &pending, &counts))
+    std::this_thread::sleep_for(milliseconds(10));
+  ::close(fd);
+  return counts.ping_acks;
+}
+
+// The guard's budgets are configuration keys that reach bslsd's socket:
+// with 10 frames a second (burst 10) at most about 10 + 2 x 10 of 100 PINGs
+// are answered in 2 s; with the defaults (200 a second, burst 400) all are.
+TEST(BslsdHttp2Guard, TheConfiguredFrameBudgetHoldsOnTheSocket) {
+  const long limited = PingAcksWithin(
+      "guard_limited",
+      {"--set", "listen.guard_frames_per_second=10", "--set", "listen.guard_burst=10", "--set",
+       "listen.guard_total_frames_per_second=10", "--set", "listen.guard_total_burst=10"},
+      milliseconds(2000));
+  const long defaults = PingAcksWithin("guard_defaults", {}, milliseconds(2000));
+  std::printf("ping acks in 2 s: %ld with a budget of 10/s, %ld with the defaults\n", limited,
+              defaults);
+  EXPECT_GE(limited, 1);
+  // The preface's SETTINGS takes one frame of the budget; some slack for
+  // the second's edges.
+  EXPECT_LE(limited, 35);
+  EXPECT_EQ(defaults, 100);
+}
+
 #ifdef BSLS_PROCESSD_PATH
 // bsls-processd has the same front door (rpc::UnixAcceptor, rpc::Http2Guard).
 TEST(ProcessdHttp2Flood, MemoryReturnsWithin20PercentAfterPingAndRapidResetFloods) {

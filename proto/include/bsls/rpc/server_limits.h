@@ -12,7 +12,10 @@
 #ifndef BSLS_RPC_SERVER_LIMITS_H_
 #define BSLS_RPC_SERVER_LIMITS_H_
 
+#include <string>
 #include <vector>
+
+#include "bsls/rpc/http2_guard.h"
 
 namespace grpc {
 class ServerBuilder;
@@ -71,6 +74,14 @@ const std::vector<LimitKey<ConnectionLimits>>& ConnectionLimitKeys();
 
 // The keys of Http2Limits, in the order --check-config prints them.
 const std::vector<LimitKey<Http2Limits>>& Http2LimitKeys();
+
+// The keys of Http2GuardLimits (the plaintext relay's frame budgets), in the
+// order --check-config prints them.
+const std::vector<LimitKey<Http2GuardLimits>>& Http2GuardLimitKeys();
+
+// Why `guard` cannot be used (a connection's budget above the total), or
+// empty when it can; the keys are named as under `listen:`.
+std::string Http2GuardLimitsError(const Http2GuardLimits& guard);
 
 // Sets `limits` on `builder` as gRPC channel arguments (keep-alive, ping
 // strikes, idle connections, concurrent streams, handshake deadline).
