@@ -36,9 +36,13 @@ class MalformedRequestInterceptor final : public grpc::experimental::Interceptor
     if (methods->QueryInterceptionHookPoint(InterceptionHookPoints::POST_RECV_MESSAGE) &&
         methods->GetRecvMessage() == nullptr)
       malformed_ = true;
+    // gRPC answers a request that did not parse with INTERNAL (sync
+    // handlers) or with UNIMPLEMENTED and no message (callback handlers).
     if (malformed_ &&
         methods->QueryInterceptionHookPoint(InterceptionHookPoints::PRE_SEND_STATUS) &&
-        methods->GetSendStatus().error_code() == grpc::StatusCode::INTERNAL) {
+        (methods->GetSendStatus().error_code() == grpc::StatusCode::INTERNAL ||
+         (methods->GetSendStatus().error_code() == grpc::StatusCode::UNIMPLEMENTED &&
+          methods->GetSendStatus().error_message().empty()))) {
       const std::string type = RequestTypeOf(info_->method());
       methods->ModifySendStatus(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
                                              "request: the bytes received are not a " +

@@ -8,6 +8,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <condition_variable>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -111,14 +113,44 @@ TEST_F(CaptureDeviceOverUsb, ASilentDeviceEndsInDeadlineExceededAndTheThreadGoes
   EXPECT_GT(events_.ticks, ticks);
 }
 
+// A preview as a stream uses it: woken by the capture thread after each
+// frame, it takes the newest.
+class PreviewReader {
+ public:
+  explicit PreviewReader(CaptureDevice& device)
+      : preview_(device.OpenPreview([this] {
+          {
+            std::lock_guard lock(mutex_);
+            ++wakes_;
+          }
+          woken_.notify_all();
+        })) {}
+  // The next frame newer than the last one taken, waiting up to `timeout`.
+  std::shared_ptr<const framestore::GreyFrame> Next(milliseconds timeout) {
+    const auto until = Clock::now() + timeout;
+    for (;;) {
+      std::uint64_t dropped = 0;
+      if (auto frame = preview_->Take(&dropped)) return frame;
+      std::unique_lock lock(mutex_);
+      const int seen = wakes_;
+      if (!woken_.wait_until(lock, until, [&] { return wakes_ != seen; })) return nullptr;
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable woken_;
+  int wakes_ = 0;
+  std::unique_ptr<CaptureDevice::Preview> preview_;  // last: its callback uses the members above
+};
+
 TEST_F(CaptureDeviceOverUsb, PreviewsRideOutADamagedFrame) {
-  auto preview = device_->OpenPreview();
-  std::uint64_t dropped = 0;
-  ASSERT_NE(preview->Next(In(milliseconds(5000)), &dropped), nullptr);
+  PreviewReader preview(*device_);
+  ASSERT_NE(preview.Next(milliseconds(5000)), nullptr);
   model_->SetFaults({.corrupt_payload = true});
   // The damaged frame is never published; the next good one is.
   for (int i = 0; i < 3; ++i) {
-    auto frame = preview->Next(In(milliseconds(5000)), &dropped);
+    auto frame = preview.Next(milliseconds(5000));
     ASSERT_NE(frame, nullptr);
     EXPECT_EQ(frame->at(5, 5), 60);
   }

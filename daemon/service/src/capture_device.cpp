@@ -33,7 +33,6 @@ CaptureDevice::~CaptureDevice() {
     stopping_ = true;
   }
   wake_.notify_all();
-  frames_.notify_all();
   thread_.join();
 }
 
@@ -156,38 +155,37 @@ Result<std::vector<GreyFrame>> CaptureDevice::Grab(GrabSides sides, Clock::time_
 CaptureDevice::Preview::~Preview() {
   {
     std::lock_guard lock(device_->mutex_);
-    --device_->previews_;
+    std::erase(device_->previews_, this);
   }
   device_->wake_.notify_all();
 }
 
-std::shared_ptr<const GreyFrame> CaptureDevice::Preview::Next(Clock::time_point deadline,
-                                                              std::uint64_t* dropped) {
-  std::unique_lock lock(device_->mutex_);
-  const bool fresh = device_->frames_.wait_until(lock, deadline, [&] {
-    return device_->stopping_ || (device_->latest_ && device_->published_ > last_);
-  });
-  if (!fresh || device_->stopping_) return nullptr;
+std::shared_ptr<const GreyFrame> CaptureDevice::Preview::Take(std::uint64_t* dropped) {
+  std::lock_guard lock(device_->mutex_);
+  if (device_->stopping_ || !device_->latest_ || device_->published_ <= last_) return nullptr;
   if (dropped) *dropped = last_ == 0 ? 0 : device_->published_ - last_ - 1;
   last_ = device_->published_;
   return device_->latest_;
 }
 
-std::unique_ptr<CaptureDevice::Preview> CaptureDevice::OpenPreview() {
+std::unique_ptr<CaptureDevice::Preview> CaptureDevice::OpenPreview(std::function<void()> on_frame) {
+  std::unique_ptr<Preview> preview(new Preview(this));
+  preview->on_frame_ = std::move(on_frame);
   {
     std::lock_guard lock(mutex_);
-    ++previews_;
+    previews_.push_back(preview.get());
   }
   wake_.notify_all();
-  return std::unique_ptr<Preview>(new Preview(this));
+  return preview;
 }
 
 int CaptureDevice::preview_streams() const {
   std::lock_guard lock(mutex_);
-  return previews_;
+  return static_cast<int>(previews_.size());
 }
 
 void CaptureDevice::Publish(GreyFrame frame) {
+  std::vector<std::function<void()>> notify;
   {
     std::lock_guard lock(mutex_);
     latest_ = std::make_shared<const GreyFrame>(std::move(frame));
@@ -196,8 +194,12 @@ void CaptureDevice::Publish(GreyFrame frame) {
     preview_times_.push_back(now);
     while (!preview_times_.empty() && now - preview_times_.front() > std::chrono::seconds(1))
       preview_times_.pop_front();
+    for (const Preview* preview : previews_)
+      if (preview->on_frame_) notify.push_back(preview->on_frame_);
   }
-  frames_.notify_all();
+  // Copies, called without the lock: a stream may close (and its Preview
+  // go) meanwhile; what its callback holds outlives it.
+  for (const auto& on_frame : notify) on_frame();
 }
 
 void CaptureDevice::NoteResult(const Status& status) {
@@ -230,13 +232,13 @@ void CaptureDevice::Loop() {
     {
       std::unique_lock lock(mutex_);
       wake_.wait_for(lock, kIdleTick,
-                     [&] { return stopping_ || !commands_.empty() || previews_ > 0; });
+                     [&] { return stopping_ || !commands_.empty() || !previews_.empty(); });
       if (stopping_) break;
       if (!commands_.empty()) {
         command = std::move(commands_.front());
         commands_.pop_front();
       } else {
-        preview = previews_ > 0;
+        preview = !previews_.empty();
       }
     }
     if (command) {

@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "bsls/rpc/artifacts.h"
+#include "push_stream.h"
 
 namespace bsls::service {
 
@@ -193,8 +196,8 @@ void CaptureService::FillCapture(const store::CaptureInfo& info, v1::CaptureInfo
     reply->mutable_processing()->set_last_error(record.status().message());
 }
 
-grpc::Status CaptureService::Authorize(grpc::ServerContext* context, std::string_view method,
-                                       Caller* caller) {
+grpc::Status CaptureService::Authorize(const grpc::ServerContextBase* context,
+                                       std::string_view method, Caller* caller) {
   const std::string full = std::string(kMethodPrefix) + std::string(method);
   std::optional<Caller> found = peers_->Find(context->peer());
   if (!found) {
@@ -226,7 +229,7 @@ grpc::Status CaptureService::Authorize(grpc::ServerContext* context, std::string
   return grpc::Status::OK;
 }
 
-Clock::time_point CaptureService::Deadline(const grpc::ServerContext* context) const {
+Clock::time_point CaptureService::Deadline(const grpc::ServerContextBase* context) const {
   const Clock::time_point now = Clock::now();
   if (context->deadline() == std::chrono::system_clock::time_point::max())
     return now + limits_.default_deadline;  // a client that set none
@@ -297,21 +300,19 @@ grpc::Status CaptureService::SetGain(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
-grpc::Status CaptureService::StreamPreview(grpc::ServerContext* context,
-                                           const v1::PreviewRequest* request,
-                                           grpc::ServerWriter<v1::PreviewFrame>* writer) {
+grpc::Status CaptureService::AdmitPreview(grpc::CallbackServerContext* context,
+                                          const v1::PreviewRequest& request) {
   Caller caller;
   if (grpc::Status s = Authorize(context, "StreamPreview", &caller); !s.ok()) return s;
   if (draining_) return Draining();
-  std::optional<Camera> camera;
-  if (request->camera() != v1::CAMERA_UNSPECIFIED) {
-    camera = FromProto(request->camera());
+  if (request.camera() != v1::CAMERA_UNSPECIFIED) {
+    const std::optional<Camera> camera = FromProto(request.camera());
     if (!camera || !device_->Snapshot().capabilities.HasCamera(*camera))
-      return Invalid("preview camera " + std::to_string(request->camera()) +
+      return Invalid("preview camera " + std::to_string(request.camera()) +
                      " is not one of the device's cameras");
   }
-  if (request->decimation() > 250)
-    return Invalid("preview decimation " + std::to_string(request->decimation()) +
+  if (request.decimation() > 250)
+    return Invalid("preview decimation " + std::to_string(request.decimation()) +
                    " is above 250 (10 s between frames)");
   if (++preview_streams_ > limits_.max_preview_streams) {
     --preview_streams_;
@@ -319,31 +320,48 @@ grpc::Status CaptureService::StreamPreview(grpc::ServerContext* context,
                                                       std::to_string(limits_.max_preview_streams) +
                                                       " preview streams; close one first"};
   }
-  struct Release {
-    std::atomic<int>& count;
-    ~Release() { --count; }
-  } release{preview_streams_};
+  return grpc::Status::OK;
+}
 
+grpc::ServerWriteReactor<v1::PreviewFrame>* CaptureService::StreamPreview(
+    grpc::CallbackServerContext* context, const v1::PreviewRequest* request) {
+  using Stream = internal::PushStream<v1::PreviewFrame>;
+  if (grpc::Status s = AdmitPreview(context, *request); !s.ok())
+    return new internal::EndedStream<v1::PreviewFrame>(std::move(s));
+  const std::uint64_t key = ReserveStreamKey();
+  auto [stream, control] = Stream::Start({.context = context,
+                                          .stalled = &stalled_writes_,
+                                          .what = "preview",
+                                          .on_done = [this, key] {
+                                            RemoveStream(key);
+                                            --preview_streams_;
+                                          }});
+  // The stream takes the newest frame whenever its write is done: the
+  // frames published meanwhile are skipped, and the next message says how
+  // many. A preview of another camera than the selected one waits for it.
+  std::optional<Camera> camera;
+  if (request->camera() != v1::CAMERA_UNSPECIFIED) camera = FromProto(request->camera());
   const std::uint32_t every = std::max<std::uint32_t>(1, request->decimation());
-  std::unique_ptr<CaptureDevice::Preview> preview = device_->OpenPreview();
-  std::uint64_t skipped = 0;
-  std::uint32_t counter = 0;
-  while (!context->IsCancelled() && !draining_) {
+  std::shared_ptr<CaptureDevice::Preview> preview =
+      device_->OpenPreview([weak = std::weak_ptr(control)] {
+        if (auto c = weak.lock()) c->Wake();
+      });
+  stream->SetSource([preview, camera, every, skipped = std::uint64_t{0},
+                     counter = std::uint32_t{0}]() mutable -> std::optional<v1::PreviewFrame> {
     std::uint64_t dropped = 0;
-    std::shared_ptr<const framestore::GreyFrame> frame =
-        preview->Next(Clock::now() + std::chrono::milliseconds(250), &dropped);
-    if (!frame) continue;
+    std::shared_ptr<const framestore::GreyFrame> frame = preview->Take(&dropped);
+    if (!frame) return std::nullopt;
     skipped += dropped;
-    // A preview of another camera than the selected one waits for it.
-    if ((camera && frame->camera != *camera) || (counter++ % every) != 0) continue;
+    if ((camera && frame->camera != *camera) || (counter++ % every) != 0) return std::nullopt;
     v1::PreviewFrame message;
     FillFrame(*frame, true, "", message.mutable_frame());
     message.set_dropped(skipped);
     skipped = 0;
-    StalledWrites::Watch watch(stalled_writes_, context, "preview");
-    if (!writer->Write(message)) break;  // the client went away or stopped reading
-  }
-  return draining_ ? Draining() : grpc::Status::OK;
+    return message;
+  });
+  AddStream(key, control);
+  control->Wake();
+  return stream;
 }
 
 grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRequest* request,
@@ -496,7 +514,7 @@ grpc::Status CaptureService::GetCaptureResult(grpc::ServerContext* context,
     const bool sent = rpc::EmitArtifact(
         name, name.ends_with(".json") ? "application/json" : "application/octet-stream", bytes,
         [this, context, writer](const v1::WorkEvent& event) {
-          StalledWrites::Watch watch(stalled_writes_, context, "result");
+          StalledWrites::Watch watch(stalled_writes_, context->c_call(), context->peer(), "result");
           return writer->Write(event.artifact());
         });
     if (!sent) return grpc::Status(grpc::StatusCode::CANCELLED, "the caller went away");
@@ -596,42 +614,80 @@ grpc::Status CaptureService::SetLamp(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
-grpc::Status CaptureService::WatchEvents(grpc::ServerContext* context,
-                                         const v1::WatchEventsRequest*,
-                                         grpc::ServerWriter<v1::Event>* writer) {
+grpc::ServerWriteReactor<v1::Event>* CaptureService::WatchEvents(
+    grpc::CallbackServerContext* context, const v1::WatchEventsRequest*) {
+  using Stream = internal::PushStream<v1::Event>;
   Caller caller;
-  if (grpc::Status s = Authorize(context, "WatchEvents", &caller); !s.ok()) return s;
-  if (draining_) return Draining();
+  if (grpc::Status s = Authorize(context, "WatchEvents", &caller); !s.ok())
+    return new internal::EndedStream<v1::Event>(std::move(s));
+  if (draining_) return new internal::EndedStream<v1::Event>(Draining());
   if (++event_streams_ > limits_.max_event_streams) {
     --event_streams_;
-    return {grpc::StatusCode::RESOURCE_EXHAUSTED, "bslsd already serves " +
-                                                      std::to_string(limits_.max_event_streams) +
-                                                      " event streams; close one first"};
+    return new internal::EndedStream<v1::Event>(
+        {grpc::StatusCode::RESOURCE_EXHAUSTED, "bslsd already serves " +
+                                                   std::to_string(limits_.max_event_streams) +
+                                                   " event streams; close one first"});
   }
-  struct Release {
-    std::atomic<int>& count;
-    ~Release() { --count; }
-  } release{event_streams_};
-  std::unique_ptr<EventHub::Watcher> watcher = events_->Watch();
-  // The client learns at once that the stream is open.
-  writer->SendInitialMetadata();
-  while (!context->IsCancelled() && !draining_) {
+  const std::uint64_t key = ReserveStreamKey();
+  auto [stream, control] = Stream::Start({.context = context,
+                                          .stalled = &stalled_writes_,
+                                          .what = "events",
+                                          .send_initial_metadata = true,
+                                          .on_done = [this, key] {
+                                            RemoveStream(key);
+                                            --event_streams_;
+                                          }});
+  std::shared_ptr<EventHub::Watcher> watcher = events_->Watch([weak = std::weak_ptr(control)] {
+    if (auto c = weak.lock()) c->Wake();
+  });
+  // A watcher that read too slowly lost its oldest events: it is told how
+  // many before the next one.
+  stream->SetSource([watcher, held = std::optional<v1::Event>()]() mutable
+                    -> std::optional<v1::Event> {
+    if (held) return std::exchange(held, std::nullopt);
     std::uint64_t dropped = 0;
-    std::optional<v1::Event> event =
-        watcher->Next(Clock::now() + std::chrono::milliseconds(250), &dropped);
-    if (!event) continue;
-    if (dropped > 0) {
-      v1::Event lost;
-      *lost.mutable_time() = event->time();
-      lost.mutable_error()->set_message(std::to_string(dropped) +
-                                        " events were dropped: this watcher read too slowly");
-      StalledWrites::Watch watch(stalled_writes_, context, "events");
-      if (!writer->Write(lost)) break;
-    }
-    StalledWrites::Watch watch(stalled_writes_, context, "events");
-    if (!writer->Write(*event)) break;
+    std::optional<v1::Event> event = watcher->Take(&dropped);
+    if (!event || dropped == 0) return event;
+    v1::Event lost;
+    *lost.mutable_time() = event->time();
+    lost.mutable_error()->set_message(std::to_string(dropped) +
+                                      " events were dropped: this watcher read too slowly");
+    held = std::move(event);
+    return lost;
+  });
+  AddStream(key, control);
+  control->Wake();
+  return stream;
+}
+
+void CaptureService::BeginDrain() {
+  draining_ = true;
+  std::vector<std::shared_ptr<internal::PushControl>> open;
+  {
+    std::lock_guard lock(streams_mutex_);
+    for (const auto& [key, control] : streams_) open.push_back(control);
   }
-  return draining_ ? Draining() : grpc::Status::OK;
+  for (const auto& control : open) control->End(Draining());
+}
+
+std::uint64_t CaptureService::ReserveStreamKey() {
+  std::lock_guard lock(streams_mutex_);
+  return next_stream_++;
+}
+
+void CaptureService::AddStream(std::uint64_t key, std::shared_ptr<internal::PushControl> control) {
+  {
+    std::lock_guard lock(streams_mutex_);
+    streams_[key] = control;
+  }
+  // A drain that began before the stream was listed ends it too (without
+  // the lock: ending may remove it at once).
+  if (draining_) control->End(Draining());
+}
+
+void CaptureService::RemoveStream(std::uint64_t key) {
+  std::lock_guard lock(streams_mutex_);
+  streams_.erase(key);
 }
 
 }  // namespace bsls::service

@@ -2,6 +2,8 @@
 
 #include <google/protobuf/util/time_util.h>
 
+#include <vector>
+
 namespace bsls::service {
 
 EventHub::Watcher::~Watcher() {
@@ -9,11 +11,9 @@ EventHub::Watcher::~Watcher() {
   hub_->watchers_.erase(this);
 }
 
-std::optional<v1::Event> EventHub::Watcher::Next(std::chrono::steady_clock::time_point deadline,
-                                                 std::uint64_t* dropped) {
-  std::unique_lock lock(hub_->mutex_);
-  hub_->changed_.wait_until(lock, deadline, [&] { return hub_->closed_ || !queue_.empty(); });
-  if (queue_.empty()) return std::nullopt;
+std::optional<v1::Event> EventHub::Watcher::Take(std::uint64_t* dropped) {
+  std::lock_guard lock(hub_->mutex_);
+  if (hub_->closed_ || queue_.empty()) return std::nullopt;
   v1::Event event = std::move(queue_.front());
   queue_.pop_front();
   if (dropped) *dropped = dropped_;
@@ -21,8 +21,9 @@ std::optional<v1::Event> EventHub::Watcher::Next(std::chrono::steady_clock::time
   return event;
 }
 
-std::unique_ptr<EventHub::Watcher> EventHub::Watch() {
+std::unique_ptr<EventHub::Watcher> EventHub::Watch(std::function<void()> on_event) {
   std::unique_ptr<Watcher> watcher(new Watcher(this));
+  watcher->on_event_ = std::move(on_event);
   std::lock_guard lock(mutex_);
   watchers_.insert(watcher.get());
   return watcher;
@@ -30,6 +31,7 @@ std::unique_ptr<EventHub::Watcher> EventHub::Watch() {
 
 void EventHub::Publish(v1::Event event) {
   *event.mutable_time() = google::protobuf::util::TimeUtil::GetCurrentTime();
+  std::vector<std::function<void()>> notify;
   {
     std::lock_guard lock(mutex_);
     for (Watcher* watcher : watchers_) {
@@ -38,17 +40,17 @@ void EventHub::Publish(v1::Event event) {
         ++watcher->dropped_;
       }
       watcher->queue_.push_back(event);
+      if (watcher->on_event_) notify.push_back(watcher->on_event_);
     }
   }
-  changed_.notify_all();
+  // Copies, called without the lock: a watcher may go meanwhile; what its
+  // callback holds outlives it.
+  for (const auto& on_event : notify) on_event();
 }
 
 void EventHub::Close() {
-  {
-    std::lock_guard lock(mutex_);
-    closed_ = true;
-  }
-  changed_.notify_all();
+  std::lock_guard lock(mutex_);
+  closed_ = true;
 }
 
 std::size_t EventHub::watchers() const {

@@ -1,8 +1,9 @@
 #include "bsls/service/stalled_writes.h"
 
 #include <grpc/grpc.h>
-#include <grpcpp/server_context.h>
 #include <spdlog/spdlog.h>
+
+#include <vector>
 
 namespace bsls::service {
 
@@ -13,25 +14,38 @@ StalledWrites::~StalledWrites() {
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
+    for (auto& [id, entry] : watched_) grpc_call_unref(entry.call);
+    watched_.clear();
   }
   wake_.notify_all();
   thread_.join();
 }
 
-StalledWrites::Watch::Watch(StalledWrites& owner, grpc::ServerContext* context, const char* what)
-    : owner_(owner), context_(context) {
+StalledWrites::Watch::Watch(StalledWrites& owner, grpc_call* call, std::string peer,
+                            const char* what)
+    : owner_(owner) {
+  // The call is referenced while watched: the watch thread may cancel it
+  // after the stream let go of it.
+  grpc_call_ref(call);
   {
     std::lock_guard lock(owner_.mutex_);
-    owner_.watched_[context_] = {std::chrono::steady_clock::now() + owner_.limit_, what};
+    id_ = owner_.next_id_++;
+    owner_.watched_[id_] = {std::chrono::steady_clock::now() + owner_.limit_, call,
+                            std::move(peer), what};
   }
   owner_.wake_.notify_all();
 }
 
 StalledWrites::Watch::~Watch() {
-  // Under the mutex: once this returns, the watch thread no longer touches
-  // the context (the handler may end and gRPC free it).
-  std::lock_guard lock(owner_.mutex_);
-  owner_.watched_.erase(context_);
+  grpc_call* call = nullptr;
+  {
+    std::lock_guard lock(owner_.mutex_);
+    if (auto it = owner_.watched_.find(id_); it != owner_.watched_.end()) {
+      call = it->second.call;
+      owner_.watched_.erase(it);
+    }
+  }
+  if (call != nullptr) grpc_call_unref(call);
 }
 
 std::uint64_t StalledWrites::ended() const {
@@ -40,6 +54,7 @@ std::uint64_t StalledWrites::ended() const {
 }
 
 void StalledWrites::Run() {
+  std::vector<Entry> expired;
   std::unique_lock lock(mutex_);
   while (!stopping_) {
     auto next = std::chrono::steady_clock::time_point::max();
@@ -50,19 +65,30 @@ void StalledWrites::Run() {
         ++it;
         continue;
       }
-      // The sync API cannot abandon a blocked Write with a status of our
-      // choosing (TryCancel gives the client CANCELLED); cancelling the
-      // call in gRPC's core sends RESOURCE_EXHAUSTED with the reason and
-      // makes the Write return false.
-      const std::string reason = std::string("bslsd ended the ") + it->second.what +
-                                 " stream: the reader took no message for " +
-                                 std::to_string(limit_.count()) +
-                                 " ms (limits.stream_write_timeout_ms)";
-      grpc_call_cancel_with_status(it->first->c_call(), GRPC_STATUS_RESOURCE_EXHAUSTED,
-                                   reason.c_str(), nullptr);
-      spdlog::warn("{} (peer {})", reason, it->first->peer());
-      ++ended_;
+      expired.push_back(std::move(it->second));
       it = watched_.erase(it);
+      ++ended_;
+    }
+    if (!expired.empty()) {
+      // Outside the lock: cancelling may run the stream's reactions, which
+      // may watch or end a write of their own.
+      lock.unlock();
+      for (Entry& entry : expired) {
+        // TryCancel would give the client CANCELLED; cancelling the call in
+        // gRPC's core sends RESOURCE_EXHAUSTED with the reason and fails
+        // the write in flight.
+        const std::string reason = std::string("bslsd ended the ") + entry.what +
+                                   " stream: the reader took no message for " +
+                                   std::to_string(limit_.count()) +
+                                   " ms (limits.stream_write_timeout_ms)";
+        grpc_call_cancel_with_status(entry.call, GRPC_STATUS_RESOURCE_EXHAUSTED, reason.c_str(),
+                                     nullptr);
+        grpc_call_unref(entry.call);
+        spdlog::warn("{} (peer {})", reason, entry.peer);
+      }
+      expired.clear();
+      lock.lock();
+      continue;
     }
     if (next == std::chrono::steady_clock::time_point::max())
       wake_.wait(lock);

@@ -2,9 +2,9 @@
 //
 // gRPC C++ parses a request before any handler runs and sends the parser's
 // status as the call's: for protobuf, INTERNAL with
-// InitializationErrorString(), which is empty for proto3. A caller that sent
-// bytes that are not the message was told "internal error" without a word
-// of why. The generated code parses every unary request as a
+// InitializationErrorString(), which is empty for proto3 (a handler on the
+// callback API: UNIMPLEMENTED with no message). A caller that sent bytes
+// that are not the message was told "internal error" without a word of why. The generated code parses every unary request as a
 // protobuf::MessageLite (the same traits as the client's replies), so the
 // parse itself cannot be given another status without rewriting the
 // services on the generic API; a server interceptor can: it sees that no
@@ -28,7 +28,8 @@ namespace bsls::rpc {
 
 // Makes `builder`'s server answer a request that does not parse as its
 // method's request type with INVALID_ARGUMENT "request: the bytes received
-// are not a <type> message" instead of INTERNAL with an empty message.
+// are not a <type> message" instead of INTERNAL (or UNIMPLEMENTED) with an
+// empty message.
 // Replaces any interceptors set on `builder` before.
 void ReportMalformedRequests(grpc::ServerBuilder& builder);
 

@@ -79,20 +79,22 @@ class CaptureDevice {
   class Preview {
    public:
     ~Preview();
-    // Waits for a frame newer than the last one returned (until `deadline`);
-    // nullptr on timeout or when the device stopped. `dropped` counts the
-    // frames published in between that this stream never saw.
-    std::shared_ptr<const framestore::GreyFrame> Next(Clock::time_point deadline,
-                                                      std::uint64_t* dropped);
+    // The newest frame if it is newer than the last one taken, else nullptr
+    // (also once the device stopped); never waits. `dropped` counts the
+    // frames published in between that this stream never took.
+    std::shared_ptr<const framestore::GreyFrame> Take(std::uint64_t* dropped);
 
    private:
     friend class CaptureDevice;
     explicit Preview(CaptureDevice* device) : device_(device) {}
     CaptureDevice* device_;
-    std::uint64_t last_ = 0;  // publication number of the last frame returned
+    std::uint64_t last_ = 0;  // publication number of the last frame taken
+    std::function<void()> on_frame_;
   };
-  // Opens a preview stream; the capture thread grabs while any is open.
-  std::unique_ptr<Preview> OpenPreview();
+  // Opens a preview stream; the capture thread grabs while any is open and
+  // calls `on_frame` after publishing each frame (on the capture thread,
+  // without the device's lock: it may Take, it must not block).
+  std::unique_ptr<Preview> OpenPreview(std::function<void()> on_frame);
   // Streams open now.
   int preview_streams() const;
 
@@ -113,10 +115,9 @@ class CaptureDevice {
 
   mutable std::mutex mutex_;
   std::condition_variable wake_;    // the capture thread: commands, previews, stop
-  std::condition_variable frames_;  // preview streams: a new frame
   std::deque<Command> commands_;
   bool stopping_ = false;
-  int previews_ = 0;
+  std::vector<Preview*> previews_;
   std::shared_ptr<const framestore::GreyFrame> latest_;
   std::uint64_t published_ = 0;
   DeviceSnapshot snapshot_;

@@ -5,6 +5,9 @@
 // events. Errors of the layers below map one to one onto gRPC status codes;
 // every message names the field or the thing and the reason.
 //
+// The preview and event streams run on gRPC's callback API: an open stream
+// holds no thread, only its newest message and one write in flight.
+//
 // Thread-safety: gRPC calls the handlers from its thread pool; every member
 // is safe to call concurrently.
 #ifndef BSLS_SERVICE_CAPTURE_SERVICE_H_
@@ -13,6 +16,9 @@
 #include <atomic>
 #include <chrono>
 #include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <string>
 
 #include "bsls/common/status.h"
@@ -47,7 +53,13 @@ grpc::StatusCode ToGrpcCode(ErrorCode code);
 // A grpc::Status carrying `status`'s code and message.
 grpc::Status ToGrpc(const Status& status);
 
-class CaptureService final : public v1::CaptureDaemon::Service {
+namespace internal {
+class PushControl;
+}
+
+class CaptureService final
+    : public v1::CaptureDaemon::WithCallbackMethod_StreamPreview<
+          v1::CaptureDaemon::WithCallbackMethod_WatchEvents<v1::CaptureDaemon::Service>> {
  public:
   // Everything is borrowed and must outlive the service; `slides` may be
   // nullptr (no slide controller configured: slide calls fail UNAVAILABLE),
@@ -59,7 +71,7 @@ class CaptureService final : public v1::CaptureDaemon::Service {
 
   // From now on new calls that change anything fail UNAVAILABLE ("shutting
   // down") and open streams end; calls under way finish.
-  void BeginDrain() { draining_ = true; }
+  void BeginDrain();
   // Grabs acknowledged (stored) since start.
   std::uint64_t grabs_acknowledged() const { return grabs_acknowledged_; }
 
@@ -69,8 +81,8 @@ class CaptureService final : public v1::CaptureDaemon::Service {
                             v1::DeviceStatus* reply) override;
   grpc::Status SetGain(grpc::ServerContext* context, const v1::SetGainRequest* request,
                        v1::DeviceStatus* reply) override;
-  grpc::Status StreamPreview(grpc::ServerContext* context, const v1::PreviewRequest* request,
-                             grpc::ServerWriter<v1::PreviewFrame>* writer) override;
+  grpc::ServerWriteReactor<v1::PreviewFrame>* StreamPreview(
+      grpc::CallbackServerContext* context, const v1::PreviewRequest* request) override;
   grpc::Status Grab(grpc::ServerContext* context, const v1::GrabRequest* request,
                     v1::GrabResponse* reply) override;
   grpc::Status ListCaptures(grpc::ServerContext* context, const v1::ListCapturesRequest* request,
@@ -90,14 +102,23 @@ class CaptureService final : public v1::CaptureDaemon::Service {
                         v1::SlideState* reply) override;
   grpc::Status SetLamp(grpc::ServerContext* context, const v1::SetLampRequest* request,
                        v1::SlideState* reply) override;
-  grpc::Status WatchEvents(grpc::ServerContext* context, const v1::WatchEventsRequest* request,
-                           grpc::ServerWriter<v1::Event>* writer) override;
+  grpc::ServerWriteReactor<v1::Event>* WatchEvents(grpc::CallbackServerContext* context,
+                                                  const v1::WatchEventsRequest* request) override;
 
  private:
   // OK with the caller filled in, or UNAUTHENTICATED / PERMISSION_DENIED.
-  grpc::Status Authorize(grpc::ServerContext* context, std::string_view method, Caller* caller);
+  grpc::Status Authorize(const grpc::ServerContextBase* context, std::string_view method,
+                         Caller* caller);
   // The call's deadline on the steady clock, capped; the default when none.
-  Clock::time_point Deadline(const grpc::ServerContext* context) const;
+  Clock::time_point Deadline(const grpc::ServerContextBase* context) const;
+  // The preview stream's checks: OK, or why it is refused.
+  grpc::Status AdmitPreview(grpc::CallbackServerContext* context, const v1::PreviewRequest& request);
+  // A key for a push stream, taken before it starts.
+  std::uint64_t ReserveStreamKey();
+  // Keeps `control` under `key` until the stream ends (the drain ends it).
+  void AddStream(std::uint64_t key, std::shared_ptr<internal::PushControl> control);
+  // Forgets the stream of `key` (it ended).
+  void RemoveStream(std::uint64_t key);
   void FillStatus(const Caller& caller, v1::DeviceStatus* reply);
   void FillSlideState(v1::SlideState* reply) const;
   // The capture's metadata and its processing status.
@@ -116,6 +137,9 @@ class CaptureService final : public v1::CaptureDaemon::Service {
   std::atomic<int> preview_streams_{0};
   std::atomic<int> event_streams_{0};
   std::atomic<std::uint64_t> grabs_acknowledged_{0};
+  std::mutex streams_mutex_;
+  std::map<std::uint64_t, std::shared_ptr<internal::PushControl>> streams_;  // open push streams
+  std::uint64_t next_stream_ = 0;
   StalledWrites stalled_writes_;  // last: its thread stops first
 };
 

@@ -8,8 +8,8 @@
 #define BSLS_SERVICE_EVENT_HUB_H_
 
 #include <chrono>
-#include <condition_variable>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -28,10 +28,9 @@ class EventHub {
   class Watcher {
    public:
     ~Watcher();
-    // The next event, waiting until `deadline`; nullopt on timeout or when
-    // the hub closed. `dropped` counts events lost to overflow before it.
-    std::optional<v1::Event> Next(std::chrono::steady_clock::time_point deadline,
-                                  std::uint64_t* dropped);
+    // The next queued event, or nullopt when none is queued or the hub
+    // closed; never waits. `dropped` counts events lost to overflow before it.
+    std::optional<v1::Event> Take(std::uint64_t* dropped);
 
    private:
     friend class EventHub;
@@ -39,13 +38,16 @@ class EventHub {
     EventHub* hub_;
     std::deque<v1::Event> queue_;
     std::uint64_t dropped_ = 0;
+    std::function<void()> on_event_;
   };
 
-  // Registers a watcher; it sees events published from now on.
-  std::unique_ptr<Watcher> Watch();
+  // Registers a watcher; it sees events published from now on, and
+  // `on_event` is called after each is queued (on the publisher's thread,
+  // without the hub's lock: it may Take, it must not block).
+  std::unique_ptr<Watcher> Watch(std::function<void()> on_event);
   // Stamps `event` with the current time and queues it for every watcher.
   void Publish(v1::Event event);
-  // Wakes every watcher for good (shutdown).
+  // Ends the hub: watchers take nothing more (shutdown).
   void Close();
   // Watchers registered now.
   std::size_t watchers() const;
@@ -53,7 +55,6 @@ class EventHub {
  private:
   const std::size_t queue_limit_;
   mutable std::mutex mutex_;
-  std::condition_variable changed_;
   std::set<Watcher*> watchers_;
   bool closed_ = false;
 };

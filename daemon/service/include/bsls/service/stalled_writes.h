@@ -1,11 +1,11 @@
-// Server streams whose reader stopped reading: with the sync API
-// a stream message is written by a blocking Write, which a client that never
-// reads (and set no deadline) holds for ever, and with it the stream's slot
-// (one of limits.max_preview_streams) and a handler thread. StalledWrites
-// watches each Write in flight and ends the call of one that has not
-// completed within the limit with RESOURCE_EXHAUSTED ("the reader took no
-// message for N ms"): the Write returns false, the handler returns and its
-// slot is free again.
+// Server streams whose reader stopped reading: a stream message that a
+// client never reads (and that set no deadline) stays in flight for ever,
+// and with it the stream's slot (one of limits.max_preview_streams) and,
+// with the sync API, a handler thread. StalledWrites watches each write in
+// flight and ends the call of one that has not completed within the limit
+// with RESOURCE_EXHAUSTED ("the reader took no message for N ms"): a sync
+// Write returns false, a callback stream's write completes with ok false,
+// and the stream's slot is free again.
 //
 // Thread-safety: every member is safe from any thread. The watch thread
 // starts in the constructor and is joined in the destructor.
@@ -20,9 +20,7 @@
 #include <string>
 #include <thread>
 
-namespace grpc {
-class ServerContext;
-}
+struct grpc_call;
 
 namespace bsls::service {
 
@@ -35,19 +33,21 @@ class StalledWrites {
   StalledWrites(const StalledWrites&) = delete;
   StalledWrites& operator=(const StalledWrites&) = delete;
 
-  // Watches one Write of `context`'s call while it exists: create it just
-  // before the Write, on the handler's stack. `what` names the stream in
-  // the status ("preview", "events").
+  // Watches one write of a call while it exists: create it just before the
+  // write (`call` and `peer` from the call's context: c_call() and peer() of
+  // a grpc::ServerContext or grpc::CallbackServerContext) and destroy it
+  // when the write completes. `what` names the stream in the status
+  // ("preview", "events").
   class Watch {
    public:
-    Watch(StalledWrites& owner, grpc::ServerContext* context, const char* what);
+    Watch(StalledWrites& owner, grpc_call* call, std::string peer, const char* what);
     ~Watch();
     Watch(const Watch&) = delete;
     Watch& operator=(const Watch&) = delete;
 
    private:
     StalledWrites& owner_;
-    grpc::ServerContext* context_;
+    std::uint64_t id_;
   };
 
   // Calls ended so far because a Write stalled.
@@ -56,6 +56,8 @@ class StalledWrites {
  private:
   struct Entry {
     std::chrono::steady_clock::time_point until;
+    grpc_call* call;  // referenced while watched (grpc_call_ref)
+    std::string peer;
     const char* what;
   };
   void Run();
@@ -63,7 +65,8 @@ class StalledWrites {
   const std::chrono::milliseconds limit_;
   mutable std::mutex mutex_;
   std::condition_variable wake_;
-  std::map<grpc::ServerContext*, Entry> watched_;  // Writes in flight
+  std::map<std::uint64_t, Entry> watched_;  // writes in flight, by watch
+  std::uint64_t next_id_ = 0;
   std::uint64_t ended_ = 0;
   bool stopping_ = false;
   std::thread thread_;
