@@ -52,8 +52,8 @@ struct ListenConfig {
   // The Unix socket's frame budgets (rpc::Http2Guard: new streams, resets,
   // pings, settings per second), per connection and in all.
   rpc::Http2GuardLimits guard;
-  std::string tcp;                    // "host:port" with mutual TLS; "" : no TCP (the default)
-  std::string tls_certificate;        // PEM files, required with tcp
+  std::string tcp;              // "host:port" with mutual TLS; "" : no TCP (the default)
+  std::string tls_certificate;  // PEM files, required with tcp
   std::string tls_key;
   std::string tls_client_ca;
   int max_receive_message_bytes = 64 * 1024;      // requests are small

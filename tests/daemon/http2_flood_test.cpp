@@ -161,8 +161,7 @@ long PingAcksWithin(const std::string& name, std::vector<std::string> args,
   }
   // This test's user may call GetStatus (viewer: the start-up probe), whoever runs it.
   DaemonProcess daemon(
-      dir,
-      WriteDaemonConfig(dir, "roles:\n  viewer: ['" + std::to_string(::geteuid()) + "']\n"),
+      dir, WriteDaemonConfig(dir, "roles:\n  viewer: ['" + std::to_string(::geteuid()) + "']\n"),
       args, seconds(60));
   EXPECT_TRUE(daemon.ready()) << daemon.Log();
   if (!daemon.ready()) return -1;
@@ -170,7 +169,8 @@ long PingAcksWithin(const std::string& name, std::vector<std::string> args,
   EXPECT_GE(fd, 0);
   std::string pings = h2::Preface();
   for (int i = 0; i < 100; ++i) pings += h2::Ping(static_cast<std::uint64_t>(i));
-  EXPECT_EQ(::send(fd, pings.data(), pings.size(), MSG_NOSIGNAL), static_cast<ssize_t>(pings.size()));
+  EXPECT_EQ(::send(fd, pings.data(), pings.size(), MSG_NOSIGNAL),
+            static_cast<ssize_t>(pings.size()));
   h2::FloodCounts counts;
   std::string pending;
   const auto until = std::chrono::steady_clock::now() + window;

@@ -173,9 +173,9 @@ int ThreadsOf(pid_t pid) {
 TEST(BslsdPreview, SixtyFourStreamsTwoStalledTheOthersAtFullRateOnFlatThreads) {
   const fs::path dir = MakeDaemonDir("preview_64");
   const fs::path config = WriteDaemonConfig(dir, "roles:\n  admin: [root]\n");
-  DaemonProcess daemon(dir, config,
-                       {"--set", "limits.max_preview_streams=64", "--set",
-                        "limits.stream_write_timeout_ms=60000"});
+  DaemonProcess daemon(
+      dir, config,
+      {"--set", "limits.max_preview_streams=64", "--set", "limits.stream_write_timeout_ms=60000"});
   ASSERT_TRUE(daemon.ready()) << daemon.Log();
   constexpr int kStreams = 64, kStalled = 2, kChannels = 6;
   constexpr std::uint32_t kEvery = 5;
@@ -270,11 +270,12 @@ TEST(BslsdPreview, SixtyFourStreamsTwoStalledTheOthersAtFullRateOnFlatThreads) {
   for (int n : counted) slowest = std::min(slowest, n / kWindowSeconds);
   std::uint64_t most_missed = 0;
   for (std::uint64_t n : missed) most_missed = std::max(most_missed, n);
-  std::printf("[ figures  ] %d streams (%d stalled): camera %.1f frames/s; slowest reader "
-              "%.2f frames/s of %.2f, at most %llu frames missed; bslsd threads %d with 8 "
-              "streams, %d with 64\n",
-              kStreams, kStalled, status.preview_rate_hz(), slowest, full_rate,
-              static_cast<unsigned long long>(most_missed), threads_at_8, threads_at_64);
+  std::printf(
+      "[ figures  ] %d streams (%d stalled): camera %.1f frames/s; slowest reader "
+      "%.2f frames/s of %.2f, at most %llu frames missed; bslsd threads %d with 8 "
+      "streams, %d with 64\n",
+      kStreams, kStalled, status.preview_rate_hz(), slowest, full_rate,
+      static_cast<unsigned long long>(most_missed), threads_at_8, threads_at_64);
   // Every reader took every frame it asked for (the stalled two hold up
   // nobody), at the camera's rate.
   EXPECT_EQ(most_missed, 0u);

@@ -73,15 +73,16 @@ TEST(ProcessdConfig, GuardBudgetsAreBoundedKeys) {
   const Config defaults = LoadConfig(std::nullopt, {});
   EXPECT_EQ(defaults.listen.guard.frames_per_second, 200);
   EXPECT_EQ(defaults.listen.guard.total_burst, 4000);
-  const Config c = LoadConfig(std::nullopt, {"listen.guard_frames_per_second=50",
-                                             "listen.guard_total_burst=500"});
+  const Config c = LoadConfig(
+      std::nullopt, {"listen.guard_frames_per_second=50", "listen.guard_total_burst=500"});
   EXPECT_EQ(c.listen.guard.frames_per_second, 50);
   EXPECT_EQ(c.listen.guard.total_burst, 500);
   EXPECT_NE(Dump(c).find("guard_frames_per_second: 50"), std::string::npos) << Dump(c);
   EXPECT_NE(ErrorOf({"listen.guard_burst=0"}).find("listen.guard_burst"), std::string::npos);
-  EXPECT_NE(ErrorOf({"listen.guard_frames_per_second=3000"})
-                .find("listen.guard_frames_per_second is above listen.guard_total_frames_per_second"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf({"listen.guard_frames_per_second=3000"})
+          .find("listen.guard_frames_per_second is above listen.guard_total_frames_per_second"),
+      std::string::npos);
   EXPECT_NE(ErrorOf({"listen.guard_burst=5000"}).find("listen.guard_total_burst"),
             std::string::npos);
 }

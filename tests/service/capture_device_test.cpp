@@ -15,6 +15,7 @@
 
 #include "bsls/framestore/usb_device_model.h"
 #include "bsls/framestore/usb_framestore.h"
+#include "bsls/slides/emulated_slide_changer.h"
 
 namespace bsls::service {
 namespace {
@@ -111,6 +112,50 @@ TEST_F(CaptureDeviceOverUsb, ASilentDeviceEndsInDeadlineExceededAndTheThreadGoes
   while (events_.ticks <= ticks && Clock::now() < until)
     std::this_thread::sleep_for(milliseconds(10));
   EXPECT_GT(events_.ticks, ticks);
+}
+
+// The slides a grab takes (contracts section 1): with a brick slide in
+// place both sides are grabbed each under its own slide (2, then 3, which
+// stays in) and the capture records slide 0; under the cross both cameras
+// see the cross; one side, or no slide controller, keeps the slide there.
+TEST_F(CaptureDeviceOverUsb, AGrabOfBothSidesPutsEachSidesSlideInPlace) {
+  slides::SlideControllerConfig config;
+  config.pulse = milliseconds(12);
+  config.settle = milliseconds(20);
+  config.change_timeout = milliseconds(1000);
+  config.emulated_travel = milliseconds(30);
+  auto opened =
+      slides::SlideController::Open(std::make_unique<slides::EmulatedSlideChanger>(config), config);
+  ASSERT_TRUE(opened.ok()) << opened.status().ToString();
+  slides::SlideController& slides = **opened;
+
+  ASSERT_TRUE(slides.ChangeTo(2, In(milliseconds(5000))).ok());
+  auto both = device_->GrabWithSlides(GrabSides::kBoth, &slides, In(milliseconds(10000)));
+  ASSERT_TRUE(both.ok()) << both.status().ToString();
+  ASSERT_EQ(both->frames.size(), 2u);
+  EXPECT_EQ(both->frames[0].camera, framestore::Camera::kLeft);
+  EXPECT_EQ(both->frames[0].at(5, 5), 60);
+  EXPECT_EQ(both->frames[1].camera, framestore::Camera::kRight);
+  EXPECT_EQ(both->frames[1].at(5, 5), 100);
+  EXPECT_EQ(both->slide, 0);
+  EXPECT_EQ(slides.State().slide, 3);
+
+  auto one = device_->GrabWithSlides(GrabSides::kLeft, &slides, In(milliseconds(5000)));
+  ASSERT_TRUE(one.ok()) << one.status().ToString();
+  EXPECT_EQ(one->frames.size(), 1u);
+  EXPECT_EQ(one->slide, 3);  // one side keeps the slide in place
+
+  ASSERT_TRUE(slides.ChangeTo(1, In(milliseconds(5000))).ok());
+  auto cross = device_->GrabWithSlides(GrabSides::kBoth, &slides, In(milliseconds(5000)));
+  ASSERT_TRUE(cross.ok()) << cross.status().ToString();
+  EXPECT_EQ(cross->frames.size(), 2u);
+  EXPECT_EQ(cross->slide, 1);
+  EXPECT_EQ(slides.State().slide, 1);
+
+  auto bare = device_->GrabWithSlides(GrabSides::kBoth, nullptr, In(milliseconds(5000)));
+  ASSERT_TRUE(bare.ok()) << bare.status().ToString();
+  EXPECT_EQ(bare->frames.size(), 2u);
+  EXPECT_EQ(bare->slide, 0);
 }
 
 // A preview as a stream uses it: woken by the capture thread after each

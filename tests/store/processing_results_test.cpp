@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "bsls/store/capture_store.h"
 #include "store_test_util.h"
@@ -19,6 +20,16 @@ using testing::OpenStore;
 using testing::RandomRequest;
 using testing::TempDir;
 using testing::TestOptions;
+
+// Provenance of a replica "r" at version "v".
+ProcessingProvenance By(const std::string& replica = "r", const std::string& version = "v") {
+  ProcessingProvenance p;
+  p.call = "ProcessFrame";
+  p.replica = replica;
+  p.processing_software_version = version;
+  p.daemon_software_version = "d";
+  return p;
+}
 
 std::vector<std::string> Ids(const Result<std::vector<CaptureId>>& ids) {
   std::vector<std::string> out;
@@ -53,18 +64,20 @@ TEST(ProcessingResults, EveryCaptureWaitsUntilDoneOrFailed) {
 
   // Done and failed captures no longer wait.
   const std::map<std::string, std::string> files = {{"surface.ply", "ply bytes"},
-                                                    {"record.json", "{}"}};
-  ASSERT_TRUE(store->PutProcessingResult(a->id.str(), files, "r1", "0.1.0").ok());
+                                                    {"report.json", "{}"}};
+  ASSERT_TRUE(store->PutProcessingResult(a->id.str(), files, By("r1", "0.1.0")).ok());
   ASSERT_TRUE(store->PutProcessingFailure(b->id.str(), "no reference line").ok());
   EXPECT_EQ(Ids(store->Unprocessed()), std::vector<std::string>{c->id.str()});
   auto done = store->Processing(a->id.str());
   ASSERT_TRUE(done.ok() && done->has_value());
   EXPECT_EQ((*done)->state, ProcessingState::kDone);
   EXPECT_EQ((*done)->replica, "r1");
-  EXPECT_EQ((*done)->files.size(), 2u);
+  EXPECT_EQ((*done)->files.size(), 3u);  // and the record
   auto read = store->ReadProcessingFiles(a->id.str());
   ASSERT_TRUE(read.ok()) << read.status().ToString();
-  EXPECT_EQ(*read, files);
+  EXPECT_EQ(read->size(), 3u);
+  for (const auto& [name, bytes] : files) EXPECT_EQ(read->at(name), bytes) << name;
+  EXPECT_EQ(read->count(std::string(kRecordFileName)), 1u);
   EXPECT_EQ(store->ReadProcessingFiles(b->id.str()).status().code(), ErrorCode::kNotFound);
   EXPECT_EQ(store->ReadProcessingFiles(a->id.str(), "other.bin").status().code(),
             ErrorCode::kNotFound);
@@ -78,6 +91,43 @@ TEST(ProcessingResults, EveryCaptureWaitsUntilDoneOrFailed) {
   EXPECT_EQ(store->recovery_report().result_files_removed, 0);
 }
 
+// The store seals the results with record.json, written from its own copy
+// of the capture's metadata: the frames by hash, every file by hash, and
+// where the results came from.
+TEST(ProcessingResults, TheRecordSealsTheFilesWithTheCapturesOwnMetadata) {
+  TempDir dir;
+  auto store = OpenStore(TestOptions(dir.path()));
+  ASSERT_TRUE(store);
+  std::mt19937 rng(10);
+  auto a = store->Put(RandomRequest(rng));
+  ASSERT_TRUE(a.ok());
+  ProcessingProvenance p = By("replica-1", "1.2.3");
+  p.call = "ReconstructSession";
+  p.calibrations["left"] = "sha256:abc";
+  p.results.push_back({{"replica", "replica-1"}});
+  ASSERT_TRUE(store->PutProcessingResult(a->id.str(), {{"surface.ply", "ply"}}, p).ok());
+  auto files = store->ReadProcessingFiles(a->id.str());
+  ASSERT_TRUE(files.ok()) << files.status().ToString();
+  const nlohmann::json record = nlohmann::json::parse(files->at(kRecordFileName));
+  EXPECT_EQ(record.at("format"), "bsls-processing-record");
+  EXPECT_EQ(record.at("capture_id"), a->id.str());
+  EXPECT_EQ(record.at("session_id"), a->session_id);
+  EXPECT_EQ(record.at("side"), ToString(a->side));
+  ASSERT_EQ(record.at("frames").size(), a->frames.size());
+  for (std::size_t i = 0; i < a->frames.size(); ++i)
+    EXPECT_EQ(record.at("frames")[i].at("sha256"), a->frames[i].sha256);
+  auto done = store->Processing(a->id.str());
+  ASSERT_TRUE(done.ok() && done->has_value());
+  EXPECT_EQ(record.at("files").at("surface.ply"), (*done)->files.at("surface.ply"));
+  EXPECT_EQ(record.at("files").count(kRecordFileName), 0u);  // it cannot list itself
+  EXPECT_EQ(record.at("call"), "ReconstructSession");
+  EXPECT_EQ(record.at("calibrations").at("left"), "sha256:abc");
+  EXPECT_EQ(record.at("results")[0].at("replica"), "replica-1");
+  EXPECT_EQ(record.at("replica"), "replica-1");
+  EXPECT_EQ(record.at("processing_software_version"), "1.2.3");
+  EXPECT_EQ(record.at("daemon_software_version"), "d");
+}
+
 TEST(ProcessingResults, DamageIsFoundAndBadNamesAreRefused) {
   TempDir dir;
   auto store = OpenStore(TestOptions(dir.path()));
@@ -85,15 +135,14 @@ TEST(ProcessingResults, DamageIsFoundAndBadNamesAreRefused) {
   std::mt19937 rng(8);
   auto a = store->Put(RandomRequest(rng));
   ASSERT_TRUE(a.ok());
-  for (const std::string& bad :
-       std::vector<std::string>{"../escape", ".hidden", "a/b", std::string(65, 'x'), ""})
-    EXPECT_EQ(store->PutProcessingResult(a->id.str(), {{bad, "x"}}, "r", "v").code(),
+  for (const std::string& bad : std::vector<std::string>{"../escape", ".hidden", "a/b",
+                                                         std::string(65, 'x'), "", kRecordFileName})
+    EXPECT_EQ(store->PutProcessingResult(a->id.str(), {{bad, "x"}}, By()).code(),
               ErrorCode::kInvalidArgument)
         << bad;
-  EXPECT_EQ(store->PutProcessingResult("nope", {{"a.txt", "x"}}, "r", "v").code(),
+  EXPECT_EQ(store->PutProcessingResult("nope", {{"a.txt", "x"}}, By()).code(),
             ErrorCode::kInvalidArgument);
-  ASSERT_TRUE(
-      store->PutProcessingResult(a->id.str(), {{"report.json", "{\"a\": 1}"}}, "r", "v").ok());
+  ASSERT_TRUE(store->PutProcessingResult(a->id.str(), {{"report.json", "{\"a\": 1}"}}, By()).ok());
   const std::string path = dir.path() + "/results/" + a->id.str() + "-report.json";
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -116,8 +165,8 @@ TEST(ProcessingResults, LeftoversAreRemovedAndResultsGoWithTheirCapture) {
     ASSERT_TRUE(kept.ok() && deleted.ok());
     kept_id = kept->id.str();
     deleted_id = deleted->id.str();
-    ASSERT_TRUE(store->PutProcessingResult(kept_id, {{"surface.ply", "k"}}, "r", "v").ok());
-    ASSERT_TRUE(store->PutProcessingResult(deleted_id, {{"surface.ply", "d"}}, "r", "v").ok());
+    ASSERT_TRUE(store->PutProcessingResult(kept_id, {{"surface.ply", "k"}}, By()).ok());
+    ASSERT_TRUE(store->PutProcessingResult(deleted_id, {{"surface.ply", "d"}}, By()).ok());
     ASSERT_TRUE(store->Delete(deleted_id).ok());
     EXPECT_FALSE(fs::exists(dir.path() + "/results/" + deleted_id + "-surface.ply"));
   }

@@ -152,6 +152,29 @@ Result<std::vector<GreyFrame>> CaptureDevice::Grab(GrabSides sides, Clock::time_
       deadline);
 }
 
+Result<CaptureDevice::SlideGrab> CaptureDevice::GrabWithSlides(GrabSides sides,
+                                                               slides::SlideController* slides,
+                                                               Clock::time_point deadline) {
+  SlideGrab out;
+  out.slide = slides ? slides->State().slide : 0;
+  if (sides != GrabSides::kBoth || (out.slide != 2 && out.slide != 3)) {
+    Result<std::vector<GreyFrame>> frames = Grab(sides, deadline);
+    if (!frames.ok()) return frames.status();
+    out.frames = std::move(frames).value();
+    return out;
+  }
+  for (const auto& [one, side_slide] : {std::pair{GrabSides::kLeft, 2}, {GrabSides::kRight, 3}}) {
+    if (Status changed = slides->ChangeTo(side_slide, deadline); !changed.ok())
+      return Status(changed.code(), "slide " + std::to_string(side_slide) +
+                                        " for the grab of both sides: " + changed.message());
+    Result<std::vector<GreyFrame>> grabbed = Grab(one, deadline);
+    if (!grabbed.ok()) return grabbed.status();
+    for (GreyFrame& frame : *grabbed) out.frames.push_back(std::move(frame));
+  }
+  out.slide = 0;  // per frame: 2 for the left, 3 for the right
+  return out;
+}
+
 CaptureDevice::Preview::~Preview() {
   {
     std::lock_guard lock(device_->mutex_);

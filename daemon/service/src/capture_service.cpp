@@ -329,13 +329,11 @@ grpc::ServerWriteReactor<v1::PreviewFrame>* CaptureService::StreamPreview(
   if (grpc::Status s = AdmitPreview(context, *request); !s.ok())
     return new internal::EndedStream<v1::PreviewFrame>(std::move(s));
   const std::uint64_t key = ReserveStreamKey();
-  auto [stream, control] = Stream::Start({.context = context,
-                                          .stalled = &stalled_writes_,
-                                          .what = "preview",
-                                          .on_done = [this, key] {
-                                            RemoveStream(key);
-                                            --preview_streams_;
-                                          }});
+  auto [stream, control] = Stream::Start(
+      {.context = context, .stalled = &stalled_writes_, .what = "preview", .on_done = [this, key] {
+         RemoveStream(key);
+         --preview_streams_;
+       }});
   // The stream takes the newest frame whenever its write is done: the
   // frames published meanwhile are skipped, and the next message says how
   // many. A preview of another camera than the selected one waits for it.
@@ -392,43 +390,21 @@ grpc::Status CaptureService::Grab(grpc::ServerContext* context, const v1::GrabRe
   if (grpc::Status s = CheckText(request->patient_reference(), "patient_reference"); !s.ok())
     return s;
 
-  // Contracts section 1: each side has its own brick slide (2 left, 3
-  // right). With a brick slide in place, a grab of both sides puts each
-  // side's slide in place before its frame (the right one stays in); with
-  // the reference cross (slide 1) both cameras see the cross (calibration).
-  Result<std::vector<framestore::GreyFrame>> frames = std::vector<framestore::GreyFrame>{};
-  int slide = slides_ ? slides_->State().slide : 0;
-  if (sides == GrabSides::kBoth && (slide == 2 || slide == 3)) {
-    for (const auto& [one, side_slide] : {std::pair{GrabSides::kLeft, 2}, {GrabSides::kRight, 3}}) {
-      if (Status changed = slides_->ChangeTo(side_slide, Deadline(context)); !changed.ok()) {
-        frames = Status(changed.code(), "slide " + std::to_string(side_slide) +
-                                            " for the grab of both sides: " + changed.message());
-        break;
-      }
-      Result<std::vector<framestore::GreyFrame>> grabbed = device_->Grab(one, Deadline(context));
-      if (!grabbed.ok()) {
-        frames = grabbed.status();
-        break;
-      }
-      for (framestore::GreyFrame& frame : *grabbed) frames->push_back(std::move(frame));
-    }
-    slide = 0;  // per frame: 2 for the left, 3 for the right
-  } else {
-    frames = device_->Grab(sides, Deadline(context));
-  }
-  if (!frames.ok()) {
+  Result<CaptureDevice::SlideGrab> grabbed =
+      device_->GrabWithSlides(sides, slides_, Deadline(context));
+  if (!grabbed.ok()) {
     spdlog::error("grab {} for {} failed: {}", store::ToString(side), caller.Describe(),
-                  frames.status().ToString());
-    return ToGrpc(frames.status());
+                  grabbed.status().ToString());
+    return ToGrpc(grabbed.status());
   }
   store::CaptureRequest capture;
   capture.session_id = request->session_id();
   capture.patient_reference = request->patient_reference();
   capture.side = side;
-  capture.slide = slide;
+  capture.slide = grabbed->slide;
   capture.software_version = software_version_;
   capture.requested_by = {caller.uid, caller.name};
-  capture.frames = std::move(frames).value();
+  capture.frames = std::move(grabbed->frames);
   Result<store::CaptureInfo> stored = store_->Put(capture);
   if (!stored.ok()) {
     spdlog::error("grab {} for {} not stored: {}", store::ToString(side), caller.Describe(),
@@ -642,19 +618,19 @@ grpc::ServerWriteReactor<v1::Event>* CaptureService::WatchEvents(
   });
   // A watcher that read too slowly lost its oldest events: it is told how
   // many before the next one.
-  stream->SetSource([watcher, held = std::optional<v1::Event>()]() mutable
-                    -> std::optional<v1::Event> {
-    if (held) return std::exchange(held, std::nullopt);
-    std::uint64_t dropped = 0;
-    std::optional<v1::Event> event = watcher->Take(&dropped);
-    if (!event || dropped == 0) return event;
-    v1::Event lost;
-    *lost.mutable_time() = event->time();
-    lost.mutable_error()->set_message(std::to_string(dropped) +
-                                      " events were dropped: this watcher read too slowly");
-    held = std::move(event);
-    return lost;
-  });
+  stream->SetSource(
+      [watcher, held = std::optional<v1::Event>()]() mutable -> std::optional<v1::Event> {
+        if (held) return std::exchange(held, std::nullopt);
+        std::uint64_t dropped = 0;
+        std::optional<v1::Event> event = watcher->Take(&dropped);
+        if (!event || dropped == 0) return event;
+        v1::Event lost;
+        *lost.mutable_time() = event->time();
+        lost.mutable_error()->set_message(std::to_string(dropped) +
+                                          " events were dropped: this watcher read too slowly");
+        held = std::move(event);
+        return lost;
+      });
   AddStream(key, control);
   control->Wake();
   return stream;

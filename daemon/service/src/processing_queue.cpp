@@ -51,6 +51,16 @@ const char* SideName(framestore::Camera camera) {
   return camera == framestore::Camera::kLeft ? "left" : "right";
 }
 
+// The cameras of a capture that have a side, each with its frame.
+std::map<framestore::Camera, const framestore::GreyFrame*> SideFrames(
+    const store::Capture& capture) {
+  std::map<framestore::Camera, const framestore::GreyFrame*> frames;
+  for (const framestore::GreyFrame& frame : capture.frames)
+    if (frame.camera == framestore::Camera::kLeft || frame.camera == framestore::Camera::kRight)
+      frames[frame.camera] = &frame;
+  return frames;
+}
+
 }  // namespace
 
 ProcessingQueue::ProcessingQueue(store::CaptureStore* store, EventHub* events,
@@ -162,112 +172,89 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
     }
     return Outcome::kRetry;
   }
-  const store::CaptureInfo& info = capture->info;
-  std::map<framestore::Camera, const framestore::GreyFrame*> frames;
-  for (const framestore::GreyFrame& frame : capture->frames)
-    if (frame.camera == framestore::Camera::kLeft || frame.camera == framestore::Camera::kRight)
-      frames[frame.camera] = &frame;
-  auto calibration_of = [this](framestore::Camera camera) -> const std::string& {
-    return camera == framestore::Camera::kLeft ? options_.left_calibration
-                                               : options_.right_calibration;
-  };
-
-  std::map<std::string, std::string> files;
-  nlohmann::json results = nlohmann::json::array();
-  nlohmann::json calibrations = nlohmann::json::object();
-  std::string call, replica, version;
-  auto keep_calibration = [&](framestore::Camera camera) {
-    const std::string& yaml = calibration_of(camera);
-    if (yaml.empty()) return;
-    calibrations[SideName(camera)] = "sha256:" + Sha256Hex(yaml);  // the service's id
-    files[std::string("calibration-") + SideName(camera) + ".yaml"] = yaml;
-  };
-  auto failed = [&](const grpc::Status& status) {
-    *error = Describe(status);
-    if (!IsPermanent(status)) return Outcome::kRetry;
-    if (auto s = store_->PutProcessingFailure(id, *error); !s.ok()) {
-      *error += "; " + s.message();
-      return Outcome::kRetry;
-    }
-    return Outcome::kFailed;
-  };
-
-  const bool session = frames.size() == 2 && !options_.left_calibration.empty() &&
-                       !options_.right_calibration.empty();
-  if (session) {
-    call = "ReconstructSession";
-    v1::ReconstructSessionRequest request;
-    ToMessage(*frames[framestore::Camera::kLeft], request.mutable_left());
-    ToMessage(*frames[framestore::Camera::kRight], request.mutable_right());
-    *request.mutable_left_calibration() =
-        processing::ProcessingClient::Inline(options_.left_calibration);
-    *request.mutable_right_calibration() =
-        processing::ProcessingClient::Inline(options_.right_calibration);
-    request.set_want_side_surfaces(true);
-    request.set_want_junctions(true);
-    request.set_request_tag(id);
-    const processing::WorkOutcome out = client_->ReconstructSession(request);
-    if (!out.status.ok()) return failed(out.status);
-    files.insert(out.files.begin(), out.files.end());
-    results.push_back(JsonOf(out.result));
-    replica = out.result.replica();
-    version = out.result.software_version();
-    keep_calibration(framestore::Camera::kLeft);
-    keep_calibration(framestore::Camera::kRight);
-  } else {
-    call = "ProcessFrame";
-    for (const auto& [camera, frame] : frames) {
-      v1::ProcessFrameRequest request;
-      ToMessage(*frame, request.mutable_frame());
-      request.set_side(camera == framestore::Camera::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
-      const std::string& yaml = calibration_of(camera);
-      if (!yaml.empty()) {
-        *request.mutable_calibration() = processing::ProcessingClient::Inline(yaml);
-        request.set_want_surface(true);
-      }
-      request.set_want_overlay(true);
-      request.set_request_tag(id);
-      const processing::WorkOutcome out = client_->ProcessFrame(request);
-      if (!out.status.ok()) return failed(out.status);
-      // Both sides without both calibrations: each side's files by its name.
-      const std::string prefix = frames.size() > 1 ? std::string(SideName(camera)) + "." : "";
-      for (const auto& [name, bytes] : out.files) files[prefix + name] = bytes;
-      results.push_back(JsonOf(out.result));
-      replica = out.result.replica();
-      version = out.result.software_version();
-      keep_calibration(camera);
-    }
-  }
-
-  // The sealed record: what went in, what came out, who did it.
-  nlohmann::json frame_list = nlohmann::json::array();
-  for (const store::StoredFrameInfo& f : info.frames)
-    frame_list.push_back({{"camera", framestore::ToString(f.camera)},
-                          {"width", f.width},
-                          {"height", f.height},
-                          {"sha256", f.sha256}});
-  nlohmann::json file_hashes = nlohmann::json::object();
-  for (const auto& [name, bytes] : files) file_hashes[name] = Sha256Hex(bytes);
-  const nlohmann::json record = {{"format", "bsls-processing-record"},
-                                 {"format_version", 1},
-                                 {"capture_id", id},
-                                 {"session_id", info.session_id},
-                                 {"patient_reference", info.patient_reference},
-                                 {"side", store::ToString(info.side)},
-                                 {"frames", frame_list},
-                                 {"calibrations", calibrations},
-                                 {"call", call},
-                                 {"results", results},
-                                 {"files", file_hashes},
-                                 {"processing_software_version", version},
-                                 {"replica", replica},
-                                 {"daemon_software_version", options_.daemon_version}};
-  files["record.json"] = record.dump(2) + "\n";
-  if (auto stored = store_->PutProcessingResult(id, files, replica, version); !stored.ok()) {
+  Processed processed;
+  processed.provenance.daemon_software_version = options_.daemon_version;
+  const bool both = SideFrames(*capture).size() == 2 && !options_.left_calibration.empty() &&
+                    !options_.right_calibration.empty();
+  if (grpc::Status s =
+          both ? ReconstructBoth(*capture, &processed) : ProcessEachSide(*capture, &processed);
+      !s.ok())
+    return Failed(id, s, error);
+  if (auto stored = store_->PutProcessingResult(id, processed.files, processed.provenance);
+      !stored.ok()) {
     *error = stored.message();
     return stored.code() == ErrorCode::kNotFound ? Outcome::kGone : Outcome::kRetry;
   }
   return Outcome::kDone;
+}
+
+grpc::Status ProcessingQueue::ReconstructBoth(const store::Capture& capture, Processed* out) {
+  const auto frames = SideFrames(capture);
+  v1::ReconstructSessionRequest request;
+  ToMessage(*frames.at(framestore::Camera::kLeft), request.mutable_left());
+  ToMessage(*frames.at(framestore::Camera::kRight), request.mutable_right());
+  *request.mutable_left_calibration() =
+      processing::ProcessingClient::Inline(options_.left_calibration);
+  *request.mutable_right_calibration() =
+      processing::ProcessingClient::Inline(options_.right_calibration);
+  request.set_want_side_surfaces(true);
+  request.set_want_junctions(true);
+  request.set_request_tag(capture.info.id.str());
+  const processing::WorkOutcome result = client_->ReconstructSession(request);
+  if (!result.status.ok()) return result.status;
+  out->files.insert(result.files.begin(), result.files.end());
+  out->provenance.call = "ReconstructSession";
+  out->provenance.results.push_back(JsonOf(result.result));
+  out->provenance.replica = result.result.replica();
+  out->provenance.processing_software_version = result.result.software_version();
+  KeepCalibration(framestore::Camera::kLeft, out);
+  KeepCalibration(framestore::Camera::kRight, out);
+  return grpc::Status::OK;
+}
+
+grpc::Status ProcessingQueue::ProcessEachSide(const store::Capture& capture, Processed* out) {
+  const auto frames = SideFrames(capture);
+  out->provenance.call = "ProcessFrame";
+  for (const auto& [camera, frame] : frames) {
+    v1::ProcessFrameRequest request;
+    ToMessage(*frame, request.mutable_frame());
+    request.set_side(camera == framestore::Camera::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
+    const std::string& yaml = CalibrationOf(camera);
+    if (!yaml.empty()) {
+      *request.mutable_calibration() = processing::ProcessingClient::Inline(yaml);
+      request.set_want_surface(true);
+    }
+    request.set_want_overlay(true);
+    request.set_request_tag(capture.info.id.str());
+    const processing::WorkOutcome result = client_->ProcessFrame(request);
+    if (!result.status.ok()) return result.status;
+    // Both sides without both calibrations: each side's files by its name.
+    const std::string prefix = frames.size() > 1 ? std::string(SideName(camera)) + "." : "";
+    for (const auto& [name, bytes] : result.files) out->files[prefix + name] = bytes;
+    out->provenance.results.push_back(JsonOf(result.result));
+    out->provenance.replica = result.result.replica();
+    out->provenance.processing_software_version = result.result.software_version();
+    KeepCalibration(camera, out);
+  }
+  return grpc::Status::OK;
+}
+
+void ProcessingQueue::KeepCalibration(framestore::Camera camera, Processed* out) const {
+  const std::string& yaml = CalibrationOf(camera);
+  if (yaml.empty()) return;
+  out->provenance.calibrations[SideName(camera)] = "sha256:" + Sha256Hex(yaml);  // the service's id
+  out->files[std::string("calibration-") + SideName(camera) + ".yaml"] = yaml;
+}
+
+ProcessingQueue::Outcome ProcessingQueue::Failed(const std::string& id, const grpc::Status& status,
+                                                 std::string* error) {
+  *error = Describe(status);
+  if (!IsPermanent(status)) return Outcome::kRetry;
+  if (auto s = store_->PutProcessingFailure(id, *error); !s.ok()) {
+    *error += "; " + s.message();
+    return Outcome::kRetry;
+  }
+  return Outcome::kFailed;
 }
 
 void ProcessingQueue::Publish(const std::string& id) {

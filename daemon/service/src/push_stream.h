@@ -48,8 +48,8 @@ class PushStream final : public grpc::ServerWriteReactor<Message> {
 
   struct Options {
     grpc::CallbackServerContext* context = nullptr;
-    StalledWrites* stalled = nullptr;  // watches each write
-    const char* what = "";             // the stream's name in a stall's status
+    StalledWrites* stalled = nullptr;    // watches each write
+    const char* what = "";               // the stream's name in a stall's status
     bool send_initial_metadata = false;  // at once: the client learns the stream is open
     std::function<void()> on_done;       // after the call ended, before the reactor goes
   };

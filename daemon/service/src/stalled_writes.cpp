@@ -30,8 +30,8 @@ StalledWrites::Watch::Watch(StalledWrites& owner, grpc_call* call, std::string p
   {
     std::lock_guard lock(owner_.mutex_);
     id_ = owner_.next_id_++;
-    owner_.watched_[id_] = {std::chrono::steady_clock::now() + owner_.limit_, call,
-                            std::move(peer), what};
+    owner_.watched_[id_] = {std::chrono::steady_clock::now() + owner_.limit_, call, std::move(peer),
+                            what};
   }
   owner_.wake_.notify_all();
 }

@@ -489,23 +489,25 @@ bool IsResultFileName(std::string_view name) {
 
 Status CaptureStore::PutProcessingResult(std::string_view text,
                                          const std::map<std::string, std::string>& files,
-                                         const std::string& replica,
-                                         const std::string& software_version) {
+                                         const ProcessingProvenance& provenance) {
   auto id = ParseId(text);
   if (!id.ok()) return id.status();
   const std::string context = "storing the results of capture " + id->str();
   ProcessingRecord record;
   record.state = ProcessingState::kDone;
-  record.replica = replica;
-  record.software_version = software_version;
+  record.replica = provenance.replica;
+  record.software_version = provenance.processing_software_version;
   record.updated = std::chrono::system_clock::now();
   std::uint64_t bytes = 0;
   for (const auto& [name, content] : files) {
-    if (!IsResultFileName(name))
+    if (!IsResultFileName(name) || name == kRecordFileName)
       return Status(ErrorCode::kInvalidArgument,
                     context + ": \"" + name.substr(0, 64) + "\" is not a result file name");
     bytes += content.size();
   }
+  Result<CaptureInfo> capture = index_->Find(*id);
+  if (!capture.ok()) return WithContext(capture.status(), context);
+  bytes += 64 * 1024;  // the record, at most
   if (Status status = CheckFreeSpace(*id, bytes); !status.ok()) return WithContext(status, context);
   {
     std::lock_guard lock(mutex_);
@@ -524,6 +526,15 @@ Status CaptureStore::PutProcessingResult(std::string_view text,
     if (!sha256.ok()) return WithContext(sha256.status(), context);
     record.files[name] = std::move(sha256).value();
   }
+  // The sealed record, last: it lists every file above by its hash.
+  const std::string sealed = ProvenanceRecord(*capture, provenance, record.files);
+  if (Status status = WriteFileDurably(fs_, results_dir_, id->str() + "-" + kRecordFileName,
+                                       {sealed}, kFileMode);
+      !status.ok())
+    return WithContext(status, context);
+  Result<std::string> sealed_sha256 = BytesSha256(sealed);
+  if (!sealed_sha256.ok()) return WithContext(sealed_sha256.status(), context);
+  record.files[kRecordFileName] = std::move(sealed_sha256).value();
   if (Status status = fs_.FsyncDirectory(results_dir_); !status.ok())
     return WithContext(status, context);
   if (Status status = index_->PutProcessing(*id, record); !status.ok())

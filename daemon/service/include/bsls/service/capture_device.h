@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "bsls/framestore/framestore.h"
+#include "bsls/slides/slide_controller.h"
 
 namespace bsls::service {
 
@@ -75,6 +76,20 @@ class CaptureDevice {
   // when `deadline` passes before the device delivered.
   Result<std::vector<framestore::GreyFrame>> Grab(GrabSides sides, Clock::time_point deadline);
 
+  // A grab of `sides` as the rig's slides want it (contracts section 1):
+  // each side has its own brick slide (2 left, 3 right), so with a brick
+  // slide in place a grab of both sides puts slide 2 in place for the left
+  // frame and slide 3 for the right (which then stays in), and the capture
+  // records slide 0 ("each its own"); otherwise (one side, the reference
+  // cross for calibration, no slide controller) the slide in place serves
+  // every frame and is the one recorded. `slides` may be nullptr.
+  struct SlideGrab {
+    std::vector<framestore::GreyFrame> frames;
+    int slide = 0;  // the slide of every frame; 0: each side its own
+  };
+  Result<SlideGrab> GrabWithSlides(GrabSides sides, slides::SlideController* slides,
+                                   Clock::time_point deadline);
+
   // One open preview stream.
   class Preview {
    public:
@@ -114,7 +129,7 @@ class CaptureDevice {
   DeviceCallbacks callbacks_;
 
   mutable std::mutex mutex_;
-  std::condition_variable wake_;    // the capture thread: commands, previews, stop
+  std::condition_variable wake_;  // the capture thread: commands, previews, stop
   std::deque<Command> commands_;
   bool stopping_ = false;
   std::vector<Preview*> previews_;

@@ -103,7 +103,7 @@ class CaptureService final
   grpc::Status SetLamp(grpc::ServerContext* context, const v1::SetLampRequest* request,
                        v1::SlideState* reply) override;
   grpc::ServerWriteReactor<v1::Event>* WatchEvents(grpc::CallbackServerContext* context,
-                                                  const v1::WatchEventsRequest* request) override;
+                                                   const v1::WatchEventsRequest* request) override;
 
  private:
   // OK with the caller filled in, or UNAUTHENTICATED / PERMISSION_DENIED.
@@ -112,7 +112,8 @@ class CaptureService final
   // The call's deadline on the steady clock, capped; the default when none.
   Clock::time_point Deadline(const grpc::ServerContextBase* context) const;
   // The preview stream's checks: OK, or why it is refused.
-  grpc::Status AdmitPreview(grpc::CallbackServerContext* context, const v1::PreviewRequest& request);
+  grpc::Status AdmitPreview(grpc::CallbackServerContext* context,
+                            const v1::PreviewRequest& request);
   // A key for a push stream, taken before it starts.
   std::uint64_t ReserveStreamKey();
   // Keeps `control` under `key` until the stream ends (the drain ends it).

@@ -28,6 +28,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -72,9 +73,31 @@ class ProcessingQueue {
 
  private:
   enum class Outcome { kDone, kFailed, kRetry, kGone };
+  // What the processing service made of one capture.
+  struct Processed {
+    std::map<std::string, std::string> files;  // name -> bytes
+    store::ProcessingProvenance provenance;
+  };
   void Run();
-  // One capture: the call, then the record. `error` is set unless done.
+  // One capture: the call, then its results stored with their record.
+  // `error` is set unless done.
   Outcome ProcessOne(const std::string& id, std::string* error);
+  // Both sides with both calibrations: one ReconstructSession call.
+  grpc::Status ReconstructBoth(const store::Capture& capture, Processed* out);
+  // Otherwise: one ProcessFrame call per side (a surface where its side has
+  // a calibration).
+  grpc::Status ProcessEachSide(const store::Capture& capture, Processed* out);
+  // Keeps the calibration of `camera`'s side (when configured) among the
+  // files and names it in the provenance.
+  void KeepCalibration(framestore::Camera camera, Processed* out) const;
+  // The calibration (YAML) of `camera`'s side, empty when none is configured.
+  const std::string& CalibrationOf(framestore::Camera camera) const {
+    return camera == framestore::Camera::kLeft ? options_.left_calibration
+                                               : options_.right_calibration;
+  }
+  // The outcome of a call that failed with `status`: a permanent failure
+  // is recorded (not tried again), anything else tried later.
+  Outcome Failed(const std::string& id, const grpc::Status& status, std::string* error);
   void Publish(const std::string& id);
 
   store::CaptureStore* store_;

@@ -42,6 +42,7 @@
 #include "bsls/store/capture_id.h"
 #include "bsls/store/capture_index.h"
 #include "bsls/store/file_system.h"
+#include "bsls/store/provenance.h"
 
 namespace bsls::store {
 
@@ -170,10 +171,12 @@ class CaptureStore {
   // Marks a capture as not processable (not tried again) with the reason.
   Status PutProcessingFailure(std::string_view id, const std::string& error);
   // Stores the result files (name -> bytes; names of [A-Za-z0-9._-], at
-  // most 64 bytes) and marks the capture done. kResourceExhausted when the
-  // disk reserve would be broken; nothing is committed on failure.
+  // most 64 bytes, record.json reserved) with the sealed record of where
+  // they came from (record.json, written here from the capture's metadata
+  // and `provenance`), and marks the capture done. kResourceExhausted when
+  // the disk reserve would be broken; nothing is committed on failure.
   Status PutProcessingResult(std::string_view id, const std::map<std::string, std::string>& files,
-                             const std::string& replica, const std::string& software_version);
+                             const ProcessingProvenance& provenance);
   // The stored result files (or only `only` when not empty), each verified
   // against its SHA-256; kNotFound before the capture is done, kDataLoss for
   // a missing or damaged file.
