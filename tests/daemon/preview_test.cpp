@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdio>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,6 +26,31 @@ struct StreamFigures {
   std::uint64_t dropped = 0;
   bool ok = true;
 };
+
+// A client connection whose receive window holds about one 512 x 512
+// frame: otherwise the transport reads ahead into a window it grows on its
+// own (many frames on a loaded machine), and the daemon, never held up, has
+// nothing to drop or stall on.
+grpc::ChannelArguments OneFrameWindow() {
+  grpc::ChannelArguments args;
+  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
+  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 512 * 512);
+  return args;
+}
+
+// bslsd for a preview test `name`: the caller is admin, at most
+// `max_streams` previews, a write the reader does not take in
+// `write_timeout_ms` ends its stream.
+std::unique_ptr<DaemonProcess> PreviewDaemon(const std::string& name, int max_streams,
+                                             int write_timeout_ms) {
+  const fs::path dir = MakeDaemonDir(name);
+  const fs::path config = WriteDaemonConfig(dir, "roles:\n  admin: [root]\n");
+  return std::make_unique<DaemonProcess>(
+      dir, config,
+      std::vector<std::string>{
+          "--set", "limits.max_preview_streams=" + std::to_string(max_streams), "--set",
+          "limits.stream_write_timeout_ms=" + std::to_string(write_timeout_ms)});
+}
 
 // Reads previews until `end`; counts those that arrive after `window_start`.
 StreamFigures ReadPreview(v1::CaptureDaemon::Stub& stub, Clock::time_point window_start,
@@ -70,16 +96,9 @@ TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
   std::vector<std::thread> clients;
   for (int i = 0; i < 4; ++i) {
     clients.emplace_back([&, i] {
-      // Each client on a connection of its own. The slow one keeps gRPC's
-      // receive window at one frame: otherwise the transport reads ahead
-      // into a window it grows on its own (many frames on a loaded machine)
-      // and the daemon, never held up, has nothing to drop.
-      grpc::ChannelArguments args;
-      if (i == 3) {
-        args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
-        args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 512 * 512);
-      }
-      auto stub = daemon.Stub(args);
+      // Each client on a connection of its own; the slow one's window
+      // holds one frame.
+      auto stub = daemon.Stub(i == 3 ? OneFrameWindow() : grpc::ChannelArguments());
       figures[i] = ReadPreview(*stub, start, end, i == 3 ? milliseconds(250) : milliseconds(0));
     });
   }
@@ -103,19 +122,13 @@ TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
 // limits.stream_write_timeout_ms ends its stream with RESOURCE_EXHAUSTED,
 // and the next reader gets the slot and its frames.
 TEST(BslsdPreview, AReaderThatReadsNothingGivesItsSlotBack) {
-  const fs::path dir = MakeDaemonDir("preview_stalled");
-  const fs::path config = WriteDaemonConfig(dir, "roles:\n  admin: [root]\n");
-  DaemonProcess daemon(
-      dir, config,
-      {"--set", "limits.max_preview_streams=1", "--set", "limits.stream_write_timeout_ms=1000"});
+  const auto started = PreviewDaemon("preview_stalled", 1, 1000);
+  DaemonProcess& daemon = *started;
   ASSERT_TRUE(daemon.ready()) << daemon.Log();
 
   // The stalled reader: no deadline, a receive window of about one frame,
   // and not a single Read.
-  grpc::ChannelArguments args;
-  args.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
-  args.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 512 * 512);
-  auto stalled_stub = daemon.Stub(args);
+  auto stalled_stub = daemon.Stub(OneFrameWindow());
   grpc::ClientContext stalled;
   auto stalled_reader = stalled_stub->StreamPreview(&stalled, {});
   std::this_thread::sleep_for(milliseconds(300));
@@ -171,11 +184,8 @@ int ThreadsOf(pid_t pid) {
 // count does not grow with the streams: 8 streams and 64 take the same
 // threads within a few.
 TEST(BslsdPreview, SixtyFourStreamsTwoStalledTheOthersAtFullRateOnFlatThreads) {
-  const fs::path dir = MakeDaemonDir("preview_64");
-  const fs::path config = WriteDaemonConfig(dir, "roles:\n  admin: [root]\n");
-  DaemonProcess daemon(
-      dir, config,
-      {"--set", "limits.max_preview_streams=64", "--set", "limits.stream_write_timeout_ms=60000"});
+  const auto started = PreviewDaemon("preview_64", 64, 60000);
+  DaemonProcess& daemon = *started;
   ASSERT_TRUE(daemon.ready()) << daemon.Log();
   constexpr int kStreams = 64, kStalled = 2, kChannels = 6;
   constexpr std::uint32_t kEvery = 5;
@@ -188,14 +198,11 @@ TEST(BslsdPreview, SixtyFourStreamsTwoStalledTheOthersAtFullRateOnFlatThreads) {
 
   // The stalled streams, each on a connection of its own with a receive
   // window of about one frame, never read.
-  grpc::ChannelArguments small_window;
-  small_window.SetInt(GRPC_ARG_HTTP2_BDP_PROBE, 0);
-  small_window.SetInt(GRPC_ARG_HTTP2_STREAM_LOOKAHEAD_BYTES, 512 * 512);
   std::vector<std::unique_ptr<v1::CaptureDaemon::Stub>> stalled_stubs;
   std::vector<std::unique_ptr<grpc::ClientContext>> stalled_contexts;
   std::vector<std::unique_ptr<grpc::ClientReader<v1::PreviewFrame>>> stalled;
   for (int i = 0; i < kStalled; ++i) {
-    stalled_stubs.push_back(daemon.Stub(small_window));
+    stalled_stubs.push_back(daemon.Stub(OneFrameWindow()));
     stalled_contexts.push_back(std::make_unique<grpc::ClientContext>());
     stalled.push_back(stalled_stubs.back()->StreamPreview(stalled_contexts.back().get(), {}));
   }
@@ -277,9 +284,10 @@ TEST(BslsdPreview, SixtyFourStreamsTwoStalledTheOthersAtFullRateOnFlatThreads) {
       kStreams, kStalled, status.preview_rate_hz(), slowest, full_rate,
       static_cast<unsigned long long>(most_missed), threads_at_8, threads_at_64);
   // Every reader took every frame it asked for (the stalled two hold up
-  // nobody), at the camera's rate.
+  // nobody), at the camera's rate (read once, over one second: the slack
+  // is for its changes over the window).
   EXPECT_EQ(most_missed, 0u);
-  EXPECT_GE(slowest, 0.9 * full_rate);
+  EXPECT_GE(slowest, 0.85 * full_rate);
   EXPECT_GT(threads_at_8, 0);
   EXPECT_LE(threads_at_64, threads_at_8 + 4) << "threads grew with the streams";
   EXPECT_EQ(daemon.Terminate(), 0) << daemon.Log();

@@ -7,7 +7,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "bsls/store/capture_store.h"
 #include "store_test_util.h"
@@ -94,13 +96,23 @@ TEST(ProcessingResults, EveryCaptureWaitsUntilDoneOrFailed) {
 // The store seals the results with record.json, written from its own copy
 // of the capture's metadata: the frames by hash, every file by hash, and
 // where the results came from.
-TEST(ProcessingResults, TheRecordSealsTheFilesWithTheCapturesOwnMetadata) {
+// A store in a folder of its own with one random capture.
+class OneCapture : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    store = OpenStore(TestOptions(dir.path()));
+    ASSERT_TRUE(store);
+    std::mt19937 rng(8);
+    auto put = store->Put(RandomRequest(rng));
+    ASSERT_TRUE(put.ok()) << put.status().ToString();
+    a = std::move(put).value();
+  }
   TempDir dir;
-  auto store = OpenStore(TestOptions(dir.path()));
-  ASSERT_TRUE(store);
-  std::mt19937 rng(10);
-  auto a = store->Put(RandomRequest(rng));
-  ASSERT_TRUE(a.ok());
+  std::unique_ptr<CaptureStore> store;
+  std::optional<CaptureInfo> a;
+};
+
+TEST_F(OneCapture, TheRecordSealsTheFilesWithTheCapturesOwnMetadata) {
   ProcessingProvenance p = By("replica-1", "1.2.3");
   p.call = "ReconstructSession";
   p.calibrations["left"] = "sha256:abc";
@@ -128,13 +140,7 @@ TEST(ProcessingResults, TheRecordSealsTheFilesWithTheCapturesOwnMetadata) {
   EXPECT_EQ(record.at("daemon_software_version"), "d");
 }
 
-TEST(ProcessingResults, DamageIsFoundAndBadNamesAreRefused) {
-  TempDir dir;
-  auto store = OpenStore(TestOptions(dir.path()));
-  ASSERT_TRUE(store);
-  std::mt19937 rng(8);
-  auto a = store->Put(RandomRequest(rng));
-  ASSERT_TRUE(a.ok());
+TEST_F(OneCapture, DamageIsFoundAndBadNamesAreRefused) {
   for (const std::string& bad : std::vector<std::string>{"../escape", ".hidden", "a/b",
                                                          std::string(65, 'x'), "", kRecordFileName})
     EXPECT_EQ(store->PutProcessingResult(a->id.str(), {{bad, "x"}}, By()).code(),
