@@ -470,9 +470,9 @@ TEST_P(DeadlineInsideTheDecode, FreesTheWorker) {
 INSTANTIATE_TEST_SUITE_P(ProcessingService, DeadlineInsideTheDecode,
                          ::testing::Values(v1::DecodeOptions::CHAIN_TRACKS,
                                            v1::DecodeOptions::CHAIN_SKELETON),
-                         [](const auto& info) {
-                           return info.param == v1::DecodeOptions::CHAIN_TRACKS ? "Tracks"
-                                                                                : "Skeleton";
+                         [](const auto& chain) {
+                           return chain.param == v1::DecodeOptions::CHAIN_TRACKS ? "Tracks"
+                                                                                 : "Skeleton";
                          });
 
 TEST(ProcessingService, AFrameAboveThePixelBudgetIsRefusedBeforeAnyWork) {
