@@ -22,17 +22,24 @@
 namespace bsls::testing {
 
 // A connection to the Unix socket at `path` made with effective uid `uid`
-// (0: as this process), or -1. Switching the euid needs root; the test
-// aborts if it cannot switch back.
-inline int ConnectUnixAs(uid_t uid, const std::string& path) {
-  if (uid != 0 && ::seteuid(uid) != 0) return -1;
+// (0: as this process) and, when `gid` is not 0, effective gid `gid` (the
+// socket's group, for a uid that is not its owner), or -1. Switching needs
+// root; the test aborts if it cannot switch back.
+inline int ConnectUnixAs(uid_t uid, const std::string& path, gid_t gid = 0) {
+  if (gid != 0 && ::setegid(gid) != 0) return -1;
+  if (uid != 0 && ::seteuid(uid) != 0) {
+    if (gid != 0 && ::setegid(0) != 0) std::abort();
+    return -1;
+  }
   const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
   sockaddr_un address{};
   address.sun_family = AF_UNIX;
   std::strncpy(address.sun_path, path.c_str(), sizeof(address.sun_path) - 1);
   const bool connected =
       fd >= 0 && ::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) == 0;
-  if (uid != 0 && ::seteuid(0) != 0) std::abort();  // the test cannot go on as another user
+  // The test cannot go on as another user.
+  if (uid != 0 && ::seteuid(0) != 0) std::abort();
+  if (gid != 0 && ::setegid(0) != 0) std::abort();
   if (!connected) {
     if (fd >= 0) ::close(fd);
     return -1;
