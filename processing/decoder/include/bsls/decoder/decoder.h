@@ -93,8 +93,8 @@ struct TrackChainParams {
 
 struct DecodeParams {
   pattern::PatternSpec spec;
-  // The track chain: 3x the cost of a blur and Canny at 512 x 512 against
-  // the skeleton chain's 30x, the same labels; the skeleton chain places
+  // The track chain: about 4x the cost of a blur and Canny at 512 x 512
+  // against the skeleton chain's 26-30x (docs/benchmarks.md); the skeleton chain places
   // junctions closer and keeps more of steeply leaning lines
   // (docs/decoding.md, "Which chain").
   DecodeChain chain = DecodeChain::kTracks;
