@@ -300,6 +300,37 @@ grpc::Status CaptureService::SetGain(grpc::ServerContext* context,
   return grpc::Status::OK;
 }
 
+template <typename Message>
+std::pair<internal::PushStream<Message>*, std::shared_ptr<internal::PushControl>>
+CaptureService::OpenStream(grpc::CallbackServerContext* context, const char* what,
+                           std::atomic<int>* slots, bool send_initial_metadata) {
+  std::uint64_t key;
+  {
+    std::lock_guard lock(streams_mutex_);
+    key = next_stream_++;
+  }
+  auto opened =
+      internal::PushStream<Message>::Start({.context = context,
+                                            .stalled = &stalled_writes_,
+                                            .what = what,
+                                            .send_initial_metadata = send_initial_metadata,
+                                            .on_done = [this, key, slots] {
+                                              {
+                                                std::lock_guard lock(streams_mutex_);
+                                                streams_.erase(key);
+                                              }
+                                              --*slots;
+                                            }});
+  {
+    std::lock_guard lock(streams_mutex_);
+    streams_[key] = opened.second;
+  }
+  // A drain that began before the stream was listed ends it too (without
+  // the lock: ending may remove it at once).
+  if (draining_) opened.second->End(Draining());
+  return opened;
+}
+
 grpc::Status CaptureService::AdmitPreview(grpc::CallbackServerContext* context,
                                           const v1::PreviewRequest& request) {
   Caller caller;
@@ -325,15 +356,9 @@ grpc::Status CaptureService::AdmitPreview(grpc::CallbackServerContext* context,
 
 grpc::ServerWriteReactor<v1::PreviewFrame>* CaptureService::StreamPreview(
     grpc::CallbackServerContext* context, const v1::PreviewRequest* request) {
-  using Stream = internal::PushStream<v1::PreviewFrame>;
   if (grpc::Status s = AdmitPreview(context, *request); !s.ok())
     return new internal::EndedStream<v1::PreviewFrame>(std::move(s));
-  const std::uint64_t key = ReserveStreamKey();
-  auto [stream, control] = Stream::Start(
-      {.context = context, .stalled = &stalled_writes_, .what = "preview", .on_done = [this, key] {
-         RemoveStream(key);
-         --preview_streams_;
-       }});
+  auto [stream, control] = OpenStream<v1::PreviewFrame>(context, "preview", &preview_streams_);
   // The stream takes the newest frame whenever its write is done: the
   // frames published meanwhile are skipped, and the next message says how
   // many. A preview of another camera than the selected one waits for it.
@@ -341,9 +366,7 @@ grpc::ServerWriteReactor<v1::PreviewFrame>* CaptureService::StreamPreview(
   if (request->camera() != v1::CAMERA_UNSPECIFIED) camera = FromProto(request->camera());
   const std::uint32_t every = std::max<std::uint32_t>(1, request->decimation());
   std::shared_ptr<CaptureDevice::Preview> preview =
-      device_->OpenPreview([weak = std::weak_ptr(control)] {
-        if (auto c = weak.lock()) c->Wake();
-      });
+      device_->OpenPreview(internal::WakerOf(control));
   stream->SetSource([preview, camera, every, skipped = std::uint64_t{0},
                      counter = std::uint32_t{0}]() mutable -> std::optional<v1::PreviewFrame> {
     std::uint64_t dropped = 0;
@@ -357,7 +380,6 @@ grpc::ServerWriteReactor<v1::PreviewFrame>* CaptureService::StreamPreview(
     skipped = 0;
     return message;
   });
-  AddStream(key, control);
   control->Wake();
   return stream;
 }
@@ -490,7 +512,7 @@ grpc::Status CaptureService::GetCaptureResult(grpc::ServerContext* context,
     const bool sent = rpc::EmitArtifact(
         name, name.ends_with(".json") ? "application/json" : "application/octet-stream", bytes,
         [this, context, writer](const v1::WorkEvent& event) {
-          StalledWrites::Watch watch(stalled_writes_, context->c_call(), context->peer(), "result");
+          StalledWrites::Watch watch(stalled_writes_, context->c_call(), "result");
           return writer->Write(event.artifact());
         });
     if (!sent) return grpc::Status(grpc::StatusCode::CANCELLED, "the caller went away");
@@ -592,7 +614,6 @@ grpc::Status CaptureService::SetLamp(grpc::ServerContext* context,
 
 grpc::ServerWriteReactor<v1::Event>* CaptureService::WatchEvents(
     grpc::CallbackServerContext* context, const v1::WatchEventsRequest*) {
-  using Stream = internal::PushStream<v1::Event>;
   Caller caller;
   if (grpc::Status s = Authorize(context, "WatchEvents", &caller); !s.ok())
     return new internal::EndedStream<v1::Event>(std::move(s));
@@ -604,18 +625,8 @@ grpc::ServerWriteReactor<v1::Event>* CaptureService::WatchEvents(
                                                    std::to_string(limits_.max_event_streams) +
                                                    " event streams; close one first"});
   }
-  const std::uint64_t key = ReserveStreamKey();
-  auto [stream, control] = Stream::Start({.context = context,
-                                          .stalled = &stalled_writes_,
-                                          .what = "events",
-                                          .send_initial_metadata = true,
-                                          .on_done = [this, key] {
-                                            RemoveStream(key);
-                                            --event_streams_;
-                                          }});
-  std::shared_ptr<EventHub::Watcher> watcher = events_->Watch([weak = std::weak_ptr(control)] {
-    if (auto c = weak.lock()) c->Wake();
-  });
+  auto [stream, control] = OpenStream<v1::Event>(context, "events", &event_streams_, true);
+  std::shared_ptr<EventHub::Watcher> watcher = events_->Watch(internal::WakerOf(control));
   // A watcher that read too slowly lost its oldest events: it is told how
   // many before the next one.
   stream->SetSource(
@@ -631,7 +642,6 @@ grpc::ServerWriteReactor<v1::Event>* CaptureService::WatchEvents(
         held = std::move(event);
         return lost;
       });
-  AddStream(key, control);
   control->Wake();
   return stream;
 }
@@ -644,26 +654,6 @@ void CaptureService::BeginDrain() {
     for (const auto& [key, control] : streams_) open.push_back(control);
   }
   for (const auto& control : open) control->End(Draining());
-}
-
-std::uint64_t CaptureService::ReserveStreamKey() {
-  std::lock_guard lock(streams_mutex_);
-  return next_stream_++;
-}
-
-void CaptureService::AddStream(std::uint64_t key, std::shared_ptr<internal::PushControl> control) {
-  {
-    std::lock_guard lock(streams_mutex_);
-    streams_[key] = control;
-  }
-  // A drain that began before the stream was listed ends it too (without
-  // the lock: ending may remove it at once).
-  if (draining_) control->End(Draining());
-}
-
-void CaptureService::RemoveStream(std::uint64_t key) {
-  std::lock_guard lock(streams_mutex_);
-  streams_.erase(key);
 }
 
 }  // namespace bsls::service

@@ -52,7 +52,7 @@ const char* SideName(framestore::Camera camera) {
 }
 
 // The cameras of a capture that have a side, each with its frame.
-std::map<framestore::Camera, const framestore::GreyFrame*> SideFrames(
+std::map<framestore::Camera, const framestore::GreyFrame*> FramesBySide(
     const store::Capture& capture) {
   std::map<framestore::Camera, const framestore::GreyFrame*> frames;
   for (const framestore::GreyFrame& frame : capture.frames)
@@ -174,10 +174,11 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
   }
   Processed processed;
   processed.provenance.daemon_software_version = options_.daemon_version;
-  const bool both = SideFrames(*capture).size() == 2 && !options_.left_calibration.empty() &&
+  const SideFrames frames = FramesBySide(*capture);
+  const bool both = frames.size() == 2 && !options_.left_calibration.empty() &&
                     !options_.right_calibration.empty();
   if (grpc::Status s =
-          both ? ReconstructBoth(*capture, &processed) : ProcessEachSide(*capture, &processed);
+          both ? ReconstructBoth(id, frames, &processed) : ProcessEachSide(id, frames, &processed);
       !s.ok())
     return Failed(id, s, error);
   if (auto stored = store_->PutProcessingResult(id, processed.files, processed.provenance);
@@ -188,8 +189,8 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
   return Outcome::kDone;
 }
 
-grpc::Status ProcessingQueue::ReconstructBoth(const store::Capture& capture, Processed* out) {
-  const auto frames = SideFrames(capture);
+grpc::Status ProcessingQueue::ReconstructBoth(const std::string& id, const SideFrames& frames,
+                                              Processed* out) {
   v1::ReconstructSessionRequest request;
   ToMessage(*frames.at(framestore::Camera::kLeft), request.mutable_left());
   ToMessage(*frames.at(framestore::Camera::kRight), request.mutable_right());
@@ -199,7 +200,7 @@ grpc::Status ProcessingQueue::ReconstructBoth(const store::Capture& capture, Pro
       processing::ProcessingClient::Inline(options_.right_calibration);
   request.set_want_side_surfaces(true);
   request.set_want_junctions(true);
-  request.set_request_tag(capture.info.id.str());
+  request.set_request_tag(id);
   const processing::WorkOutcome result = client_->ReconstructSession(request);
   if (!result.status.ok()) return result.status;
   out->files.insert(result.files.begin(), result.files.end());
@@ -212,8 +213,8 @@ grpc::Status ProcessingQueue::ReconstructBoth(const store::Capture& capture, Pro
   return grpc::Status::OK;
 }
 
-grpc::Status ProcessingQueue::ProcessEachSide(const store::Capture& capture, Processed* out) {
-  const auto frames = SideFrames(capture);
+grpc::Status ProcessingQueue::ProcessEachSide(const std::string& id, const SideFrames& frames,
+                                              Processed* out) {
   out->provenance.call = "ProcessFrame";
   for (const auto& [camera, frame] : frames) {
     v1::ProcessFrameRequest request;
@@ -225,7 +226,7 @@ grpc::Status ProcessingQueue::ProcessEachSide(const store::Capture& capture, Pro
       request.set_want_surface(true);
     }
     request.set_want_overlay(true);
-    request.set_request_tag(capture.info.id.str());
+    request.set_request_tag(id);
     const processing::WorkOutcome result = client_->ProcessFrame(request);
     if (!result.status.ok()) return result.status;
     // Both sides without both calibrations: each side's files by its name.

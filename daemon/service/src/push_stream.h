@@ -112,7 +112,7 @@ class PushStream final : public grpc::ServerWriteReactor<Message> {
           writing = true;
           if (s->options_.stalled)
             s->watch_.emplace(*s->options_.stalled, s->options_.context->c_call(),
-                              s->options_.context->peer(), s->options_.what);
+                              s->options_.what);
           action = kWrite;
         }
       }
@@ -144,6 +144,14 @@ class PushStream final : public grpc::ServerWriteReactor<Message> {
   Message current_;  // the message of the write in flight
   std::optional<StalledWrites::Watch> watch_;
 };
+
+// A publisher's callback that wakes the stream of `control` while it is
+// open (it holds the control weakly: a publisher may outlive the stream).
+inline std::function<void()> WakerOf(const std::shared_ptr<PushControl>& control) {
+  return [weak = std::weak_ptr(control)] {
+    if (auto c = weak.lock()) c->Wake();
+  };
+}
 
 // A stream that ends at once with `status` (a refused call).
 template <typename Message>

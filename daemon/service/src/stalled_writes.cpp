@@ -1,6 +1,7 @@
 #include "bsls/service/stalled_writes.h"
 
 #include <grpc/grpc.h>
+#include <grpc/support/alloc.h>
 #include <spdlog/spdlog.h>
 
 #include <vector>
@@ -21,8 +22,7 @@ StalledWrites::~StalledWrites() {
   thread_.join();
 }
 
-StalledWrites::Watch::Watch(StalledWrites& owner, grpc_call* call, std::string peer,
-                            const char* what)
+StalledWrites::Watch::Watch(StalledWrites& owner, grpc_call* call, const char* what)
     : owner_(owner) {
   // The call is referenced while watched: the watch thread may cancel it
   // after the stream let go of it.
@@ -30,8 +30,7 @@ StalledWrites::Watch::Watch(StalledWrites& owner, grpc_call* call, std::string p
   {
     std::lock_guard lock(owner_.mutex_);
     id_ = owner_.next_id_++;
-    owner_.watched_[id_] = {std::chrono::steady_clock::now() + owner_.limit_, call, std::move(peer),
-                            what};
+    owner_.watched_[id_] = {std::chrono::steady_clock::now() + owner_.limit_, call, what};
   }
   owner_.wake_.notify_all();
 }
@@ -81,10 +80,15 @@ void StalledWrites::Run() {
                                    " stream: the reader took no message for " +
                                    std::to_string(limit_.count()) +
                                    " ms (limits.stream_write_timeout_ms)";
+        // The peer's name only now (before the cancel, which forgets it):
+        // building it for every write watched would cost each stream
+        // message a string.
+        char* peer = grpc_call_get_peer(entry.call);
         grpc_call_cancel_with_status(entry.call, GRPC_STATUS_RESOURCE_EXHAUSTED, reason.c_str(),
                                      nullptr);
+        spdlog::warn("{} (peer {})", reason, peer != nullptr ? peer : "unknown");
+        gpr_free(peer);
         grpc_call_unref(entry.call);
-        spdlog::warn("{} (peer {})", reason, entry.peer);
       }
       expired.clear();
       lock.lock();

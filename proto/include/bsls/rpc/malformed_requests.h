@@ -4,11 +4,13 @@
 // status as the call's: for protobuf, INTERNAL with
 // InitializationErrorString(), which is empty for proto3 (a handler on the
 // callback API: UNIMPLEMENTED with no message). A caller that sent bytes
-// that are not the message was told "internal error" without a word of why. The generated code
-// parses every unary request as a protobuf::MessageLite (the same traits as the client's replies),
-// so the parse itself cannot be given another status without rewriting the services on the generic
-// API; a server interceptor can: it sees that no request came out of the parse (POST_RECV_MESSAGE
-// with no message) and rewrites the status about to be sent (PRE_SEND_STATUS).
+// that are not the message was told "internal error" without a word of
+// why. The generated code parses every unary request as a
+// protobuf::MessageLite (the same traits as the client's replies), so the
+// parse itself cannot be given another status without rewriting the
+// services on the generic API; a server interceptor can: it sees that no
+// request came out of the parse (POST_RECV_MESSAGE with no message) and
+// rewrites the status about to be sent (PRE_SEND_STATUS).
 //
 // Only methods that take one request (unary, server-streaming) are
 // rewritten: in a request stream, the sync API shows a malformed message

@@ -20,6 +20,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 
 #include "bsls/common/status.h"
 #include "bsls/service/capture_device.h"
@@ -55,7 +56,9 @@ grpc::Status ToGrpc(const Status& status);
 
 namespace internal {
 class PushControl;
-}
+template <typename Message>
+class PushStream;
+}  // namespace internal
 
 class CaptureService final
     : public v1::CaptureDaemon::WithCallbackMethod_StreamPreview<
@@ -114,12 +117,13 @@ class CaptureService final
   // The preview stream's checks: OK, or why it is refused.
   grpc::Status AdmitPreview(grpc::CallbackServerContext* context,
                             const v1::PreviewRequest& request);
-  // A key for a push stream, taken before it starts.
-  std::uint64_t ReserveStreamKey();
-  // Keeps `control` under `key` until the stream ends (the drain ends it).
-  void AddStream(std::uint64_t key, std::shared_ptr<internal::PushControl> control);
-  // Forgets the stream of `key` (it ended).
-  void RemoveStream(std::uint64_t key);
+  // A push stream named `what` on `context`, listed for the drain until it
+  // ends, when it also gives back its place in `slots`; connect its source,
+  // then wake it. Ended at once when a drain has begun.
+  template <typename Message>
+  std::pair<internal::PushStream<Message>*, std::shared_ptr<internal::PushControl>> OpenStream(
+      grpc::CallbackServerContext* context, const char* what, std::atomic<int>* slots,
+      bool send_initial_metadata = false);
   void FillStatus(const Caller& caller, v1::DeviceStatus* reply);
   void FillSlideState(v1::SlideState* reply) const;
   // The capture's metadata and its processing status.

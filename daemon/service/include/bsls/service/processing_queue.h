@@ -82,11 +82,13 @@ class ProcessingQueue {
   // One capture: the call, then its results stored with their record.
   // `error` is set unless done.
   Outcome ProcessOne(const std::string& id, std::string* error);
+  // A capture's frames of a side (left, right) by camera.
+  using SideFrames = std::map<framestore::Camera, const framestore::GreyFrame*>;
   // Both sides with both calibrations: one ReconstructSession call.
-  grpc::Status ReconstructBoth(const store::Capture& capture, Processed* out);
+  grpc::Status ReconstructBoth(const std::string& id, const SideFrames& frames, Processed* out);
   // Otherwise: one ProcessFrame call per side (a surface where its side has
   // a calibration).
-  grpc::Status ProcessEachSide(const store::Capture& capture, Processed* out);
+  grpc::Status ProcessEachSide(const std::string& id, const SideFrames& frames, Processed* out);
   // Keeps the calibration of `camera`'s side (when configured) among the
   // files and names it in the provenance.
   void KeepCalibration(framestore::Camera camera, Processed* out) const;

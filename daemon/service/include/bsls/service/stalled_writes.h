@@ -17,7 +17,6 @@
 #include <cstdint>
 #include <map>
 #include <mutex>
-#include <string>
 #include <thread>
 
 struct grpc_call;
@@ -34,13 +33,12 @@ class StalledWrites {
   StalledWrites& operator=(const StalledWrites&) = delete;
 
   // Watches one write of a call while it exists: create it just before the
-  // write (`call` and `peer` from the call's context: c_call() and peer() of
-  // a grpc::ServerContext or grpc::CallbackServerContext) and destroy it
-  // when the write completes. `what` names the stream in the status
-  // ("preview", "events").
+  // write (`call`: c_call() of a grpc::ServerContext or
+  // grpc::CallbackServerContext) and destroy it when the write completes.
+  // `what` names the stream in the status ("preview", "events").
   class Watch {
    public:
-    Watch(StalledWrites& owner, grpc_call* call, std::string peer, const char* what);
+    Watch(StalledWrites& owner, grpc_call* call, const char* what);
     ~Watch();
     Watch(const Watch&) = delete;
     Watch& operator=(const Watch&) = delete;
@@ -57,7 +55,6 @@ class StalledWrites {
   struct Entry {
     std::chrono::steady_clock::time_point until;
     grpc_call* call;  // referenced while watched (grpc_call_ref)
-    std::string peer;
     const char* what;
   };
   void Run();
