@@ -2,12 +2,17 @@
 // of both chains, with bsls::Cancelled, and nothing half-decoded returned.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <map>
+#include <mutex>
 #include <string>
+#include <vector>
 
 #include "bsls/common/cancellation.h"
 #include "bsls/decoder/decoder.h"
+#include "bsls/testing/hostile_frame.h"
 #include "decoder_evaluation.h"
 
 namespace bsls::decoder::test {
@@ -74,6 +79,49 @@ TEST_P(DecoderCancellation, EveryStageAsksAndStopsWhenTold) {
     // 100 ms.
     EXPECT_GE(stops["cancelled during the re-centring on ridges"], 3);
   }
+}
+
+// A cancellation that never stops the decode but notes when it was asked.
+struct TimedCancellation {
+  using Clock = std::chrono::steady_clock;
+  std::mutex mutex;
+  std::vector<Clock::time_point> asked;
+  Cancellation Token() {
+    return Cancellation([this] {
+      const std::lock_guard lock(mutex);
+      asked.push_back(Clock::now());
+      return false;
+    });
+  }
+};
+
+// No stage runs long without asking: on the slow hostile frame (8 Mpx,
+// every other row noise), the longest stretch between two questions (or
+// from the start to the first, or from the last to the end) is a small part
+// of the whole decode. A service's deadline frees its worker within that
+// stretch (ProcessingService/DeadlineInsideTheDecode). A ratio of one run,
+// so it holds on a loaded machine and under the sanitizers alike.
+TEST_P(DecoderCancellation, NoStageRunsLongWithoutAsking) {
+  const cv::Mat frame = bsls::testing::HostileFrame();
+  TimedCancellation timed;
+  const auto start = TimedCancellation::Clock::now();
+  (void)Decode(frame, Side::kLeft, Params(), timed.Token());
+  const auto end = TimedCancellation::Clock::now();
+  std::vector<TimedCancellation::Clock::time_point> times = timed.asked;
+  std::sort(times.begin(), times.end());
+  times.insert(times.begin(), start);
+  times.push_back(end);
+  const std::chrono::duration<double> whole = end - start;
+  const double bound = whole.count() / 8;
+  std::string stretches;  // every stretch above the bound
+  for (size_t i = 1; i < times.size(); ++i) {
+    const double s = std::chrono::duration<double>(times[i] - times[i - 1]).count();
+    if (s >= bound)
+      stretches += " " + std::to_string(s) + " s after question " + std::to_string(i - 1) + ";";
+  }
+  EXPECT_TRUE(stretches.empty()) << "the decode took " << whole.count() << " s, asked "
+                                 << times.size() - 2 << " times, and ran without asking for"
+                                 << stretches;
 }
 
 std::string ChainName(const ::testing::TestParamInfo<DecodeChain>& chain) {

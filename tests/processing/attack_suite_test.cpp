@@ -47,11 +47,11 @@
 #include <thread>
 
 #include "bsls/rpc/frame_message.h"
+#include "bsls/testing/hostile_frame.h"
 #include "bsls/testing/raw_connections.h"
 #include "bsls/v1/capture.grpc.pb.h"
 #include "bsls/v1/processing.grpc.pb.h"
 #include "daemon_process.h"
-#include "hostile_frame.h"
 #include "processd_process.h"
 #include "raw_calls.h"
 
@@ -404,11 +404,11 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
           UnaryCall("/bsls.v1.Processing/ProcessFrame", Bytes(FrameRequest(at)), 1000),
           2,
           {}}});
-    run("slow frame",
-        {{"hostile frame, deadline 300 ms",
-          UnaryCall("/bsls.v1.Processing/ProcessFrame", Bytes(FrameRequest(HostileFrame())), 300),
-          2,
-          {}}});
+    run("slow frame", {{"hostile frame, deadline 300 ms",
+                        UnaryCall("/bsls.v1.Processing/ProcessFrame",
+                                  Bytes(FrameRequest(testing::HostileFrame())), 300),
+                        2,
+                        {}}});
   }
 
   // Calibration images above the pixel budget: six PNGs of 8192 x 8192.

@@ -14,7 +14,7 @@
 #include "bsls/decoder/decoder.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/simulator/calibration_session.h"
-#include "hostile_frame.h"
+#include "bsls/testing/hostile_frame.h"
 #include "raw_calls.h"
 #include "service_fixture.h"
 
@@ -430,7 +430,7 @@ class DeadlineInsideTheDecode : public ::testing::TestWithParam<v1::DecodeOption
 TEST_P(DeadlineInsideTheDecode, FreesTheWorker) {
   InProcessService s;
   v1::ProcessFrameRequest request;
-  *request.mutable_frame() = FrameMessage(HostileFrame());
+  *request.mutable_frame() = FrameMessage(testing::HostileFrame());
   request.set_side(v1::SIDE_LEFT);
   request.mutable_decode()->set_chain(GetParam());
   // How long the whole decode takes here (no deadline).

@@ -332,14 +332,17 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
 
 // The line and segment tracks' ridge points drawn on a CV_8UC1 image of
 // the full frame's `size` (0/255); found on a resampled frame, each track as
-// a polyline through its points' full-frame pixels.
+// a polyline through its points' full-frame pixels. Asks `cancel` every
+// thousand tracks.
 cv::Mat DrawTracks(const interpretation::TrackNetwork& net, const WorkingScale& scale,
-                   cv::Size size) {
+                   cv::Size size, const Cancellation& cancel) {
   cv::Mat out = cv::Mat::zeros(size, CV_8UC1);
   std::vector<cv::Point> path;
+  int drawn = 0;
   auto draw = [&](const std::vector<interpretation::Track>& tracks,
                   const extraction::RidgePoints& points, bool transposed) {
     for (const interpretation::Track& track : tracks) {
+      if (++drawn % 1024 == 0) cancel.ThrowIfRequested("drawing the tracks");
       if (scale.IsIdentity()) {  // each point on its own pixel, next to its neighbours
         for (int k : track.points) {
           const extraction::RidgePoint& p = points.points[k];
@@ -422,9 +425,9 @@ bool FindWorkingRidges(const cv::Mat& grey, const DecodeParams& params, const Ca
   cv::GaussianBlur(out->working, smoothed, cv::Size(0, 0), tp.smoothing_sigma, tp.smoothing_sigma,
                    cv::BORDER_REPLICATE);
   cancel.ThrowIfRequested("the smoothing");
-  out->rows = extraction::FindRidgePoints(smoothed, tp.ridge);
+  out->rows = extraction::FindRidgePoints(smoothed, tp.ridge, cancel);
   cancel.ThrowIfRequested("the ridges along rows");
-  out->columns = extraction::FindColumnRidgePoints(smoothed, tp.ridge);
+  out->columns = extraction::FindColumnRidgePoints(smoothed, tp.ridge, cancel);
   cancel.ThrowIfRequested("the ridges along columns");
   result->times.extraction_ms = MsSince(t);
   return true;
@@ -576,8 +579,9 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
       interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
+  cancel.ThrowIfRequested("the labelling");
   // The tracks' ridge points, as the skeleton chain's repaired skeleton.
-  result->skeleton = DrawTracks(net, scale, grey.size());
+  result->skeleton = DrawTracks(net, scale, grey.size(), cancel);
   if (!labels.ok) {
     result->error = labels.error;
     return;

@@ -253,7 +253,8 @@ cv::Mat HysteresisThreshold(const cv::Mat& magnitude, double low, double high) {
 
 namespace internal {
 
-cv::Mat KeepComponentsTouching(const cv::Mat& weak, const cv::Mat& strong) {
+cv::Mat KeepComponentsTouching(const cv::Mat& weak, const cv::Mat& strong,
+                               const Cancellation& cancel, std::string_view stage) {
   assert(weak.size() == strong.size() && weak.type() == CV_8UC1 && strong.type() == CV_8UC1);
   // Flood fill from every strong pixel of `weak` (marked 2 when reached);
   // the pixels reached are the components touching a strong pixel.
@@ -261,8 +262,12 @@ cv::Mat KeepComponentsTouching(const cv::Mat& weak, const cv::Mat& strong) {
   const std::ptrdiff_t s = static_cast<std::ptrdiff_t>(img.Stride());
   const std::ptrdiff_t offsets[8] = {-s - 1, -s, -s + 1, -1, 1, s - 1, s, s + 1};
   std::vector<size_t> stack;
+  cancel.ThrowIfRequested(stage);
   // The strong pixels in raster order, by index into a buffer laid out like img's.
-  for (size_t start : PaddedBinary(strong).SetIndices()) {
+  const std::vector<size_t> starts = PaddedBinary(strong).SetIndices();
+  for (size_t k = 0; k < starts.size(); ++k) {
+    if (k % 16384 == 0) cancel.ThrowIfRequested(stage);
+    const size_t start = starts[k];
     if (img.data[start] != 1) continue;
     stack.assign(1, start);
     img.data[start] = 2;

@@ -58,7 +58,7 @@ ExtractionResult ExtractFeatures(const cv::Mat& grey, const ExtractionParams& pa
     }
     internal::PruneSpursInPlace(&skeleton, params.spurs);
     cancel.ThrowIfRequested("the spur pruning");
-    internal::RemoveSmallComponentsInPlace(&skeleton, params.min_component_pixels);
+    internal::RemoveSmallComponentsInPlace(&skeleton, params.min_component_pixels, cancel);
     internal::MakeOnePixelWideInPlace(&skeleton, params.t_junctions, cancel);
     result.skeleton = skeleton.ToMat();
     return result;

@@ -4,12 +4,18 @@
 #define BSLS_EXTRACTION_SRC_HYSTERESIS_H_
 
 #include <opencv2/core.hpp>
+#include <string_view>
+
+#include "bsls/common/cancellation.h"
 
 namespace bsls::extraction::internal {
 
 // The 8-connected components of `weak` (CV_8UC1, non-zero = set) that contain
-// at least one pixel set in `strong` (same size and type), as 0/255.
-cv::Mat KeepComponentsTouching(const cv::Mat& weak, const cv::Mat& strong);
+// at least one pixel set in `strong` (same size and type), as 0/255. Asks
+// `cancel` every few thousand strong pixels (Cancelled naming `stage`).
+cv::Mat KeepComponentsTouching(const cv::Mat& weak, const cv::Mat& strong,
+                               const Cancellation& cancel = {},
+                               std::string_view stage = "the hysteresis");
 
 }  // namespace bsls::extraction::internal
 

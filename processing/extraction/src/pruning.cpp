@@ -133,11 +133,13 @@ cv::Mat PruneSpurs(const cv::Mat& skeleton, const SpurPruneParams& params) {
   return img.ToMat();
 }
 
-cv::Mat RemoveSmallComponents(const cv::Mat& binary, int min_pixels) {
+cv::Mat RemoveSmallComponents(const cv::Mat& binary, int min_pixels, const Cancellation& cancel) {
   RequireGrey8(binary, "RemoveSmallComponents", "binary image");
   if (min_pixels < 1) throw std::invalid_argument("RemoveSmallComponents: min_pixels must be >= 1");
   PaddedBinary img(binary);
-  internal::RemoveSmallComponentsInPlace(&img, min_pixels);
+  cancel.ThrowIfRequested("the small components");
+  internal::RemoveSmallComponentsInPlace(&img, min_pixels, cancel);
+  cancel.ThrowIfRequested("the small components");
   return img.ToMat();
 }
 
@@ -174,15 +176,17 @@ void PruneSpursInPlace(PaddedBinary* img, const SpurPruneParams& params) {
 }
 
 // 8-connected flood fill of each component from its first pixel in raster order.
-void RemoveSmallComponentsInPlace(PaddedBinary* img, int min_pixels) {
+void RemoveSmallComponentsInPlace(PaddedBinary* img, int min_pixels, const Cancellation& cancel) {
   if (min_pixels <= 1) return;
   const std::ptrdiff_t s = static_cast<std::ptrdiff_t>(img->Stride());
   const std::ptrdiff_t offsets[8] = {-s - 1, -s, -s + 1, -1, 1, s - 1, s, s + 1};
   // Flood fill each 8-connected component, marking its pixels 2; a small
   // one is erased, a large one restored to 1 afterwards.
   std::vector<size_t> component, stack, kept;
+  int components = 0;
   for (size_t start : img->SetIndices()) {
     if (img->data[start] != 1) continue;
+    if (++components % 4096 == 0) cancel.ThrowIfRequested("the small components");
     component.clear();
     stack.assign(1, start);
     img->data[start] = 2;

@@ -230,15 +230,18 @@ std::vector<RidgePoint> Joined(const std::vector<std::vector<RidgePoint>>& parts
 
 }  // namespace
 
-RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) {
+RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params,
+                            const Cancellation& cancel) {
   CheckArguments("FindRidgePoints", smoothed, params);
   // Rows are independent: bands of them in parallel (cv::parallel_for_).
   const int bands = (smoothed.rows + kBandRows - 1) / kBandRows;
   const int w = params.half_window, t = params.min_prominence, cols = smoothed.cols;
   std::vector<std::vector<RidgePoint>> found(bands);
+  BandStop stop(cancel);
   cv::parallel_for_(cv::Range(0, bands), [&](const cv::Range& r) {
     std::vector<Candidate> candidates;
     for (int b = r.start; b < r.end; ++b) {
+      if (stop.Requested()) return;
       const int y1 = std::min((b + 1) * kBandRows, smoothed.rows);
       for (int y = b * kBandRows; y < y1; ++y) {
         const uchar* row = smoothed.ptr<uchar>(y);
@@ -247,13 +250,15 @@ RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) 
       }
     }
   });
+  stop.ThrowIfStopped("the ridges along rows");
   RidgePoints out;
   out.points = Joined(found);
   IndexLines(smoothed.rows, &out);
   return out;
 }
 
-RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& params) {
+RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& params,
+                                  const Cancellation& cancel) {
   CheckArguments("FindColumnRidgePoints", smoothed, params);
   // Blocks of kVector columns in parallel; the last, narrower block pixel by pixel.
   const int w = params.half_window, t = params.min_prominence;
@@ -264,9 +269,11 @@ RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& pa
   for (int y = -w - 1; y <= smoothed.rows + w; ++y)
     rows_from.push_back(smoothed.ptr<uchar>(std::clamp(y, 0, smoothed.rows - 1)));
   std::vector<std::vector<RidgePoint>> found(blocks);
+  BandStop stop(cancel);
   cv::parallel_for_(cv::Range(0, blocks), [&](const cv::Range& r) {
     std::vector<Candidate> candidates[kVector];
     for (int b = r.start; b < r.end; ++b) {
+      if (stop.Requested()) return;
       const int x0 = b * kVector;
       const int width = std::min(kVector, smoothed.cols - x0);
       if (b < full_blocks) {
@@ -282,6 +289,7 @@ RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& pa
                            candidates[k], t, &found[b]);
     }
   });
+  stop.ThrowIfStopped("the ridges along columns");
   RidgePoints out;
   out.points = Joined(found);
   IndexLines(smoothed.cols, &out);

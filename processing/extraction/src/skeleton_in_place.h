@@ -43,8 +43,10 @@ void RecentreOnRidgeInPlace(PaddedBinary* img, const cv::Mat& smoothed,
 // PruneSpurs (pruning.h) on *img.
 void PruneSpursInPlace(PaddedBinary* img, const SpurPruneParams& params);
 
-// RemoveSmallComponents (pruning.h) on *img; min_pixels >= 1.
-void RemoveSmallComponentsInPlace(PaddedBinary* img, int min_pixels);
+// RemoveSmallComponents (pruning.h) on *img; min_pixels >= 1. Asks
+// `cancel` every few thousand components.
+void RemoveSmallComponentsInPlace(PaddedBinary* img, int min_pixels,
+                                  const Cancellation& cancel = {});
 
 }  // namespace bsls::extraction::internal
 

@@ -372,7 +372,7 @@ cv::Mat DetectByHessian(const cv::Mat& grey, const StripeDetectParams& p,
   });
   cancel.ThrowIfRequested("the stripe shape test");
   // Stripes grow from the seeds through the shaped pixels.
-  return internal::KeepComponentsTouching(shaped, seeds);
+  return internal::KeepComponentsTouching(shaped, seeds, cancel, "the stripe mask");
 }
 
 cv::Mat DetectByAdaptiveThreshold(const cv::Mat& grey, const StripeDetectParams& p) {

@@ -12,10 +12,13 @@ namespace {
 
 // Thesis 5.2.3.1 stage 8: a junction whose window shows fewer than three
 // paths is a degree-2 point with a noisy pixel or two; prune its short spurs.
-int PruneFalseJunctions(cv::Mat& sk, pattern::Side side, const InterpretationParams& params) {
-  const SkeletonGraph g = SkeletonGraph::Build(sk, params.graph);
+// Asks `cancel` after the graph and every few hundred nodes.
+int PruneFalseJunctions(cv::Mat& sk, pattern::Side side, const InterpretationParams& params,
+                        const Cancellation& cancel) {
+  const SkeletonGraph g = SkeletonGraph::Build(sk, params.graph, cancel);
   int pruned = 0;
   for (int n = 0; n < static_cast<int>(g.nodes().size()); ++n) {
+    if (n % 512 == 0) cancel.ThrowIfRequested("the false junctions");
     const SkeletonNode& node = g.nodes()[n];
     if (node.kind != NodeKind::kJunction) continue;
     const cv::Point c(cvRound(node.centre.x), cvRound(node.centre.y));
@@ -99,6 +102,7 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   cv::Mat sk, mask;
   cv::compare(skeleton, 0, sk, cv::CMP_NE);
   cv::copyMakeBorder(sk, sk, m, m, m, m, cv::BORDER_CONSTANT, 0);
+  cancel.ThrowIfRequested("the skeleton's frame");
   if (!stripe_mask.empty()) {
     if (stripe_mask.type() != CV_8UC1 || stripe_mask.size() != skeleton.size())
       throw std::invalid_argument("Interpret: stripe mask must be CV_8UC1 of the skeleton's size");
@@ -113,9 +117,9 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
   };
   // Thesis 4.4: skeleton pieces too small to be part of the pattern.
   if (params.min_component_pixels > 0)
-    sk = extraction::RemoveSmallComponents(sk, params.min_component_pixels);
+    sk = extraction::RemoveSmallComponents(sk, params.min_component_pixels, cancel);
   cancel.ThrowIfRequested("the small components");
-  PruneFalseJunctions(sk, side, params);
+  PruneFalseJunctions(sk, side, params, cancel);
   cancel.ThrowIfRequested("the false junctions");
 
   // Thesis 5.2.1: the reference line first, sealed end to end.
@@ -127,8 +131,8 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
 
   // Thesis 5.2.3.3: corners become junctions with a one-stroke stub.
   cancel.ThrowIfRequested("the reference line");
-  result.corners =
-      ExtendCorners(SkeletonGraph::Build(sk, params.graph), params.corners, sk, mask, image);
+  result.corners = ExtendCorners(SkeletonGraph::Build(sk, params.graph, cancel), params.corners, sk,
+                                 mask, image);
 
   // Thesis 5.2.3 and 5.1.4: trace boundary and loops, correct, retrace. The
   // graph of the last round is the final one: a round without repairs leaves
@@ -140,7 +144,7 @@ InterpretationResult Interpret(const cv::Mat& skeleton, pattern::Side side,
     network.reset();  // it refers to the graph
     graph.reset();    // first, so that the new graph can take over its memory
     cancel.ThrowIfRequested("the repair rounds");
-    graph = std::make_unique<SkeletonGraph>(SkeletonGraph::Build(sk, params.graph));
+    graph = std::make_unique<SkeletonGraph>(SkeletonGraph::Build(sk, params.graph, cancel));
     cancel.ThrowIfRequested("the skeleton graph");
     network = std::make_unique<JunctionNetwork>(*graph, side, params.junction);
     loops = TraceLoops(*network);

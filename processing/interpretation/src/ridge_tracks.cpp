@@ -251,13 +251,15 @@ bool TrackParams::IsValid(std::string* error) const {
 }
 
 std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const TrackParams& params,
-                              std::vector<int>* track_of_point) {
+                              std::vector<int>* track_of_point, const Cancellation& cancel,
+                              std::string_view stage) {
   const auto& pts = points.points;
   const int n = static_cast<int>(pts.size());
   std::vector<int> next(n, -1), prev(n, -1);
   const int rows = static_cast<int>(points.row_start.size()) - 1;
   const float reach = static_cast<float>(params.max_step);
   for (int y = 0; y + 1 < rows; ++y) {
+    if (y % 32 == 0) cancel.ThrowIfRequested(stage);
     const int below_end = points.row_start[y + 2];
     int j = points.row_start[y + 1];  // both rows run left to right
     for (int i = points.row_start[y]; i < points.row_start[y + 1]; ++i) {
@@ -285,6 +287,7 @@ std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const Track
   std::vector<Track> tracks;
   if (track_of_point) track_of_point->assign(n, -1);
   for (int i = 0; i < n; ++i) {
+    if (i % 8192 == 0) cancel.ThrowIfRequested(stage);
     if (prev[i] >= 0) continue;
     Track t;
     for (int k = i; k >= 0; k = next[k]) t.points.push_back(k);
@@ -297,12 +300,15 @@ std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const Track
 }
 
 std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
-                                     std::vector<Track> segments, const TrackParams& params) {
+                                     std::vector<Track> segments, const TrackParams& params,
+                                     const Cancellation& cancel) {
   const auto& cp = columns.points;  // x: image row, y: image column
   const int w = params.steep_columns;
   std::vector<Track> out;
   std::vector<char> steep;
+  int cut = 0;
   for (Track& t : segments) {
+    if (++cut % 1024 == 0) cancel.ThrowIfRequested("the segment tracks");
     const int n = static_cast<int>(t.points.size());
     // Every point of a window of w + 1 points (w columns) that climbs too
     // steeply belongs to a steep stretch.
@@ -339,12 +345,15 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
   TrackNetwork net;
   net.rows = std::move(rows);
   net.columns = std::move(columns);
-  net.lines = LinkTracks(net.rows, params, &net.line_of_point);
+  net.lines = LinkTracks(net.rows, params, &net.line_of_point, cancel, "the line tracks");
   cancel.ThrowIfRequested("the line tracks");
-  net.segments = CutSteepStretches(net.columns, LinkTracks(net.columns, params), params);
+  net.segments = CutSteepStretches(
+      net.columns, LinkTracks(net.columns, params, nullptr, cancel, "the segment tracks"), params,
+      cancel);
   cancel.ThrowIfRequested("the segment tracks");
 
   BridgeLineGaps(params, &net);
+  cancel.ThrowIfRequested("the bridges across line gaps");
   FindJunctions(side, params, GapsByRow(net), cancel, &net);
   net.junctions_on_line.assign(net.lines.size(), {});
   for (int i = 0; i < static_cast<int>(net.junctions.size()); ++i)

@@ -496,13 +496,18 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   for (int t : out.reference) is_reference[t] = 1;
   const RowSpacings spacing = MeasureRowSpacings(net, is_reference, params);
   out.row_spacing = spacing.frame;
+  cancel.ThrowIfRequested("the row spacings");
 
   // The links: steps along lines, segments, steps across a line's gap.
   const std::vector<Step> down = StepsDown(net, spacing, params);
   const std::vector<int> across = SegmentPartners(net);
+  cancel.ThrowIfRequested("the steps along lines");
   TrackLinks links(net, spacing, params);
-  links.AddStepsAndSegments(down, across, TrustClosedBricks(down, across));
+  const TrustedLinks trusted = TrustClosedBricks(down, across);
+  cancel.ThrowIfRequested("the closed bricks");
+  links.AddStepsAndSegments(down, across, trusted);
   links.AddLineGaps();
+  cancel.ThrowIfRequested("the links between junctions");
 
   const std::vector<int> seeds = LineZeroSeeds(net, out.reference, spacing);
   if (static_cast<int>(seeds.size()) < params.min_reference_junctions) {
@@ -525,6 +530,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   const Consensus consensus =
       LabelByConsensus(odd_kind, links.links(), seeds, params.min_reference_junctions,
                        {params.min_support, params.max_dissent});
+  cancel.ThrowIfRequested("the consensus of labels");
   if (consensus.p.empty() || std::none_of(consensus.p.begin(), consensus.p.end(),
                                           [](int p) { return p != kUnlabelled; })) {
     out.error = "no reference line (line 0): its junctions do not agree on their labels";

@@ -15,8 +15,10 @@
 #ifndef BSLS_COMMON_CANCELLATION_H_
 #define BSLS_COMMON_CANCELLATION_H_
 
+#include <atomic>
 #include <functional>
 #include <stdexcept>
+#include <string>
 #include <string_view>
 
 namespace bsls {
@@ -41,6 +43,32 @@ class Cancellation {
 
  private:
   std::function<bool()> requested_;
+};
+
+// A Cancellation asked by bands of work that run in parallel (one question
+// per band): once one band hears stop, the bands after it skip their work
+// without asking again, and the stage throws once they are done (an
+// exception must not leave OpenCV's workers).
+class BandStop {
+ public:
+  explicit BandStop(const Cancellation& cancel) : cancel_(cancel) {}
+
+  // True when the caller asked to stop, in this band or an earlier one.
+  bool Requested() {
+    if (stopped_.load(std::memory_order_relaxed)) return true;
+    if (!cancel_.Requested()) return false;
+    stopped_.store(true, std::memory_order_relaxed);
+    return true;
+  }
+  // Throws Cancelled naming `where` when a band heard stop (asks no more).
+  void ThrowIfStopped(std::string_view where) const {
+    if (stopped_.load(std::memory_order_relaxed))
+      throw Cancelled("cancelled during " + std::string(where));
+  }
+
+ private:
+  const Cancellation& cancel_;
+  std::atomic<bool> stopped_{false};
 };
 
 }  // namespace bsls

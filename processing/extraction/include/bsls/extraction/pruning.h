@@ -16,6 +16,8 @@
 #include <opencv2/core.hpp>
 #include <string>
 
+#include "bsls/common/cancellation.h"
+
 namespace bsls::extraction {
 
 // Thesis 4.4, Figure 4.19: the pruning windows. The figure is unreadable in
@@ -64,8 +66,10 @@ struct SpurPruneParams {
 cv::Mat PruneSpurs(const cv::Mat& skeleton, const SpurPruneParams& params = {});
 
 // Removes 8-connected components with fewer than min_pixels set pixels
-// (min_pixels >= 1; 1 keeps everything).
-cv::Mat RemoveSmallComponents(const cv::Mat& binary, int min_pixels);
+// (min_pixels >= 1; 1 keeps everything). Asks `cancel` every few thousand
+// components and between its passes over the image.
+cv::Mat RemoveSmallComponents(const cv::Mat& binary, int min_pixels,
+                              const Cancellation& cancel = {});
 
 }  // namespace bsls::extraction
 

@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/cancellation.h"
+
 namespace bsls::extraction {
 
 struct RidgeParams {
@@ -54,13 +56,16 @@ struct RidgePoints {
 // The ridge points along the rows of `smoothed` (CV_8UC1; the caller smooths,
 // e.g. a Gaussian of 1 px). A plateau (equal neighbours) is one point at its
 // middle. Throws std::invalid_argument for an empty or non-CV_8UC1 image or
-// invalid params.
-RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params = {});
+// invalid params; asks `cancel` once per band of rows (Cancelled).
+RidgePoints FindRidgePoints(const cv::Mat& smoothed, const RidgeParams& params = {},
+                            const Cancellation& cancel = {});
 
 // The same along the columns: FindRidgePoints of the transposed image,
 // without transposing it. A point's x is its sub-pixel row, its y its
-// column, and RidgePoints::Row(x) holds column x's points from top to bottom.
-RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& params = {});
+// column, and RidgePoints::Row(x) holds column x's points from top to bottom;
+// asks `cancel` once per block of columns.
+RidgePoints FindColumnRidgePoints(const cv::Mat& smoothed, const RidgeParams& params = {},
+                                  const Cancellation& cancel = {});
 
 }  // namespace bsls::extraction
 

@@ -94,15 +94,20 @@ struct TrackNetwork {
 // Links ridge points from row to row into tracks: each point to the nearest
 // point of the next row within max_step, each point taken at most once (by
 // the nearer claimant); tracks shorter than min_track are dropped.
-// `track_of_point` (optional) receives each point's track or -1.
+// `track_of_point` (optional) receives each point's track or -1. Asks
+// `cancel` every few dozen rows (Cancelled naming `stage`).
 std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const TrackParams& params,
-                              std::vector<int>* track_of_point = nullptr);
+                              std::vector<int>* track_of_point = nullptr,
+                              const Cancellation& cancel = {},
+                              std::string_view stage = "the tracks");
 
 // Cuts the stretches of `segments` (tracks through `columns`) that climb
 // more than max_segment_slope rows per column over steep_columns or more;
-// pieces shorter than min_track are dropped.
+// pieces shorter than min_track are dropped. Asks `cancel` every thousand
+// segments.
 std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
-                                     std::vector<Track> segments, const TrackParams& params);
+                                     std::vector<Track> segments, const TrackParams& params,
+                                     const Cancellation& cancel = {});
 
 // Links both sets of ridge points and finds the junctions of the brick
 // slide of `side`. Throws std::invalid_argument for invalid params and

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include "bsls/common/cancellation.h"
+
 namespace bsls::interpretation {
 
 struct GraphParams {
@@ -52,8 +54,10 @@ struct SkeletonEdge {
 class SkeletonGraph {
  public:
   // Builds the graph of a CV_8UC1 skeleton (non-zero = line); isolated pixels
-  // are ignored. Throws std::invalid_argument for an empty or non-8-bit image.
-  static SkeletonGraph Build(const cv::Mat& skeleton, const GraphParams& params = {});
+  // are ignored. Throws std::invalid_argument for an empty or non-8-bit image
+  // and Cancelled when `cancel` asks (between the build's steps).
+  static SkeletonGraph Build(const cv::Mat& skeleton, const GraphParams& params = {},
+                             const Cancellation& cancel = {});
 
   const std::vector<SkeletonNode>& nodes() const { return nodes_; }
   const std::vector<SkeletonEdge>& edges() const { return edges_; }

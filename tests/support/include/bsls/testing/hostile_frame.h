@@ -2,13 +2,13 @@
 // deadlines and draining: 2896 x 2896 (8 Mpx, bsls-processd's default pixel
 // budget), every other row the stripes (pitch 15 px), the rows between
 // noise. It decodes to nothing, after about 0.6 s on one core.
-#ifndef BSLS_TESTS_PROCESSING_HOSTILE_FRAME_H_
-#define BSLS_TESTS_PROCESSING_HOSTILE_FRAME_H_
+#ifndef BSLS_TESTING_HOSTILE_FRAME_H_
+#define BSLS_TESTING_HOSTILE_FRAME_H_
 
 #include <cmath>
 #include <opencv2/core.hpp>
 
-namespace bsls::processing::test {
+namespace bsls::testing {
 
 inline cv::Mat HostileFrame() {
   cv::Mat grey(2896, 2896, CV_8UC1);
@@ -20,6 +20,6 @@ inline cv::Mat HostileFrame() {
   return grey;
 }
 
-}  // namespace bsls::processing::test
+}  // namespace bsls::testing
 
-#endif  // BSLS_TESTS_PROCESSING_HOSTILE_FRAME_H_
+#endif  // BSLS_TESTING_HOSTILE_FRAME_H_
