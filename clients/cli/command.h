@@ -17,9 +17,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "bsls/calibration/side_calibration.h"
-#include "bsls/reconstruction/side_pipeline.h"
-
 namespace bsls::cli {
 
 enum ExitCode : int {
@@ -64,22 +61,13 @@ void AddMeasureCommand(CLI::App& app);
 // `slide`, `grab`, `captures`, `preview`.
 void AddDeviceCommands(CLI::App& app);
 
-// The side calibration in a calibration file; CommandError (exit 3) naming
-// the file and the reason when it cannot be used.
-calibration::SideCalibration LoadCalibrationFile(const std::string& path);
-
 // The whole file; CommandError (exit 3) naming `option` and `path` when it
 // cannot be read.
 std::string ReadInputFile(const std::string& path, const std::string& option);
 
-// Loads `image` into *frame (saying on stderr when it was converted to 8-bit
-// grey) and runs one side's pipeline on it; CommandError naming the image for
-// an unusable calibration (exit 3) or a decode that cannot be reconstructed
-// (exit 1). A frame that does not decode comes back with decode.ok == false.
-reconstruction::SideOutcome ProcessFrame(const std::string& image, pattern::Side side,
-                                         const reconstruction::SideGeometry& geometry,
-                                         const reconstruction::SidePipelineParams& params,
-                                         cv::Mat* frame);
+// The whole calibration file, checked: CommandError (exit 3) naming the file
+// and the reason when it cannot be read or is not a calibration.
+std::string ReadCalibrationFile(const std::string& path, const std::string& option);
 
 }  // namespace bsls::cli
 

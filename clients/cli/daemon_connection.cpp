@@ -48,23 +48,6 @@ void AddServerOptions(CLI::App& command, ServiceAddress& address) {
   AddTlsOptions(command, address);
 }
 
-processing::ProcessingClient OpenProcessingClient(const ServiceAddress& address) {
-  processing::ClientOptions options;
-  options.target = address.target;
-  options.tls = TlsOf(address);
-  options.timeout = std::chrono::milliseconds(static_cast<long>(address.timeout_s * 1000));
-  if (!rpc::IsUnixTarget(address.target) && !rpc::IsLoopbackTarget(address.target) &&
-      !options.tls.complete())
-    throw CommandError(kExitUsage, "--server " + address.target +
-                                       " is another machine, which is mutual TLS only: give "
-                                       "--tls-ca, --tls-cert and --tls-key");
-  try {
-    return processing::ProcessingClient(processing::OpenProcessingChannel(options), options);
-  } catch (const rpc::TlsFileError& e) {
-    throw CommandError(kExitInput, e.what());
-  }
-}
-
 void CheckWork(const grpc::Status& status, const std::string& what, const ServiceAddress& address) {
   switch (status.error_code()) {
     case grpc::StatusCode::INVALID_ARGUMENT:
@@ -73,8 +56,11 @@ void CheckWork(const grpc::Status& status, const std::string& what, const Servic
     case grpc::StatusCode::FAILED_PRECONDITION:
       throw CommandError(kExitNotProcessed, what + ": " + status.error_message());
     case grpc::StatusCode::RESOURCE_EXHAUSTED:
-      throw CommandError(kExitUnavailable, what + ": every replica at " + address.target +
-                                               " is busy (" + status.error_message() + ")");
+      throw CommandError(kExitUnavailable,
+                         what + ": " +
+                             (address.target.empty() ? std::string("the processing service here")
+                                                     : "every replica at " + address.target) +
+                             " is busy (" + status.error_message() + ")");
     default:
       CheckCall(status, what, address);
   }

@@ -32,16 +32,12 @@ struct ServiceAddress {
 // the daemon's address defaults to $BSLS_DAEMON, else the system socket.
 void AddDaemonOptions(CLI::App& command, ServiceAddress& address);
 
-// Adds --server (default $BSLS_SERVER; none: the work is done here), the
+// Adds --server (default $BSLS_SERVER; none: the service runs in this
+// process, processing_route.h), the
 // TLS options and --timeout to a command that can run on the processing
 // service. --server takes one address or several for round_robin
 // ("ipv4:127.0.0.1:7001,127.0.0.1:7002", "dns:///processd:7000").
 void AddServerOptions(CLI::App& command, ServiceAddress& address);
-
-// A client of the processing service at `address`; CommandError (exit 2)
-// for TCP to another machine without the TLS files, (exit 3) when a TLS
-// file cannot be read.
-processing::ProcessingClient OpenProcessingClient(const ServiceAddress& address);
 
 // Throws the CommandError that the status of a processing call means: bad
 // input (exit 3), not processed (1), busy or unreachable (5), refused (6),

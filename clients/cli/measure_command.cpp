@@ -16,11 +16,11 @@
 #include <vector>
 
 #include "bsls/common/atomic_file.h"
-#include "bsls/io/surface_file.h"
-#include "bsls/measurement/measurement_error.h"
 #include "bsls/measurement/plan.h"
+#include "bsls/measurement/report.h"
 #include "command.h"
 #include "daemon_connection.h"
+#include "processing_route.h"
 
 namespace bsls::cli {
 namespace {
@@ -37,7 +37,8 @@ struct MeasureOptions {
   bool register_baseline = true;
   std::string json;
   int decimals = 2;
-  ServiceAddress server;  // target empty: measured here
+  bool quiet = false;
+  ServiceAddress server;  // target empty: measured in this process
 };
 
 // Parses "X,Y X,Y ..." (commas between coordinates, spaces or semicolons
@@ -85,9 +86,10 @@ void AddPolygon(const measurement::Polygon2d& polygon, v1::Polygon* out) {
   for (const Eigen::Vector2d& p : polygon) AddPoint(p, out->add_points());
 }
 
-// The same figures measured by the processing service: the surface (and
-// baseline) go up, measurements.json comes back.
-void RunMeasureRemote(const MeasureOptions& o, const measurement::MeasurementPlan& plan) {
+// The figures of `plan`, measured by the processing service (here or the
+// one --server names): the surface (and baseline) go up, measurements.json
+// comes back; a table on stdout and the JSON report.
+void MeasureOnService(const MeasureOptions& o, const measurement::MeasurementPlan& plan) {
   v1::MeasureRequest request;
   request.set_surface_ply(ReadInputFile(o.surface, "surface"));
   if (!o.baseline.empty()) request.set_baseline_ply(ReadInputFile(o.baseline, "--baseline"));
@@ -104,9 +106,9 @@ void RunMeasureRemote(const MeasureOptions& o, const measurement::MeasurementPla
                        : v1::MeasurementPlan::REFERENCE_CUBIC);
   m->set_ring_mm(plan.lesion.ring_width_mm);
   request.set_request_tag(o.surface.substr(0, 256));
-  processing::ProcessingClient client = OpenProcessingClient(o.server);
-  const processing::WorkOutcome out = client.Measure(request, ProgressPrinter(true));
-  CheckWork(out.status, o.surface, o.server);
+  ProcessingRoute route(o.server);
+  const processing::WorkOutcome out = route.client().Measure(request, route.Progress(o.quiet));
+  route.Check(out.status, o.surface);
   nlohmann::json report = {
       {"surface", o.surface},
       {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
@@ -123,7 +125,7 @@ void RunMeasureRemote(const MeasureOptions& o, const measurement::MeasurementPla
   std::cout << measurement::FormatTable(rows, o.decimals);
 }
 
-// Every requested figure, measured; a table on stdout and the JSON report.
+// Every requested figure, checked here and measured on the service.
 void RunMeasure(const MeasureOptions& o) {
   if (o.heights.empty() && o.distances.empty() && o.areas.empty() && o.lesions.empty())
     throw CommandError(kExitUsage,
@@ -156,24 +158,7 @@ void RunMeasure(const MeasureOptions& o) {
                                            "\": a region needs at least 3 points");
     }
   plan.baseline_params.register_rigidly = o.register_baseline;
-  if (!o.server.target.empty()) return RunMeasureRemote(o, plan);
-  const geometry::SurfaceMesh mesh = io::ReadPly(o.surface);
-  if (!o.baseline.empty()) {
-    plan.baseline = io::ReadPly(o.baseline);
-    plan.baseline_name = o.baseline;
-  }
-  measurement::MeasurementOutcome outcome;
-  try {
-    outcome = measurement::MeasurePlan(mesh, plan);
-  } catch (const measurement::MeasurementError& e) {
-    throw CommandError(kExitNotProcessed, o.surface + ": " + e.what());
-  }
-  nlohmann::json report = {
-      {"surface", o.surface},
-      {"baseline", o.baseline.empty() ? nlohmann::json() : nlohmann::json(o.baseline)}};
-  report.update(outcome.report);
-  if (!o.json.empty()) WriteFileAtomically(o.json, report.dump(2) + "\n");
-  std::cout << measurement::FormatTable(outcome.rows, o.decimals);
+  MeasureOnService(o, plan);
 }
 
 }  // namespace
@@ -206,6 +191,7 @@ void AddMeasureCommand(CLI::App& app) {
   cmd->add_option("--decimals", options->decimals, "Decimals in the table")
       ->check(CLI::Range(0, 6))
       ->capture_default_str();
+  cmd->add_flag("-q,--quiet", options->quiet, "No progress on stderr");
   AddServerOptions(*cmd, options->server);
   cmd->callback([options] { RunMeasure(*options); });
 }

@@ -4,19 +4,17 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <optional>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "bsls/calibration/calibration_file.h"
 #include "bsls/common/atomic_file.h"
-#include "bsls/decoder/decode_output.h"
-#include "bsls/decoder/decoder.h"
 #include "bsls/io/frame_file.h"
-#include "bsls/io/surface_file.h"
-#include "bsls/reconstruction/side_pipeline.h"
+#include "bsls/pattern/brick_pattern.h"
 #include "bsls/rpc/frame_message.h"
 #include "command.h"
 #include "daemon_connection.h"
+#include "processing_route.h"
 #include "surface_choices.h"
 
 namespace bsls::cli {
@@ -38,35 +36,10 @@ struct ProcessOptions {
   bool no_repair = false;
   bool json_summary = false;
   bool quiet = false;
-  ServiceAddress server;  // target empty: the work is done here
+  ServiceAddress server;  // target empty: the service in this process
 };
 
 }  // namespace
-
-reconstruction::SideOutcome ProcessFrame(const std::string& image, pattern::Side side,
-                                         const reconstruction::SideGeometry& geometry,
-                                         const reconstruction::SidePipelineParams& params,
-                                         cv::Mat* frame) {
-  io::FrameConversion conversion;
-  *frame = io::LoadGreyFrame(image, &conversion);
-  if (conversion.converted())
-    std::cerr << "bsls: note: " << image << ": " << conversion.Describe() << "\n";
-  try {
-    return reconstruction::ProcessSide(*frame, side, geometry, params);
-  } catch (const std::invalid_argument& e) {
-    throw CommandError(kExitInput, image + ": " + e.what());
-  } catch (const reconstruction::ReconstructionError& e) {
-    throw CommandError(kExitNotProcessed, image + ": " + e.what());
-  }
-}
-
-calibration::SideCalibration LoadCalibrationFile(const std::string& path) {
-  try {
-    return calibration::LoadCalibration(path).calibration;
-  } catch (const calibration::CalibrationFileError& e) {
-    throw CommandError(kExitInput, e.what());
-  }
-}
 
 std::string ReadInputFile(const std::string& path, const std::string& option) {
   std::ifstream in(path, std::ios::binary);
@@ -74,15 +47,21 @@ std::string ReadInputFile(const std::string& path, const std::string& option) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+std::string ReadCalibrationFile(const std::string& path, const std::string& option) {
+  std::string yaml = ReadInputFile(path, option);
+  try {
+    (void)calibration::CalibrationFromYaml(yaml, path);
+  } catch (const calibration::CalibrationFileError& e) {
+    throw CommandError(kExitInput, e.what());
+  }
+  return yaml;
+}
+
 namespace {
 
-// The same job on the processing service: the frame (converted here to 8-bit
-// grey) and the calibration file go up, the contracts' files come back.
-void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
-  if (o.geometric_setup)
-    throw CommandError(kExitUsage, "--geometric-setup runs here only: drop --server");
-  if (!o.skeleton.empty())
-    throw CommandError(kExitUsage, "--skeleton runs here only: drop --server");
+// The request the options ask for: the frame (converted here to 8-bit grey,
+// saying so), the calibration file as it is, the options.
+v1::ProcessFrameRequest ProcessRequest(const ProcessOptions& o, pattern::Side side) {
   io::FrameConversion conversion;
   const cv::Mat frame = io::LoadGreyFrame(o.image, &conversion);
   if (conversion.converted())
@@ -92,9 +71,11 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   request.set_side(side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
   if (!o.calibration.empty())
     *request.mutable_calibration() =
-        processing::ProcessingClient::Inline(ReadInputFile(o.calibration, "--calibration"));
+        processing::ProcessingClient::Inline(ReadCalibrationFile(o.calibration, "--calibration"));
+  request.set_geometric_setup(o.geometric_setup);
   request.set_want_surface(!o.surface.empty());
   request.set_want_overlay(!o.overlay.empty());
+  request.set_want_skeleton(!o.skeleton.empty());
   request.mutable_decode()->set_method(o.method == "thesis" ? v1::DecodeOptions::METHOD_THESIS
                                                             : v1::DecodeOptions::METHOD_MODERN);
   request.mutable_decode()->set_no_repair(o.no_repair);
@@ -105,20 +86,19 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
   ApplySurfaceChoices(o.surface_choices, request.mutable_surface());
   request.mutable_surface()->set_ascii_ply(o.ascii);
   request.set_request_tag(o.image.substr(0, 256));
+  return request;
+}
 
-  processing::ProcessingClient client = OpenProcessingClient(o.server);
-  const processing::WorkOutcome out =
-      client.ProcessFrame(request, ProgressPrinter(o.quiet || o.json_summary));
-  CheckWork(out.status, o.image, o.server);
+// The wall time of `stage` in `result` (0 when it did not run).
+double StageMs(const v1::Result& result, const std::string& stage) {
+  for (const v1::StageTime& t : result.times())
+    if (t.stage() == stage) return t.ms();
+  return 0.0;
+}
+
+// The summary on stdout: one JSON object, or a line (two with a surface).
+void PrintProcessSummary(const ProcessOptions& o, const processing::WorkOutcome& out, bool local) {
   const v1::SideSummary& s = out.result.sides(0);
-  if (!o.calibration.empty() && !s.q_absolute())
-    std::cerr << "bsls: note: " << o.image << ": q stays relative: " << s.rows_note() << "\n";
-  WriteFileAtomically(o.junctions, out.files.at("junctions.json"));
-  if (!o.overlay.empty()) WriteFileAtomically(o.overlay, out.files.at("overlay.png"));
-  if (!o.surface.empty()) WriteFileAtomically(o.surface, out.files.at("surface.ply"));
-  double total_ms = 0;
-  for (const v1::StageTime& t : out.result.times())
-    if (t.stage() == "decode") total_ms = t.ms();
   if (o.json_summary) {
     nlohmann::json j = {{"image", o.image},
                         {"side", o.side},
@@ -128,25 +108,34 @@ void RunProcessRemote(const ProcessOptions& o, pattern::Side side) {
                         {"lines", s.lines()},
                         {"q_absolute", s.q_absolute()},
                         {"repairs", s.repairs()},
-                        {"time_ms", total_ms},
+                        {"label_conflicts", s.label_conflicts()},
+                        {"time_ms", StageMs(out.result, "decode")},
+                        {"extraction_ms", StageMs(out.result, "extraction")},
+                        {"interpretation_ms", StageMs(out.result, "interpretation")},
+                        {"subpixel_ms", StageMs(out.result, "subpixel")},
                         {"replica", out.result.replica()},
                         {"attempts", out.attempts}};
     if (!o.surface.empty())
       j["surface"] = {{"vertices", s.vertices()},
                       {"triangles", s.triangles()},
-                      {"bridged", s.bridged_samples()}};
+                      {"bridged", s.bridged_samples()},
+                      {"dropped_samples", s.dropped_samples()},
+                      {"junctions", s.surface_junctions()},
+                      {"junctions_by_projector", s.junctions_by_projector()},
+                      {"time_ms", StageMs(out.result, "reconstruct")}};
     std::cout << j.dump() << "\n";
-  } else {
-    std::printf(
-        "%s (%s): %u junctions (%u interpolated, %u unlabelled) on %u lines, %u repairs, "
-        "q %s, %.1f ms on %s\n",
-        o.image.c_str(), o.side.c_str(), s.junctions(), s.interpolated_junctions(),
-        s.unlabelled_junctions(), s.lines(), s.repairs(), s.q_absolute() ? "absolute" : "relative",
-        total_ms, out.result.replica().c_str());
-    if (!o.surface.empty())
-      std::printf("%s: %u vertices (%u bridged), %u triangles\n", o.surface.c_str(), s.vertices(),
-                  s.bridged_samples(), s.triangles());
+    return;
   }
+  std::printf(
+      "%s (%s): %u junctions (%u interpolated, %u unlabelled) on %u lines, %u repairs, "
+      "q %s, %.1f ms%s\n",
+      o.image.c_str(), o.side.c_str(), s.junctions(), s.interpolated_junctions(),
+      s.unlabelled_junctions(), s.lines(), s.repairs(), s.q_absolute() ? "absolute" : "relative",
+      StageMs(out.result, "decode"), local ? "" : (" on " + out.result.replica()).c_str());
+  if (!o.surface.empty())
+    std::printf("%s: %u vertices (%u bridged), %u triangles, %.1f ms\n", o.surface.c_str(),
+                s.vertices(), s.bridged_samples(), s.triangles(),
+                StageMs(out.result, "reconstruct"));
 }
 
 void RunProcess(const ProcessOptions& o) {
@@ -158,82 +147,26 @@ void RunProcess(const ProcessOptions& o) {
                        "uncalibrated height formula)");
   if (!o.calibration.empty() && o.geometric_setup)
     throw CommandError(kExitUsage, "--calibration and --geometric-setup exclude each other");
-  if (!o.server.target.empty()) return RunProcessRemote(o, *side);
-  reconstruction::SidePipelineParams params;
-  params.decode.extraction.method = o.method == "thesis" ? extraction::ExtractionMethod::kThesis
-                                                         : extraction::ExtractionMethod::kModern;
-  params.decode.interpretation.enable_repair = !o.no_repair;
-  std::optional<decoder::DecodeChain> named;
-  if (o.chain == "tracks") named = decoder::DecodeChain::kTracks;
-  if (o.chain == "skeleton") named = decoder::DecodeChain::kSkeleton;
-  std::string why;
-  if (!decoder::ChainFor(named, params.decode, &why))
-    throw CommandError(kExitUsage, "--chain tracks: " + why);
-  params.chain = named;
-  ApplySurfaceChoices(o.surface_choices, &params);
-  params.reconstruct = !o.surface.empty();
+  if (o.chain == "tracks" && (o.method == "thesis" || o.no_repair))
+    throw CommandError(kExitUsage,
+                       "--chain tracks: --method thesis and --no-repair are the skeleton "
+                       "chain's options");
+  const v1::ProcessFrameRequest request = ProcessRequest(o, *side);
 
-  std::optional<calibration::SideCalibration> cal;
-  reconstruction::SideGeometry geometry;
-  if (!o.calibration.empty()) {
-    cal = LoadCalibrationFile(o.calibration);
-    geometry = &*cal;
-  } else if (o.geometric_setup) {
-    geometry = reconstruction::GeometricSetupParams{};
-  }
-
-  cv::Mat frame;
-  const reconstruction::SideOutcome outcome =
-      ProcessFrame(o.image, *side, geometry, params, &frame);
-  const decoder::DecodeResult& result = outcome.decode;
+  ProcessingRoute route(o.server);
+  const processing::WorkOutcome out =
+      route.client().ProcessFrame(request, route.Progress(o.quiet || o.json_summary));
   // The skeleton helps to see why a frame failed, so it is written either way.
-  if (!o.skeleton.empty() && !result.skeleton.empty())
-    io::WritePngAtomically(o.skeleton, result.skeleton);
-  if (!result.ok) throw CommandError(kExitNotProcessed, o.image + ": " + result.error);
-  if (cal && !result.q_absolute)
-    std::cerr << "bsls: note: " << o.image << ": q stays relative: " << outcome.rows_note << "\n";
-
-  WriteFileAtomically(o.junctions, decoder::ToJson(result).dump(1) + "\n");
-  if (!o.overlay.empty()) io::WritePngAtomically(o.overlay, decoder::RenderOverlay(frame, result));
-  if (outcome.surface)
-    io::WriteSurface(o.surface, *outcome.surface,
-                     o.ascii ? io::PlyEncoding::kAscii : io::PlyEncoding::kBinaryLittleEndian);
-
-  int interpolated = 0;
-  for (const auto& j : result.junctions) interpolated += j.interpolated;
-  const reconstruction::ReconstructionReport& r = outcome.report;
-  if (o.json_summary) {
-    nlohmann::json s = {{"image", o.image},
-                        {"side", o.side},
-                        {"junctions", result.junctions.size()},
-                        {"interpolated", interpolated},
-                        {"unlabelled", result.unlabelled.size()},
-                        {"lines", result.lines.size()},
-                        {"q_absolute", result.q_absolute},
-                        {"repairs", result.repairs},
-                        {"label_conflicts", result.label_conflicts},
-                        {"time_ms", result.times.total_ms},
-                        {"extraction_ms", result.times.extraction_ms},
-                        {"interpretation_ms", result.times.interpretation_ms},
-                        {"subpixel_ms", result.times.subpixel_ms}};
-    if (outcome.surface)
-      s["surface"] = {
-          {"vertices", r.vertices},       {"triangles", r.triangles},
-          {"bridged", r.bridged_samples}, {"dropped_samples", r.dropped_samples},
-          {"junctions", r.junctions},     {"junctions_by_projector", r.junctions_by_projector},
-          {"time_ms", r.time_ms}};
-    std::cout << s.dump() << "\n";
-  } else {
-    std::printf(
-        "%s (%s): %zu junctions (%d interpolated, %zu unlabelled) on %zu lines, %d repairs, "
-        "q %s, %.1f ms\n",
-        o.image.c_str(), o.side.c_str(), result.junctions.size(), interpolated,
-        result.unlabelled.size(), result.lines.size(), result.repairs,
-        result.q_absolute ? "absolute" : "relative", result.times.total_ms);
-    if (outcome.surface)
-      std::printf("%s: %d vertices (%d bridged), %d triangles, %.1f ms\n", o.surface.c_str(),
-                  r.vertices, r.bridged_samples, r.triangles, r.time_ms);
-  }
+  if (!o.skeleton.empty() && out.files.count("skeleton.png"))
+    WriteFileAtomically(o.skeleton, out.files.at("skeleton.png"));
+  route.Check(out.status, o.image);
+  const v1::SideSummary& s = out.result.sides(0);
+  if ((!o.calibration.empty()) && !s.q_absolute())
+    std::cerr << "bsls: note: " << o.image << ": q stays relative: " << s.rows_note() << "\n";
+  WriteFileAtomically(o.junctions, out.files.at("junctions.json"));
+  if (!o.overlay.empty()) WriteFileAtomically(o.overlay, out.files.at("overlay.png"));
+  if (!o.surface.empty()) WriteSurfaceArtifact(o.surface, out.files, "surface.ply");
+  PrintProcessSummary(o, out, route.local());
 }
 
 }  // namespace
@@ -272,7 +205,7 @@ void AddProcessCommand(CLI::App& app) {
   cmd->add_flag("--no-repair", opts->no_repair,
                 "Skeleton chain: label what is seen; seal no discontinuity");
   cmd->add_flag("--json", opts->json_summary, "Print the summary as one JSON object");
-  cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
+  cmd->add_flag("-q,--quiet", opts->quiet, "No progress on stderr");
   AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunProcess(*opts); });
 }

@@ -7,19 +7,16 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
-#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "bsls/calibration/side_calibration.h"
 #include "bsls/common/atomic_file.h"
 #include "bsls/io/frame_file.h"
-#include "bsls/io/surface_file.h"
 #include "bsls/rpc/frame_message.h"
-#include "bsls/session/session.h"
 #include "command.h"
 #include "daemon_connection.h"
+#include "processing_route.h"
 #include "surface_choices.h"
 
 namespace bsls::cli {
@@ -39,7 +36,7 @@ struct ReconstructOptions {
   bool ascii = false;
   bool quiet = false;
   bool json = false;      // the report on stdout instead of the summary
-  ServiceAddress server;  // target empty: the work is done here
+  ServiceAddress server;  // target empty: the service in this process
 };
 
 // Loads one side's frame (saying when it was converted to 8-bit grey).
@@ -77,16 +74,14 @@ void PrintSessionSummary(const nlohmann::json& report, const std::string& output
               report.at("total_ms").get<double>());
 }
 
-// The same job on the processing service: frames (converted here to 8-bit
-// grey) and calibration files go up, the surfaces and the report come back.
-void RunReconstructRemote(const ReconstructOptions& o) {
+void RunReconstruct(const ReconstructOptions& o) {
   v1::ReconstructSessionRequest request;
   rpc::ToFrameMessage(LoadFrame(o.left_image), request.mutable_left());
   rpc::ToFrameMessage(LoadFrame(o.right_image), request.mutable_right());
-  *request.mutable_left_calibration() =
-      processing::ProcessingClient::Inline(ReadInputFile(o.left_calibration, "--calibration-left"));
+  *request.mutable_left_calibration() = processing::ProcessingClient::Inline(
+      ReadCalibrationFile(o.left_calibration, "--calibration-left"));
   *request.mutable_right_calibration() = processing::ProcessingClient::Inline(
-      ReadInputFile(o.right_calibration, "--calibration-right"));
+      ReadCalibrationFile(o.right_calibration, "--calibration-right"));
   request.set_join(o.join == "shared"     ? v1::ReconstructSessionRequest::JOIN_SHARED
                    : o.join == "features" ? v1::ReconstructSessionRequest::JOIN_FEATURES
                                           : v1::ReconstructSessionRequest::JOIN_AUTO);
@@ -95,9 +90,10 @@ void RunReconstructRemote(const ReconstructOptions& o) {
   request.set_want_side_surfaces(!o.left_surface.empty() || !o.right_surface.empty());
   request.set_request_tag((o.left_image + " + " + o.right_image).substr(0, 256));
 
-  processing::ProcessingClient client = OpenProcessingClient(o.server);
-  const processing::WorkOutcome out = client.ReconstructSession(request, ProgressPrinter(o.quiet));
-  CheckWork(out.status, o.left_image + " + " + o.right_image, o.server);
+  ProcessingRoute route(o.server);
+  const processing::WorkOutcome out =
+      route.client().ReconstructSession(request, route.Progress(o.quiet || o.json));
+  route.Check(out.status, o.left_image + " + " + o.right_image);
   for (const v1::SideSummary& s : out.result.sides())
     if (!s.q_absolute())
       std::cerr << "bsls: note: " << (s.side() == v1::SIDE_LEFT ? o.left_image : o.right_image)
@@ -105,63 +101,11 @@ void RunReconstructRemote(const ReconstructOptions& o) {
   nlohmann::json report = nlohmann::json::parse(out.files.at("report.json"));
   report["left"]["image"] = o.left_image;
   report["right"]["image"] = o.right_image;
-  const auto encoding = o.ascii ? io::PlyEncoding::kAscii : io::PlyEncoding::kBinaryLittleEndian;
-  // PLY comes back; other formats are written here from it.
-  auto write = [&](const std::string& path, const std::string& artifact) {
-    io::WriteSurface(path, io::DecodePly(out.files.at(artifact), artifact), encoding);
-  };
-  if (!o.left_surface.empty()) write(o.left_surface, "left.ply");
-  if (!o.right_surface.empty()) write(o.right_surface, "right.ply");
-  if (!o.report.empty()) WriteFileAtomically(o.report, report.dump(2) + "\n");
-  write(o.output, "surface.ply");
-  if (o.json)
-    std::cout << report.dump() << "\n";
-  else
-    PrintSessionSummary(report, o.output);
-}
-
-void RunReconstruct(const ReconstructOptions& o) {
-  if (!o.server.target.empty()) return RunReconstructRemote(o);
-  const calibration::SideCalibration left_cal = LoadCalibrationFile(o.left_calibration);
-  const calibration::SideCalibration right_cal = LoadCalibrationFile(o.right_calibration);
-  session::SessionParams params;
-  ApplySurfaceChoices(o.surface_choices, &params.side);
-  params.join = o.join == "shared"     ? session::JoinMode::kShared
-                : o.join == "features" ? session::JoinMode::kFeatures
-                                       : session::JoinMode::kAuto;
-  const cv::Mat left_frame = LoadFrame(o.left_image);
-  const cv::Mat right_frame = LoadFrame(o.right_image);
-
-  session::SessionOutcome s;
-  try {
-    s = session::ReconstructSession(left_frame, left_cal, right_frame, right_cal, params);
-  } catch (const session::SessionError& e) {
-    // Name the files the error is about.
-    const std::map<session::SessionPart, std::string> subjects = {
-        {session::SessionPart::kLeftFrame, o.left_image},
-        {session::SessionPart::kRightFrame, o.right_image},
-        {session::SessionPart::kLeftCalibration, o.left_calibration},
-        {session::SessionPart::kRightCalibration, o.right_calibration},
-        {session::SessionPart::kCalibrations, o.left_calibration + " and " + o.right_calibration},
-        {session::SessionPart::kJoin, o.left_image + " + " + o.right_image},
-        {session::SessionPart::kMeasurements, o.left_image + " + " + o.right_image}};
-    const std::string subject = subjects.at(e.part());
-    throw CommandError(
-        e.reason() == session::SessionErrorReason::kInvalidInput ? kExitInput : kExitNotProcessed,
-        subject + ": " + e.what());
-  }
-  for (const auto* side : {&s.left, &s.right})
-    if (!side->decode.q_absolute)
-      std::cerr << "bsls: note: " << (side == &s.left ? o.left_image : o.right_image)
-                << ": q stays relative: " << side->rows_note << "\n";
-  const auto encoding = o.ascii ? io::PlyEncoding::kAscii : io::PlyEncoding::kBinaryLittleEndian;
-  const nlohmann::json report = session::SessionReport(s, o.left_image, o.right_image);
-
   // Side surfaces first: the joined one, written last, says the run is complete.
-  if (!o.left_surface.empty()) io::WriteSurface(o.left_surface, *s.left.surface, encoding);
-  if (!o.right_surface.empty()) io::WriteSurface(o.right_surface, *s.right.surface, encoding);
+  if (!o.left_surface.empty()) WriteSurfaceArtifact(o.left_surface, out.files, "left.ply");
+  if (!o.right_surface.empty()) WriteSurfaceArtifact(o.right_surface, out.files, "right.ply");
   if (!o.report.empty()) WriteFileAtomically(o.report, report.dump(2) + "\n");
-  io::WriteSurface(o.output, s.joined.mesh, encoding);
+  WriteSurfaceArtifact(o.output, out.files, "surface.ply");
   if (o.json)
     std::cout << report.dump() << "\n";
   else
@@ -192,7 +136,7 @@ void AddReconstructCommand(CLI::App& app) {
       ->capture_default_str();
   AddSurfaceChoices(cmd, &opts->surface_choices);
   cmd->add_flag("--ascii", opts->ascii, "Write ASCII PLY instead of binary");
-  cmd->add_flag("-q,--quiet", opts->quiet, "With --server: no progress on stderr");
+  cmd->add_flag("-q,--quiet", opts->quiet, "No progress on stderr");
   cmd->add_flag("--json", opts->json, "Print the report as one JSON object instead of the summary");
   AddServerOptions(*cmd, opts->server);
   cmd->callback([opts] { RunReconstruct(*opts); });

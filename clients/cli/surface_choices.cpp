@@ -14,16 +14,6 @@ void AddSurfaceChoices(CLI::App* cmd, SurfaceChoices* choices) {
   cmd->add_flag("--smooth", choices->smooth, "Smooth along each line (thesis eq. 5.32) first");
 }
 
-void ApplySurfaceChoices(const SurfaceChoices& choices,
-                         reconstruction::SidePipelineParams* params) {
-  params->planes = choices.plane_model == "parallel" ? reconstruction::PlaneModelKind::kParallel
-                                                     : reconstruction::PlaneModelKind::kPerspective;
-  params->reconstruction.mesh.strips = choices.strips == "rows"
-                                           ? reconstruction::StripMethod::kRowPairs
-                                           : reconstruction::StripMethod::kStitched;
-  params->reconstruction.smooth_lines = choices.smooth;
-}
-
 void ApplySurfaceChoices(const SurfaceChoices& choices, v1::SurfaceOptions* options) {
   options->set_plane_model(choices.plane_model == "parallel"
                                ? v1::SurfaceOptions::PLANE_MODEL_PARALLEL

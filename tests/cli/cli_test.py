@@ -6,6 +6,7 @@ Usage: cli_test.py PATH_TO_BSLS
 """
 import json
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -618,6 +619,82 @@ class SurfaceCliTest(unittest.TestCase):
                 self.fail("bsls-processd ended: " + proc.stderr.read())
             time.sleep(0.05)
         self.fail("bsls-processd did not open its socket")
+
+    def test_every_command_gives_the_same_outputs_here_and_on_the_service(self):
+        """One path: process, reconstruct, measure and calibrate build one request and
+        run the same service class, in this process or on bsls-processd. Every file
+        comes out byte for byte the same, and every report and summary (written or
+        printed) the same but for wall times, the replica's name and the attempts."""
+        server = self.start_processd()
+        session = os.path.join(self.dir.name, "left", "session.yaml")
+
+        def outputs(where):
+            def p(name):
+                return self.path(f"one_{where}_{name}")
+            extra = ("--server", server, "-q") if where == "remote" else ()
+            commands = {
+                "process": ("process", self.faces["left"], "--side", "left", "--calibration",
+                            self.calibration, "--junctions", p("j.json"), "--overlay",
+                            p("o.png"), "--skeleton", p("s.png"), "--surface", p("s.ply"),
+                            "--json"),
+                "process_stl": ("process", self.faces["left"], "--side", "left",
+                                "--calibration", self.calibration, "--junctions", p("j2.json"),
+                                "--surface", p("s.stl"), "--ascii"),
+                "geometric": ("process", self.frame, "--side", "left", "--geometric-setup",
+                              "--junctions", p("g.json"), "--surface", p("g.obj"), "--json"),
+                "reconstruct": ("reconstruct", "--left", self.faces["left"], "--right",
+                                self.faces["right"], "--calibration-left", self.calibration,
+                                "--calibration-right", self.right_calibration, "-o",
+                                p("face.ply"), "--left-surface", p("left.obj"),
+                                "--right-surface", p("right.stl"), "--report", p("rep.json"),
+                                "--json"),
+                "measure": ("measure", self.surface, "--height", "0,0", "--area",
+                            "-20,-20 20,-20 20,20 -20,20", "--distance", "-10,0 10,0",
+                            "--json", p("m.json")),
+                "calibrate": ("calibrate", session, "-o", p("cal.yaml"), "--report",
+                              p("cal.json"), "--json"),
+            }
+            printed = {}
+            for name, args in commands.items():
+                r = run(*args, *extra)
+                self.assertEqual(r.returncode, EXIT_OK, (where, name, r.stderr))
+                printed[name] = r.stdout
+            files = {}
+            for f in sorted(os.listdir(self.dir.name)):
+                if f.startswith(f"one_{where}_"):
+                    with open(self.path(f), "rb") as g:
+                        files[f[len(f"one_{where}_"):]] = g.read()
+            return printed, files
+
+        def without_times(value):
+            if isinstance(value, dict):
+                return {k: without_times(v) for k, v in value.items()
+                        if not k.endswith("_ms") and k not in ("replica", "attempts")}
+            if isinstance(value, list):
+                return [without_times(v) for v in value]
+            return value
+
+        here_printed, here_files = outputs("local")
+        there_printed, there_files = outputs("remote")
+        self.assertEqual(sorted(here_files), sorted(there_files))
+        self.assertEqual(len(here_files), 15)
+        for name, data in here_files.items():
+            if name.endswith(".json") and name in ("rep.json", "cal.json", "m.json"):
+                self.assertEqual(without_times(json.loads(data)),
+                                 without_times(json.loads(there_files[name])), name)
+            else:
+                self.assertEqual(data, there_files[name], name)
+        for name, text in here_printed.items():
+            if text.startswith("{"):
+                self.assertEqual(without_times(json.loads(text)),
+                                 without_times(json.loads(there_printed[name])), name)
+            else:  # wall times and the replica's name aside
+                def plain(t):
+                    t = re.sub(r"one_(local|remote)_", "one_", t)
+                    return re.sub(r"[0-9.]+ ms( on [\w.:-]+)?", "ms", t)
+                self.assertEqual(plain(text), plain(there_printed[name]), name)
+        self.assertEqual(json.loads(here_printed["process"])["replica"], "local")
+        self.assertEqual(json.loads(there_printed["process"])["replica"], "cli-test")
 
     def test_process_on_the_service_gives_the_same_files(self):
         server = self.start_processd()

@@ -44,14 +44,20 @@ CHANNEL_OPTIONS = [
 ]
 RETRYABLE = (grpc.StatusCode.UNAVAILABLE, grpc.StatusCode.RESOURCE_EXHAUSTED)
 
-_SIDES = {"left": pb.SIDE_LEFT, "right": pb.SIDE_RIGHT}
-_JOINS = {"auto": pb.ReconstructSessionRequest.JOIN_AUTO,
-          "shared": pb.ReconstructSessionRequest.JOIN_SHARED,
-          "features": pb.ReconstructSessionRequest.JOIN_FEATURES}
-_REFERENCES = {"plane": pb.MeasurementPlan.REFERENCE_PLANE,
-               "quadric": pb.MeasurementPlan.REFERENCE_QUADRIC,
-               "cubic": pb.MeasurementPlan.REFERENCE_CUBIC}
-_MEASUREMENT_KEYS = {"heights", "distances", "areas", "lesions", "reference", "ring_mm"}
+
+
+def _enum_names(enum_type, prefix: str) -> Dict[str, int]:
+    """{name: number} of the values of a proto enum, each name lower case without
+    `prefix` ("JOIN_AUTO" -> "auto"), the UNSPECIFIED value left out: the names the
+    contracts give, read from the protos' descriptors rather than copied here."""
+    return {v.name[len(prefix):].lower(): v.number for v in enum_type.DESCRIPTOR.values
+            if v.name.startswith(prefix) and not v.name.endswith("_UNSPECIFIED")}
+
+
+_SIDES = _enum_names(pb.Side, "SIDE_")
+_JOINS = _enum_names(pb.ReconstructSessionRequest.Join, "JOIN_")
+_REFERENCES = _enum_names(pb.MeasurementPlan.Reference, "REFERENCE_")
+_MEASUREMENT_KEYS = {f.name for f in pb.MeasurementPlan.DESCRIPTOR.fields}
 
 Calibration = Union[bytes, str]  # the file's bytes, or the id "sha256:<hex>" of a cached one
 Point = Tuple[float, float]
@@ -396,7 +402,7 @@ class ProcessingClient:
         # from it cancels the call); decode / surface: the proto's options.
         method = "ProcessFrame"
         if side not in _SIDES:
-            raise _invalid(method, f"side: \"left\" or \"right\", not {side!r}")
+            raise _invalid(method, f"side: one of {sorted(_SIDES)}, not {side!r}")
         request = pb.ProcessFrameRequest(frame=_frame(image, "frame", method), side=_SIDES[side],
                                          want_surface=want_surface, want_overlay=want_overlay,
                                          request_tag=tag)

@@ -41,7 +41,11 @@ grpc::Status ReadWork(Reader* reader, const ProgressCallback& progress, WorkOutc
   }
   if (before_finish) before_finish();
   grpc::Status status = reader->Finish();
-  if (!status.ok()) return status;
+  if (!status.ok()) {
+    // What was sent whole before a refusal (a skeleton that shows why).
+    if (damage.empty()) out->files = artifacts.files();
+    return status;
+  }
   if (!damage.empty()) return grpc::Status(grpc::StatusCode::DATA_LOSS, damage);
   if (!have_result || !artifacts.Unfinished().empty())
     return grpc::Status(
@@ -60,11 +64,16 @@ bool IsRetryable(const grpc::Status& status) {
          status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED;
 }
 
-std::shared_ptr<grpc::Channel> OpenProcessingChannel(const ClientOptions& options) {
+grpc::ChannelArguments ProcessingChannelArguments() {
   grpc::ChannelArguments args;
+  args.SetMaxReceiveMessageSize(kMaxReplyMessageBytes);
+  args.SetMaxSendMessageSize(kMaxRequestMessageBytes);
+  return args;
+}
+
+std::shared_ptr<grpc::Channel> OpenProcessingChannel(const ClientOptions& options) {
+  grpc::ChannelArguments args = ProcessingChannelArguments();
   args.SetLoadBalancingPolicyName("round_robin");
-  args.SetMaxReceiveMessageSize(8 << 20);  // replies are cut into 1 MiB chunks
-  args.SetMaxSendMessageSize(40 << 20);    // two 4096^2 frames
   // A replica that went away is tried again soon after it comes back.
   args.SetInt(GRPC_ARG_INITIAL_RECONNECT_BACKOFF_MS, 200);
   args.SetInt(GRPC_ARG_MAX_RECONNECT_BACKOFF_MS, 2000);

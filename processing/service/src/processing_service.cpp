@@ -239,6 +239,10 @@ void FillSide(const reconstruction::SideOutcome& o, pattern::Side side, v1::Side
   out->set_vertices(static_cast<std::uint32_t>(o.report.vertices));
   out->set_triangles(static_cast<std::uint32_t>(o.report.triangles));
   out->set_bridged_samples(static_cast<std::uint32_t>(o.report.bridged_samples));
+  out->set_label_conflicts(static_cast<std::uint32_t>(d.label_conflicts));
+  out->set_dropped_samples(static_cast<std::uint32_t>(o.report.dropped_samples));
+  out->set_surface_junctions(static_cast<std::uint32_t>(o.report.junctions));
+  out->set_junctions_by_projector(static_cast<std::uint32_t>(o.report.junctions_by_projector));
 }
 
 // SHA-256 of the frame's packed pixels (width * height bytes, as the
@@ -481,6 +485,13 @@ struct ProcessingService::Work {
     if (!rpc::EmitArtifact(name, media_type, bytes, emit))
       throw session::Cancelled("the caller went away while " + name + " was sent");
   }
+  // Sends `image` as a PNG file.
+  void Png(const std::string& name, const cv::Mat& image) {
+    std::vector<unsigned char> png;
+    if (!cv::imencode(".png", image, png)) throw std::runtime_error(name + ": PNG encoding failed");
+    Artifact(name, "image/png",
+             std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
+  }
   void Time(const std::string& stage, double ms) {
     v1::StageTime* t = result.add_times();
     t->set_stage(stage);
@@ -604,8 +615,12 @@ Status ProcessingService::ProcessFrame(grpc::ServerContext* context,
     std::shared_ptr<const CachedCalibration> cal;
     if (request->calibration().source_case() != v1::CalibrationSource::SOURCE_NOT_SET)
       cal = ResolveCalibration(request->calibration(), "calibration");
-    if (request->want_surface() && !cal)
-      Refuse(StatusCode::INVALID_ARGUMENT, "want_surface: needs a calibration");
+    if (cal && request->geometric_setup())
+      Refuse(StatusCode::INVALID_ARGUMENT, "geometric_setup: excludes a calibration");
+    if (request->want_surface() && !cal && !request->geometric_setup())
+      Refuse(StatusCode::INVALID_ARGUMENT,
+             "want_surface: needs a calibration (or geometric_setup, the thesis's uncalibrated "
+             "height formula)");
     reconstruction::SidePipelineParams params = SideParams(request->decode(), request->surface());
     params.reconstruct = request->want_surface();
 
@@ -613,19 +628,17 @@ Status ProcessingService::ProcessFrame(grpc::ServerContext* context,
     w.observer.Report(request->want_surface() ? "decode and reconstruct" : "decode", 0.0);
     reconstruction::SideGeometry geometry;
     if (cal) geometry = &cal->calibration;
+    if (request->geometric_setup()) geometry = reconstruction::GeometricSetupParams{};
     const reconstruction::SideOutcome outcome =
         reconstruction::ProcessSide(grey, side, geometry, params, w.observer.cancellation());
     const decoder::DecodeResult& d = outcome.decode;
+    // The skeleton shows why a frame failed: sent before a refusal too.
+    if (request->want_skeleton() && !d.skeleton.empty()) w.Png("skeleton.png", d.skeleton);
     if (!d.ok) Refuse(StatusCode::FAILED_PRECONDITION, "frame: " + d.error);
     w.observer.CheckCancelled("sending the results");
     w.observer.Report("results", 0.9);
     w.Artifact("junctions.json", "application/json", decoder::ToJson(d).dump(1) + "\n");
-    if (request->want_overlay()) {
-      std::vector<unsigned char> png;
-      cv::imencode(".png", decoder::RenderOverlay(grey, d), png);
-      w.Artifact("overlay.png", "image/png",
-                 std::string_view(reinterpret_cast<const char*>(png.data()), png.size()));
-    }
+    if (request->want_overlay()) w.Png("overlay.png", decoder::RenderOverlay(grey, d));
     if (outcome.surface)
       w.Artifact("surface.ply", "application/x-ply",
                  io::EncodePly(*outcome.surface, request->surface().ascii_ply()

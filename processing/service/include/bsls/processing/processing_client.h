@@ -40,6 +40,14 @@ struct ClientOptions {
   std::chrono::milliseconds backoff{100};     // before the 2nd try, doubled after
 };
 
+// The message caps of the contracts: a request holds at most two 4096^2
+// frames; replies are cut into 1 MiB chunks.
+constexpr int kMaxRequestMessageBytes = 40 << 20;
+constexpr int kMaxReplyMessageBytes = 8 << 20;
+
+// A client's channel arguments with those caps.
+grpc::ChannelArguments ProcessingChannelArguments();
+
 // A channel to the service with round_robin balancing and the message caps
 // of the contracts. Throws rpc::TlsFileError for unusable TLS files and
 // std::invalid_argument for plain TCP to an address that is not loopback.
@@ -48,9 +56,11 @@ std::shared_ptr<grpc::Channel> OpenProcessingChannel(const ClientOptions& option
 // What a work call gave.
 struct WorkOutcome {
   grpc::Status status;
-  v1::Result result;                         // set when status is OK
-  std::map<std::string, std::string> files;  // artifacts by name (OK only)
-  int attempts = 0;                          // tries made
+  v1::Result result;  // set when status is OK
+  // Artifacts by name: all of them when OK; those sent whole before a
+  // refusal otherwise (ProcessFrame's skeleton.png).
+  std::map<std::string, std::string> files;
+  int attempts = 0;  // tries made
 };
 
 using ProgressCallback = std::function<void(const v1::Progress&)>;
