@@ -7,6 +7,7 @@
 #include <set>
 
 #include "bsls/common/sha256.h"
+#include "contract_messages.h"
 
 namespace bsls::service {
 namespace {
@@ -32,23 +33,12 @@ std::string Describe(const grpc::Status& status) {
          status.error_message();
 }
 
-void ToMessage(const framestore::GreyFrame& frame, v1::Frame* out) {
-  out->set_width(static_cast<std::uint32_t>(frame.width));
-  out->set_height(static_cast<std::uint32_t>(frame.height));
-  out->set_stride(static_cast<std::uint32_t>(frame.stride));
-  out->set_pixels(frame.pixels.data(), frame.pixels.size());
-}
-
 nlohmann::json JsonOf(const google::protobuf::Message& message) {
   google::protobuf::util::JsonPrintOptions options;
   options.preserve_proto_field_names = true;
   std::string text;
   (void)google::protobuf::util::MessageToJsonString(message, &text, options);
   return nlohmann::json::parse(text, nullptr, false);
-}
-
-const char* SideName(framestore::Camera camera) {
-  return camera == framestore::Camera::kLeft ? "left" : "right";
 }
 
 // The cameras of a capture that have a side, each with its frame.
@@ -192,8 +182,8 @@ ProcessingQueue::Outcome ProcessingQueue::ProcessOne(const std::string& id, std:
 grpc::Status ProcessingQueue::ReconstructBoth(const std::string& id, const SideFrames& frames,
                                               Processed* out) {
   v1::ReconstructSessionRequest request;
-  ToMessage(*frames.at(framestore::Camera::kLeft), request.mutable_left());
-  ToMessage(*frames.at(framestore::Camera::kRight), request.mutable_right());
+  FillFrame(*frames.at(framestore::Camera::kLeft), true, "", request.mutable_left());
+  FillFrame(*frames.at(framestore::Camera::kRight), true, "", request.mutable_right());
   *request.mutable_left_calibration() =
       processing::ProcessingClient::Inline(options_.left_calibration);
   *request.mutable_right_calibration() =
@@ -218,7 +208,7 @@ grpc::Status ProcessingQueue::ProcessEachSide(const std::string& id, const SideF
   out->provenance.call = "ProcessFrame";
   for (const auto& [camera, frame] : frames) {
     v1::ProcessFrameRequest request;
-    ToMessage(*frame, request.mutable_frame());
+    FillFrame(*frame, true, "", request.mutable_frame());
     request.set_side(camera == framestore::Camera::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
     const std::string& yaml = CalibrationOf(camera);
     if (!yaml.empty()) {
@@ -230,7 +220,8 @@ grpc::Status ProcessingQueue::ProcessEachSide(const std::string& id, const SideF
     const processing::WorkOutcome result = client_->ProcessFrame(request);
     if (!result.status.ok()) return result.status;
     // Both sides without both calibrations: each side's files by its name.
-    const std::string prefix = frames.size() > 1 ? std::string(SideName(camera)) + "." : "";
+    const std::string prefix =
+        frames.size() > 1 ? std::string(framestore::ToString(camera)) + "." : "";
     for (const auto& [name, bytes] : result.files) out->files[prefix + name] = bytes;
     out->provenance.results.push_back(JsonOf(result.result));
     out->provenance.replica = result.result.replica();
@@ -243,8 +234,9 @@ grpc::Status ProcessingQueue::ProcessEachSide(const std::string& id, const SideF
 void ProcessingQueue::KeepCalibration(framestore::Camera camera, Processed* out) const {
   const std::string& yaml = CalibrationOf(camera);
   if (yaml.empty()) return;
-  out->provenance.calibrations[SideName(camera)] = "sha256:" + Sha256Hex(yaml);  // the service's id
-  out->files[std::string("calibration-") + SideName(camera) + ".yaml"] = yaml;
+  out->provenance.calibrations[framestore::ToString(camera)] =
+      "sha256:" + Sha256Hex(yaml);  // the service's id
+  out->files[std::string("calibration-") + framestore::ToString(camera) + ".yaml"] = yaml;
 }
 
 ProcessingQueue::Outcome ProcessingQueue::Failed(const std::string& id, const grpc::Status& status,
