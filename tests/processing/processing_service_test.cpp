@@ -6,6 +6,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <thread>
@@ -403,6 +405,68 @@ TEST(ProcessingService, AFullPoolRefusesAtOnce) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   EXPECT_TRUE(s.Client().ProcessFrame(FaceRequest(pattern::Side::kLeft, false)).status.ok());
+}
+
+// A ProcessFrame call read on gRPC's callback client: no thread of the
+// test's waits for it.
+class FrameCall final : public grpc::ClientReadReactor<v1::WorkEvent> {
+ public:
+  FrameCall(InProcessService& s, const v1::ProcessFrameRequest& request) : request_(request) {
+    s.stub().async()->ProcessFrame(&context_, &request_, this);
+    StartRead(&event_);
+    StartCall();
+  }
+  void OnReadDone(bool ok) override {
+    if (ok) StartRead(&event_);
+  }
+  void OnDone(const grpc::Status& status) override { done_.set_value(status); }
+  // The call's status once it ended.
+  grpc::Status Wait() { return ended_.get(); }
+
+ private:
+  grpc::ClientContext context_;
+  v1::ProcessFrameRequest request_;
+  v1::WorkEvent event_;
+  std::promise<grpc::Status> done_;
+  std::future<grpc::Status> ended_ = done_.get_future();
+};
+
+// Threads of this process now.
+int ThreadCount() {
+  return static_cast<int>(
+      std::distance(fs::directory_iterator("/proc/self/task"), fs::directory_iterator()));
+}
+
+// The work calls are on the callback API and run on the pool's own
+// workers: calls waiting for a worker hold no thread (on the synchronous
+// API each held a handler thread until it got one).
+TEST(ProcessingService, CallsWaitingForAWorkerHoldNoThread) {
+  ProcessingServiceOptions options;
+  options.workers = 1;
+  options.queue = 12;
+  InProcessService s(options);
+  ASSERT_TRUE(s.Client().ProcessFrame(FaceRequest(pattern::Side::kLeft, false)).status.ok());
+  const int before = ThreadCount();
+  v1::ProcessFrameRequest slow;
+  *slow.mutable_frame() = FrameMessage(testing::HostileFrame());
+  slow.set_side(v1::SIDE_LEFT);
+  std::vector<std::unique_ptr<FrameCall>> calls;
+  calls.push_back(std::make_unique<FrameCall>(s, slow));  // holds the one worker a while
+  for (int i = 0; i < 500 && s.service().Stats().busy == 0; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  for (int i = 0; i < 12; ++i)
+    calls.push_back(std::make_unique<FrameCall>(s, FaceRequest(pattern::Side::kLeft, false)));
+  WorkPoolStats stats;
+  for (int i = 0; i < 500; ++i) {
+    stats = s.service().Stats();
+    if (stats.busy == 1 && stats.waiting == 12) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  const int during = ThreadCount();
+  EXPECT_EQ(stats.waiting, 12);
+  EXPECT_LE(during - before, 3) << before << " threads before, " << during << " with 12 waiting";
+  EXPECT_EQ(calls.front()->Wait().error_code(), StatusCode::FAILED_PRECONDITION);  // no pattern
+  for (std::size_t i = 1; i < calls.size(); ++i) EXPECT_TRUE(calls[i]->Wait().ok()) << i;
 }
 
 TEST(ProcessingService, ACallPastItsDeadlineStops) {

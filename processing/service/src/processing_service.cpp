@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <future>
 #include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
@@ -27,6 +28,7 @@
 #include "bsls/rpc/frame_message.h"
 #include "bsls/rpc/server_limits.h"
 #include "bsls/session/session.h"
+#include "work_stream.h"
 
 namespace bsls::processing {
 namespace {
@@ -475,7 +477,7 @@ std::shared_ptr<const CachedCalibration> ProcessingService::ResolveCalibration(
 
 // What a work call's body gets: where to send events and how to observe.
 struct ProcessingService::Work {
-  const Emit& emit;
+  Emit emit;  // sends an event; false when the caller went away
   session::WorkObserver observer;
   v1::Result result;
   std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
@@ -501,8 +503,8 @@ struct ProcessingService::Work {
 
 ProcessingService::ProcessingService(ProcessingServiceOptions options)
     : options_(std::move(options)),
-      pool_(options_.workers, options_.queue),
-      calibrations_(options_.calibration_cache_entries) {
+      calibrations_(options_.calibration_cache_entries),
+      pool_(options_.workers, options_.queue) {
   if (options_.replica.empty()) options_.replica = DefaultReplicaName();
   // Calibrate's messages are parsed by CalibrateUpload, not by gRPC. The
   // generated service adds its methods in the .proto's order.
@@ -522,76 +524,95 @@ ProcessingService::ProcessingService(ProcessingServiceOptions options)
 
 void ProcessingService::BeginDrain() { draining_ = true; }
 
-Status ProcessingService::RunWork(grpc::ServerContext* context, const std::string& call,
-                                  const Emit& emit, const std::function<void(Work&)>& prepare,
-                                  const std::function<void(Work&)>& work) {
-  if (draining_) return Status(StatusCode::UNAVAILABLE, "the service is shutting down");
-  std::optional<WorkPool::Ticket> ticket = pool_.TryAdmit();
-  // What an admitted call allocated goes back to the system when it ends
-  // (glibc keeps freed blocks otherwise; a burst of calls would leave the
-  // replica large).
-  struct TrimOnExit {
-    bool admitted;
-    ~TrimOnExit() {
-      if (admitted) rpc::ReturnFreedMemory();
-    }
-  } trim{ticket.has_value()};
-  if (!ticket) {
-    const WorkPoolStats s = pool_.Stats();
-    return Status(StatusCode::RESOURCE_EXHAUSTED,
-                  "replica " + options_.replica + " is full: " + std::to_string(s.workers) +
-                      " workers and " + std::to_string(s.queue) +
-                      " queue places taken; retry later or on another replica");
-  }
+// What a work call's checks need: its name, whether its caller gave up
+// (cancelled, deadline, drain) and the status that says which.
+struct ProcessingService::CallState {
+  std::string name;
+  std::function<bool()> gave_up;
+  std::function<Status()> stopped;
+};
+
+namespace {
+
+// The call state of `context`'s call; `cancelled` adds what the transport
+// knows beyond the context (a failed write).
+template <typename Context>
+std::function<bool()> GaveUp(Context* context, const std::atomic<bool>& draining,
+                             std::function<bool()> cancelled = {}) {
   const auto deadline = context->deadline();
-  auto gave_up = [this, context, deadline] {
-    return context->IsCancelled() || draining_ || std::chrono::system_clock::now() > deadline;
+  return [context, &draining, deadline, cancelled = std::move(cancelled)] {
+    return context->IsCancelled() || draining || std::chrono::system_clock::now() > deadline ||
+           (cancelled && cancelled());
   };
-  auto stopped_status = [this, context, deadline, &call] {
+}
+
+template <typename Context>
+std::function<Status()> Stopped(Context* context, const std::atomic<bool>& draining,
+                                const std::string& call) {
+  const auto deadline = context->deadline();
+  return [context, &draining, deadline, call] {
     if (std::chrono::system_clock::now() > deadline)
       return Status(StatusCode::DEADLINE_EXCEEDED, call + ": the deadline passed; work stopped");
-    if (draining_ && !context->IsCancelled())
+    if (draining && !context->IsCancelled())
       return Status(StatusCode::UNAVAILABLE, call + ": the service is shutting down; work stopped");
     return Status(StatusCode::CANCELLED, call + ": cancelled; work stopped");
   };
-  v1::WorkEvent queued;
-  queued.mutable_progress()->set_stage("queued");
-  if (!emit(queued)) return stopped_status();
+}
 
-  Work w{emit, {}, {}};
-  w.observer.cancelled = gave_up;
-  w.observer.progress = [&emit](std::string_view stage, double fraction) {
-    v1::WorkEvent event;
-    event.mutable_progress()->set_stage(std::string(stage));
-    event.mutable_progress()->set_fraction(fraction);
-    emit(event);
-  };
+v1::WorkEvent Progress(std::string_view stage, double fraction) {
+  v1::WorkEvent event;
+  event.mutable_progress()->set_stage(std::string(stage));
+  event.mutable_progress()->set_fraction(fraction);
+  return event;
+}
+
+}  // namespace
+
+Status ProcessingService::Admit(std::optional<WorkPool::Place>* place) {
+  if (draining_) return Status(StatusCode::UNAVAILABLE, "the service is shutting down");
+  if (std::optional<WorkPool::Place> admitted = pool_.TryAdmit()) {
+    place->emplace(std::move(*admitted));
+    return Status::OK;
+  }
+  const WorkPoolStats s = pool_.Stats();
+  return Status(StatusCode::RESOURCE_EXHAUSTED,
+                "replica " + options_.replica + " is full: " + std::to_string(s.workers) +
+                    " workers and " + std::to_string(s.queue) +
+                    " queue places taken; retry later or on another replica");
+}
+
+Status ProcessingService::Guarded(const CallState& call, const std::function<void()>& body) {
   try {
-    if (prepare) prepare(w);
-    if (!ticket->WaitForWorker(gave_up)) return stopped_status();
-    work(w);
+    body();
   } catch (const Refusal& r) {
     return r.status;
   } catch (const session::Cancelled&) {
-    return stopped_status();
+    return call.stopped();
   } catch (const session::SessionError& e) {
     return Status(e.reason() == session::SessionErrorReason::kInvalidInput
                       ? StatusCode::INVALID_ARGUMENT
                       : StatusCode::FAILED_PRECONDITION,
                   e.what());
   } catch (const calibration::CalibrationError& e) {
-    if (e.reason() == calibration::CalibrationErrorReason::kCancelled) return stopped_status();
+    if (e.reason() == calibration::CalibrationErrorReason::kCancelled) return call.stopped();
     return Status(CodeOf(e.reason()), e.what());
   } catch (const reconstruction::ReconstructionError& e) {
     return Status(StatusCode::FAILED_PRECONDITION, e.what());
   } catch (const std::invalid_argument& e) {
     return Status(StatusCode::INVALID_ARGUMENT, e.what());
   } catch (const std::bad_alloc&) {
-    return Status(StatusCode::RESOURCE_EXHAUSTED, call + ": out of memory");
+    return Status(StatusCode::RESOURCE_EXHAUSTED, call.name + ": out of memory");
   } catch (const std::exception& e) {
-    spdlog::error("{}: internal error: {}", call, e.what());
-    return Status(StatusCode::INTERNAL, call + ": internal error: " + e.what());
+    spdlog::error("{}: internal error: {}", call.name, e.what());
+    return Status(StatusCode::INTERNAL, call.name + ": internal error: " + e.what());
   }
+  return Status::OK;
+}
+
+Status ProcessingService::Perform(const CallState& call, Work& w,
+                                  const std::function<void(Work&)>& work) {
+  if (call.gave_up()) return call.stopped();
+  if (Status s = Guarded(call, [&] { work(w); }); !s.ok()) return s;
   w.result.set_software_version(options_.software_version);
   w.result.set_replica(options_.replica);
   w.Time("total",
@@ -599,15 +620,79 @@ Status ProcessingService::RunWork(grpc::ServerContext* context, const std::strin
              .count());
   v1::WorkEvent done;
   *done.mutable_result() = std::move(w.result);
-  if (!emit(done)) return stopped_status();
+  if (!w.emit(done)) return call.stopped();
   return Status::OK;
 }
 
-Status ProcessingService::ProcessFrame(grpc::ServerContext* context,
-                                       const v1::ProcessFrameRequest* request,
-                                       grpc::ServerWriter<v1::WorkEvent>* writer) {
-  const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
-  return RunWork(context, "ProcessFrame", emit, {}, [&](Work& w) {
+grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::StartWork(
+    grpc::CallbackServerContext* context, const std::string& call,
+    std::function<void(Work&)> work) {
+  auto* stream = new internal::WorkStream();
+  std::optional<WorkPool::Place> place;
+  if (Status refused = Admit(&place); !refused.ok()) {
+    stream->End(refused);
+    return stream;
+  }
+  auto state = std::make_shared<CallState>(
+      CallState{call, GaveUp(context, draining_, [stream] { return stream->cancelled(); }),
+                Stopped(context, draining_, call)});
+  // Cancelled while it waits: the job leaves the queue and the call ends now.
+  stream->SetOnCancel([this, number = place->number()] { pool_.Cancel(number); });
+  stream->Push(Progress("queued", 0.0));
+  WorkPool::Job job;
+  job.run = [this, stream, state, work = std::move(work)] {
+    Work w{[stream](const v1::WorkEvent& e) { return stream->Push(e); }, {}, {}};
+    w.observer.cancelled = state->gave_up;
+    w.observer.progress = [stream](std::string_view stage, double fraction) {
+      stream->Push(Progress(stage, fraction));
+    };
+    Status status = Perform(*state, w, work);
+    // What the call allocated goes back to the system (glibc keeps freed
+    // blocks otherwise; a burst of calls would leave the replica large).
+    rpc::ReturnFreedMemory();
+    // The status goes out once the worker counts as free; the last use of
+    // the stream.
+    return std::function<void()>([stream, status] { stream->End(status); });
+  };
+  job.dropped = [stream, state] { stream->End(state->stopped()); };
+  pool_.Start(std::move(*place), std::move(job));
+  return stream;
+}
+
+Status ProcessingService::RunWaiting(grpc::ServerContext* context, const std::string& call,
+                                     const Emit& emit, const std::function<void(Work&)>& prepare,
+                                     const std::function<void(Work&)>& work) {
+  std::optional<WorkPool::Place> place;
+  if (Status refused = Admit(&place); !refused.ok()) return refused;
+  const CallState state{call, GaveUp(context, draining_), Stopped(context, draining_, call)};
+  if (!emit(Progress("queued", 0.0))) return state.stopped();
+  Work w{emit, {}, {}};
+  w.observer.cancelled = state.gave_up;
+  w.observer.progress = [&emit](std::string_view stage, double fraction) {
+    emit(Progress(stage, fraction));
+  };
+  if (Status s = Guarded(state, [&] { prepare(w); }); !s.ok()) return s;
+  // The work runs on a worker; this thread waits for it, and takes it out
+  // of the queue when the caller gives up before it started.
+  std::promise<Status> done;
+  std::future<Status> status = done.get_future();
+  const std::uint64_t number = place->number();
+  WorkPool::Job job;
+  job.run = [&] {
+    Status s = Perform(state, w, work);
+    rpc::ReturnFreedMemory();
+    return std::function<void()>([&done, s] { done.set_value(s); });
+  };
+  job.dropped = [&] { done.set_value(state.stopped()); };
+  pool_.Start(std::move(*place), std::move(job));
+  while (status.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready)
+    if (state.gave_up()) pool_.Cancel(number);
+  return status.get();
+}
+
+grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ProcessFrame(
+    grpc::CallbackServerContext* context, const v1::ProcessFrameRequest* request) {
+  return StartWork(context, "ProcessFrame", [this, request](Work& w) {
     // Every field is checked before any work.
     const cv::Mat grey = FrameOf(request->frame(), "frame", options_.max_frame_pixels);
     const pattern::Side side = SideOf(request->side(), "side");
@@ -656,11 +741,9 @@ Status ProcessingService::ProcessFrame(grpc::ServerContext* context,
   });
 }
 
-Status ProcessingService::ReconstructSession(grpc::ServerContext* context,
-                                             const v1::ReconstructSessionRequest* request,
-                                             grpc::ServerWriter<v1::WorkEvent>* writer) {
-  const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
-  return RunWork(context, "ReconstructSession", emit, {}, [&](Work& w) {
+grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ReconstructSession(
+    grpc::CallbackServerContext* context, const v1::ReconstructSessionRequest* request) {
+  return StartWork(context, "ReconstructSession", [this, request](Work& w) {
     const cv::Mat left = FrameOf(request->left(), "left", options_.max_frame_pixels);
     const cv::Mat right = FrameOf(request->right(), "right", options_.max_frame_pixels);
     CheckTag(request->request_tag());
@@ -728,10 +811,9 @@ Status ProcessingService::ReconstructSession(grpc::ServerContext* context,
   });
 }
 
-Status ProcessingService::Measure(grpc::ServerContext* context, const v1::MeasureRequest* request,
-                                  grpc::ServerWriter<v1::WorkEvent>* writer) {
-  const Emit emit = [writer](const v1::WorkEvent& e) { return writer->Write(e); };
-  return RunWork(context, "Measure", emit, {}, [&](Work& w) {
+grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::Measure(
+    grpc::CallbackServerContext* context, const v1::MeasureRequest* request) {
+  return StartWork(context, "Measure", [this, request](Work& w) {
     CheckTag(request->request_tag());
     measurement::MeasurementPlan plan = PlanOf(request->measurements(), options_.max_measurements);
     if (plan.empty())
@@ -796,7 +878,7 @@ Status ProcessingService::CalibrateUpload(
     w.observer.Report("upload", 0.0);
     ReceiveUploadFiles(stream, folder.path(), options_, w.observer);
   };
-  return RunWork(context, "Calibrate", emit, upload, [&](Work& w) {
+  return RunWaiting(context, "Calibrate", emit, upload, [&](Work& w) {
     const ScratchFolder& folder = *scratch;
     // Paths in errors are the client's, not the scratch folder's.
     const std::string prefix = folder.path().string() + "/";

@@ -2,22 +2,74 @@
 
 #include <algorithm>
 #include <cassert>
+#include <utility>
 
 namespace bsls::processing {
 
 WorkPool::WorkPool(int workers, int queue) : workers_(workers), queue_(queue) {
   assert(workers >= 1 && queue >= 0);
+  for (int i = 0; i < workers; ++i) threads_.emplace_back([this] { Work(); });
 }
 
-std::optional<WorkPool::Ticket> WorkPool::TryAdmit() {
+WorkPool::~WorkPool() {
+  std::map<std::uint64_t, Job> dropped;
+  {
+    std::lock_guard lock(mutex_);
+    stopping_ = true;
+    dropped.swap(ready_);
+    for (const auto& [number, job] : dropped)
+      waiting_.erase(std::find(waiting_.begin(), waiting_.end(), number));
+  }
+  changed_.notify_all();
+  for (auto& [number, job] : dropped)
+    if (job.dropped) job.dropped();
+  for (std::thread& t : threads_) t.join();
+}
+
+std::optional<WorkPool::Place> WorkPool::TryAdmit() {
   std::lock_guard lock(mutex_);
-  if (busy_ + static_cast<int>(waiting_.size()) >= workers_ + queue_) {
+  if (stopping_ || busy_ + static_cast<int>(waiting_.size()) >= workers_ + queue_) {
     ++rejected_;
     return std::nullopt;
   }
   const std::uint64_t number = next_number_++;
   waiting_.push_back(number);
-  return Ticket(this, number);
+  return Place(this, number);
+}
+
+void WorkPool::Start(Place place, Job job) {
+  assert(place.pool_ == this);
+  place.pool_ = nullptr;  // the job holds the place from here
+  bool drop = false;
+  {
+    std::lock_guard lock(mutex_);
+    if (stopping_) {
+      waiting_.erase(std::find(waiting_.begin(), waiting_.end(), place.number_));
+      drop = true;
+    } else {
+      ready_.emplace(place.number_, std::move(job));
+    }
+  }
+  if (drop) {
+    if (job.dropped) job.dropped();
+    return;
+  }
+  changed_.notify_one();
+}
+
+bool WorkPool::Cancel(std::uint64_t number) {
+  Job job;
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = ready_.find(number);
+    if (it == ready_.end()) return false;
+    job = std::move(it->second);
+    ready_.erase(it);
+    waiting_.erase(std::find(waiting_.begin(), waiting_.end(), number));
+  }
+  changed_.notify_all();
+  if (job.dropped) job.dropped();
+  return true;
 }
 
 WorkPoolStats WorkPool::Stats() const {
@@ -25,52 +77,48 @@ WorkPoolStats WorkPool::Stats() const {
   return {workers_, queue_, busy_, static_cast<int>(waiting_.size()), completed_, rejected_};
 }
 
-void WorkPool::Leave(std::uint64_t number, bool working) {
+void WorkPool::Leave(std::uint64_t number) {
   {
     std::lock_guard lock(mutex_);
-    if (working) {
-      --busy_;
-      ++completed_;
-    } else {
-      const auto it = std::find(waiting_.begin(), waiting_.end(), number);
-      if (it != waiting_.end()) waiting_.erase(it);
-    }
+    const auto it = std::find(waiting_.begin(), waiting_.end(), number);
+    if (it != waiting_.end()) waiting_.erase(it);
   }
   changed_.notify_all();
 }
 
-WorkPool::Ticket::Ticket(Ticket&& other) noexcept
-    : pool_(other.pool_), number_(other.number_), working_(other.working_) {
+// One worker: the started job of the earliest place, run without the lock,
+// until the pool stops.
+void WorkPool::Work() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    changed_.wait(lock, [this] { return stopping_ || !ready_.empty(); });
+    if (ready_.empty()) return;  // stopping, nothing left
+    auto first = ready_.begin();
+    Job job = std::move(first->second);
+    waiting_.erase(std::find(waiting_.begin(), waiting_.end(), first->first));
+    ready_.erase(first);
+    ++busy_;
+    lock.unlock();
+    std::function<void()> then = job.run();
+    job = {};  // what the job held goes before the worker counts as free
+    lock.lock();
+    --busy_;
+    ++completed_;
+    if (then) {
+      lock.unlock();
+      then();
+      then = {};
+      lock.lock();
+    }
+  }
+}
+
+WorkPool::Place::Place(Place&& other) noexcept : pool_(other.pool_), number_(other.number_) {
   other.pool_ = nullptr;
 }
 
-WorkPool::Ticket::~Ticket() {
-  if (pool_ != nullptr) pool_->Leave(number_, working_);
-}
-
-bool WorkPool::Ticket::WaitForWorker(const std::function<bool()>& cancelled,
-                                     std::chrono::milliseconds poll) {
-  assert(pool_ != nullptr && !working_);
-  std::unique_lock lock(pool_->mutex_);
-  while (true) {
-    if (pool_->busy_ < pool_->workers_ && pool_->waiting_.front() == number_) {
-      pool_->waiting_.pop_front();
-      ++pool_->busy_;
-      working_ = true;
-      lock.unlock();
-      pool_->changed_.notify_all();  // the next in line may be served too
-      return true;
-    }
-    lock.unlock();
-    if (cancelled && cancelled()) {
-      WorkPool* pool = pool_;
-      pool_ = nullptr;
-      pool->Leave(number_, false);
-      return false;
-    }
-    lock.lock();
-    pool_->changed_.wait_for(lock, poll);
-  }
+WorkPool::Place::~Place() {
+  if (pool_ != nullptr) pool_->Leave(number_);
 }
 
 }  // namespace bsls::processing

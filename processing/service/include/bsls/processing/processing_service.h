@@ -4,13 +4,19 @@
 //
 // Every work call takes a place in the bounded WorkPool before it does
 // anything costly (RESOURCE_EXHAUSTED at once when there is none), waits for
-// a worker, and runs on its own handler thread, checking between stages
-// whether the caller cancelled, the deadline passed or the service is
-// draining; any of these stops the work. Requests are checked completely
-// before the work starts: a bad field is INVALID_ARGUMENT naming it.
+// one of the pool's workers, and runs there, checking between stages and
+// inside the long ones whether the caller cancelled, the deadline passed or
+// the service is draining; any of these stops the work. Requests are
+// checked completely before the work starts: a bad field is
+// INVALID_ARGUMENT naming it.
 //
-// Thread-safety: the handlers run concurrently on gRPC's threads; BeginDrain
-// and Stats are safe from any thread.
+// ProcessFrame, ReconstructSession and Measure are on gRPC's callback API:
+// their progress and files go out from the worker through a reactor, one
+// write at a time, and a waiting call holds no thread. Calibrate's upload is
+// read on its handler thread, which then waits for the work.
+//
+// Thread-safety: the handlers run concurrently on gRPC's threads, the work
+// on the pool's; BeginDrain and Stats are safe from any thread.
 #ifndef BSLS_PROCESSING_PROCESSING_SERVICE_H_
 #define BSLS_PROCESSING_PROCESSING_SERVICE_H_
 
@@ -19,6 +25,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bsls/processing/calibration_cache.h"
@@ -46,7 +53,10 @@ struct ProcessingServiceOptions {
   std::int64_t max_frame_pixels = std::int64_t{8} << 20;
 };
 
-class ProcessingService final : public v1::Processing::Service {
+class ProcessingService final
+    : public v1::Processing::WithCallbackMethod_ProcessFrame<
+          v1::Processing::WithCallbackMethod_ReconstructSession<
+              v1::Processing::WithCallbackMethod_Measure<v1::Processing::Service>>> {
  public:
   explicit ProcessingService(ProcessingServiceOptions options);
 
@@ -58,13 +68,12 @@ class ProcessingService final : public v1::Processing::Service {
   // The calibration cache (for tests).
   CalibrationCache& calibrations() { return calibrations_; }
 
-  grpc::Status ProcessFrame(grpc::ServerContext* context, const v1::ProcessFrameRequest* request,
-                            grpc::ServerWriter<v1::WorkEvent>* writer) override;
-  grpc::Status ReconstructSession(grpc::ServerContext* context,
-                                  const v1::ReconstructSessionRequest* request,
-                                  grpc::ServerWriter<v1::WorkEvent>* writer) override;
-  grpc::Status Measure(grpc::ServerContext* context, const v1::MeasureRequest* request,
-                       grpc::ServerWriter<v1::WorkEvent>* writer) override;
+  grpc::ServerWriteReactor<v1::WorkEvent>* ProcessFrame(
+      grpc::CallbackServerContext* context, const v1::ProcessFrameRequest* request) override;
+  grpc::ServerWriteReactor<v1::WorkEvent>* ReconstructSession(
+      grpc::CallbackServerContext* context, const v1::ReconstructSessionRequest* request) override;
+  grpc::ServerWriteReactor<v1::WorkEvent>* Measure(grpc::CallbackServerContext* context,
+                                                   const v1::MeasureRequest* request) override;
   // Calibrate's handler (the constructor puts it in the generated one's
   // place): the upload's messages arrive as bytes and are parsed here, so
   // that one that is not a CalibrateRequest is refused with INVALID_ARGUMENT
@@ -84,13 +93,26 @@ class ProcessingService final : public v1::Processing::Service {
  private:
   using Emit = std::function<bool(const v1::WorkEvent&)>;
   struct Work;
+  struct CallState;
 
-  // Admission, `prepare` (may be empty: what a call does while queued, such
-  // as taking an upload), the wait for a worker, the work and the mapping of
-  // exceptions to statuses: shared by the three work calls.
-  grpc::Status RunWork(grpc::ServerContext* context, const std::string& call, const Emit& emit,
-                       const std::function<void(Work&)>& prepare,
-                       const std::function<void(Work&)>& work);
+  // The refusal of a call the pool cannot take now (draining or full), or
+  // OK with its place in *place.
+  grpc::Status Admit(std::optional<WorkPool::Place>* place);
+  // The callback calls' common part: admission, `work` on a worker through
+  // a WorkStream, the status.
+  grpc::ServerWriteReactor<v1::WorkEvent>* StartWork(grpc::CallbackServerContext* context,
+                                                     const std::string& call,
+                                                     std::function<void(Work&)> work);
+  // Runs `body` and maps what it throws to a status (OK when it returns).
+  grpc::Status Guarded(const CallState& call, const std::function<void()>& body);
+  // Calibrate's: admission, `prepare` on the handler thread (taking the
+  // upload while the call holds its place), then `work` on a worker while
+  // the handler thread waits.
+  grpc::Status RunWaiting(grpc::ServerContext* context, const std::string& call, const Emit& emit,
+                          const std::function<void(Work&)>& prepare,
+                          const std::function<void(Work&)>& work);
+  // `work` under Guarded, then the result event; the call's status.
+  grpc::Status Perform(const CallState& call, Work& w, const std::function<void(Work&)>& work);
 
   // The calibration `source` names (cached on the way); throws the refusal
   // (NOT_FOUND, INVALID_ARGUMENT naming `field`) when there is none.
@@ -98,9 +120,9 @@ class ProcessingService final : public v1::Processing::Service {
                                                               const std::string& field);
 
   ProcessingServiceOptions options_;
-  WorkPool pool_;
   CalibrationCache calibrations_;
   std::atomic<bool> draining_{false};
+  WorkPool pool_;  // last: its workers end before what their work uses goes
 };
 
 }  // namespace bsls::processing

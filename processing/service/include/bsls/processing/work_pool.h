@@ -1,82 +1,105 @@
-// The processing service's bounded pool: at most `workers` calls compute at
-// once and at most `queue` more wait for a worker, first come first served.
-// Beyond that a call is refused at once (the service answers
-// RESOURCE_EXHAUSTED) instead of piling up threads and memory.
+// The processing service's bounded pool: `workers` threads of its own
+// compute the admitted calls' work, at most `queue` more calls wait for one,
+// first come first served. Beyond that a call is refused at once (the
+// service answers RESOURCE_EXHAUSTED) instead of piling up memory.
 //
-// The work itself runs on the caller's thread (the gRPC handler) once it
-// holds a worker: progress is written from the thread that does the work,
-// and a cancelled call leaves the queue without ever taking a worker.
+// A call takes a Place first (TryAdmit), may do something while it waits
+// (Calibrate takes its upload), then hands its Job over (Start). A waiting
+// call holds no thread: its job runs on a worker in turn, or is dropped when
+// the call is cancelled before (Cancel) or the pool goes away.
 //
-// Thread-safety: every member is safe from any thread.
+// Thread-safety: every member is safe from any thread. A job's `run` and
+// `dropped` are called without the pool's lock, exactly one of them once.
 #ifndef BSLS_PROCESSING_WORK_POOL_H_
 #define BSLS_PROCESSING_WORK_POOL_H_
 
-#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
+#include <thread>
+#include <vector>
 
 namespace bsls::processing {
 
 struct WorkPoolStats {
   int workers = 0;
   int queue = 0;
-  int busy = 0;                 // holding a worker now
+  int busy = 0;                 // jobs running on a worker now
   int waiting = 0;              // admitted, waiting for a worker
-  std::uint64_t completed = 0;  // tickets that held a worker and were released
+  std::uint64_t completed = 0;  // jobs that ran to their end
   std::uint64_t rejected = 0;   // TryAdmit refusals
 };
 
 class WorkPool {
  public:
-  // A place in the pool: queued first, then (WaitForWorker) a worker.
-  // Leaving scope gives the place back.
-  class Ticket {
-   public:
-    Ticket(Ticket&& other) noexcept;
-    Ticket& operator=(Ticket&&) = delete;
-    Ticket(const Ticket&) = delete;
-    ~Ticket();
+  // What an admitted call does: `run` on a worker in its turn, or `dropped`
+  // instead when it is cancelled while it waits or the pool goes away.
+  // What `run` returns (may be empty) is called on the worker once the pool
+  // counts it free again: a call's status goes out there, so a caller that
+  // has its answer finds the worker free.
+  struct Job {
+    std::function<std::function<void()>()> run;
+    std::function<void()> dropped;
+  };
 
-    // Waits for a worker in turn; false (the ticket then holds nothing) when
-    // `cancelled` returns true first. `cancelled` is polled every `poll`.
-    bool WaitForWorker(const std::function<bool()>& cancelled,
-                       std::chrono::milliseconds poll = std::chrono::milliseconds(20));
+  // A place in the queue; given back when it goes without being started.
+  class Place {
+   public:
+    Place(Place&& other) noexcept;
+    Place& operator=(Place&&) = delete;
+    Place(const Place&) = delete;
+    ~Place();
+
+    // The place's number (Cancel's argument).
+    std::uint64_t number() const { return number_; }
 
    private:
     friend class WorkPool;
-    Ticket(WorkPool* pool, std::uint64_t number) : pool_(pool), number_(number) {}
+    Place(WorkPool* pool, std::uint64_t number) : pool_(pool), number_(number) {}
     WorkPool* pool_;
     std::uint64_t number_;
-    bool working_ = false;
   };
 
-  // workers >= 1, queue >= 0 (asserted: the configuration checks them).
+  // Starts `workers` threads; workers >= 1, queue >= 0 (asserted: the
+  // configuration checks them).
   WorkPool(int workers, int queue);
+  // Drops the jobs still waiting and joins the workers once their jobs end.
+  ~WorkPool();
   WorkPool(const WorkPool&) = delete;
   WorkPool& operator=(const WorkPool&) = delete;
 
-  // A ticket when a worker or a queue place is free; nullopt (counted as
+  // A place when a worker or a queue place is free; nullopt (counted as
   // rejected) when all are taken.
-  std::optional<Ticket> TryAdmit();
+  std::optional<Place> TryAdmit();
+  // Hands `job` over for `place`: it runs on the first free worker after
+  // the jobs started from earlier places.
+  void Start(Place place, Job job);
+  // Drops the job of place `number` (its `dropped` is called here) or the
+  // place itself if it still waits; false when its job runs or ran already.
+  bool Cancel(std::uint64_t number);
   // The pool's size and load now.
   WorkPoolStats Stats() const;
 
  private:
-  void Leave(std::uint64_t number, bool working);
+  void Leave(std::uint64_t number);
+  void Work();
 
   const int workers_;
   const int queue_;
   mutable std::mutex mutex_;
   std::condition_variable changed_;
-  std::deque<std::uint64_t> waiting_;  // ticket numbers in arrival order
+  std::deque<std::uint64_t> waiting_;   // admitted places, in arrival order
+  std::map<std::uint64_t, Job> ready_;  // started jobs that wait, by place
   std::uint64_t next_number_ = 0;
   int busy_ = 0;
   std::uint64_t completed_ = 0;
   std::uint64_t rejected_ = 0;
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
 };
 
 }  // namespace bsls::processing
