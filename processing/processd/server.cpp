@@ -34,7 +34,9 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
   builder.SetMaxSendMessageSize(config.listen.max_send_message_bytes);
   rpc::ApplyHttp2Limits(config.listen.http2, builder);
   rpc::ReportMalformedRequests(builder);
-  // Handler threads: every worker and queue place, plus quick calls.
+  // Synchronous handler threads: Calibrate holds one for its upload and
+  // while its work runs (at most every worker and queue place), plus the
+  // quick calls. The other work calls are on the callback API and hold none.
   grpc::ResourceQuota quota("bsls-processd");
   quota.SetMaxThreads(options.workers + options.queue + 16);
   builder.SetResourceQuota(quota);
