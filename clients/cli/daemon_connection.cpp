@@ -13,11 +13,6 @@ namespace {
 
 constexpr const char* kSystemSocket = "unix:/run/bsls/bslsd.sock";
 
-rpc::TlsFiles TlsOf(const ServiceAddress& address) {
-  return {address.tls_ca, address.tls_certificate, address.tls_key, "--tls-ca", "--tls-cert",
-          "--tls-key"};
-}
-
 void AddTlsOptions(CLI::App& command, ServiceAddress& address) {
   command.add_option("--tls-ca", address.tls_ca, "CA certificate (PEM) that signed the service's");
   command.add_option("--tls-cert", address.tls_certificate, "our client certificate (PEM)");
@@ -27,6 +22,11 @@ void AddTlsOptions(CLI::App& command, ServiceAddress& address) {
 }
 
 }  // namespace
+
+rpc::TlsFiles TlsOf(const ServiceAddress& address) {
+  return {address.tls_ca, address.tls_certificate, address.tls_key, "--tls-ca", "--tls-cert",
+          "--tls-key"};
+}
 
 void AddDaemonOptions(CLI::App& command, ServiceAddress& address) {
   const char* from_env = std::getenv("BSLS_DAEMON");

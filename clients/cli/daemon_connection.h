@@ -13,6 +13,7 @@
 #include <string>
 
 #include "bsls/processing/processing_client.h"
+#include "bsls/rpc/tls.h"
 #include "command.h"
 
 namespace bsls::cli {
@@ -27,6 +28,9 @@ struct ServiceAddress {
   std::string tls_key;          // its private key
   double timeout_s = 30;        // the deadline of each call
 };
+
+// The TLS files `address` names, each named by its option in errors.
+rpc::TlsFiles TlsOf(const ServiceAddress& address);
 
 // Adds --daemon, --tls-ca, --tls-cert, --tls-key and --timeout to `command`;
 // the daemon's address defaults to $BSLS_DAEMON, else the system socket.

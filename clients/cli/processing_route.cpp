@@ -49,8 +49,7 @@ ProcessingRoute::ProcessingRoute(const ServiceAddress& address) : address_(addre
     return;
   }
   options.target = address.target;
-  options.tls = {address.tls_ca, address.tls_certificate, address.tls_key, "--tls-ca", "--tls-cert",
-                 "--tls-key"};
+  options.tls = TlsOf(address);
   if (!rpc::IsUnixTarget(address.target) && !rpc::IsLoopbackTarget(address.target) &&
       !options.tls.complete())
     throw CommandError(kExitUsage, "--server " + address.target +

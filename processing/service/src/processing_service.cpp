@@ -475,8 +475,39 @@ std::shared_ptr<const CachedCalibration> ProcessingService::ResolveCalibration(
   }
 }
 
+// What a work call's checks need: its name, whether its caller gave up
+// (cancelled, deadline, drain) and the status that says which.
+struct ProcessingService::CallState {
+  std::string name;
+  std::function<bool()> gave_up;
+  std::function<Status()> stopped;
+};
+
+namespace {
+
+// A progress event: `stage` begins with `fraction` of the work done.
+v1::WorkEvent Progress(std::string_view stage, double fraction) {
+  v1::WorkEvent event;
+  event.mutable_progress()->set_stage(std::string(stage));
+  event.mutable_progress()->set_fraction(fraction);
+  return event;
+}
+
+}  // namespace
+
 // What a work call's body gets: where to send events and how to observe.
 struct ProcessingService::Work {
+  // The work of `call`, its events sent through `send`: the stages ask
+  // whether the caller gave up and report progress as events.
+  Work(Emit send, const CallState& call) : emit(std::move(send)) {
+    observer.cancelled = call.gave_up;
+    observer.progress = [this](std::string_view stage, double fraction) {
+      emit(Progress(stage, fraction));
+    };
+  }
+  Work(const Work&) = delete;  // the observer refers to this one
+  Work& operator=(const Work&) = delete;
+
   Emit emit;  // sends an event; false when the caller went away
   session::WorkObserver observer;
   v1::Result result;
@@ -524,14 +555,6 @@ ProcessingService::ProcessingService(ProcessingServiceOptions options)
 
 void ProcessingService::BeginDrain() { draining_ = true; }
 
-// What a work call's checks need: its name, whether its caller gave up
-// (cancelled, deadline, drain) and the status that says which.
-struct ProcessingService::CallState {
-  std::string name;
-  std::function<bool()> gave_up;
-  std::function<Status()> stopped;
-};
-
 namespace {
 
 // The call state of `context`'s call; `cancelled` adds what the transport
@@ -557,13 +580,6 @@ std::function<Status()> Stopped(Context* context, const std::atomic<bool>& drain
       return Status(StatusCode::UNAVAILABLE, call + ": the service is shutting down; work stopped");
     return Status(StatusCode::CANCELLED, call + ": cancelled; work stopped");
   };
-}
-
-v1::WorkEvent Progress(std::string_view stage, double fraction) {
-  v1::WorkEvent event;
-  event.mutable_progress()->set_stage(std::string(stage));
-  event.mutable_progress()->set_fraction(fraction);
-  return event;
 }
 
 }  // namespace
@@ -641,11 +657,7 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::StartWork(
   stream->Push(Progress("queued", 0.0));
   WorkPool::Job job;
   job.run = [this, stream, state, work = std::move(work)] {
-    Work w{[stream](const v1::WorkEvent& e) { return stream->Push(e); }, {}, {}};
-    w.observer.cancelled = state->gave_up;
-    w.observer.progress = [stream](std::string_view stage, double fraction) {
-      stream->Push(Progress(stage, fraction));
-    };
+    Work w([stream](const v1::WorkEvent& e) { return stream->Push(e); }, *state);
     Status status = Perform(*state, w, work);
     // What the call allocated goes back to the system (glibc keeps freed
     // blocks otherwise; a burst of calls would leave the replica large).
@@ -666,11 +678,7 @@ Status ProcessingService::RunWaiting(grpc::ServerContext* context, const std::st
   if (Status refused = Admit(&place); !refused.ok()) return refused;
   const CallState state{call, GaveUp(context, draining_), Stopped(context, draining_, call)};
   if (!emit(Progress("queued", 0.0))) return state.stopped();
-  Work w{emit, {}, {}};
-  w.observer.cancelled = state.gave_up;
-  w.observer.progress = [&emit](std::string_view stage, double fraction) {
-    emit(Progress(stage, fraction));
-  };
+  Work w(emit, state);
   if (Status s = Guarded(state, [&] { prepare(w); }); !s.ok()) return s;
   // The work runs on a worker; this thread waits for it, and takes it out
   // of the queue when the caller gives up before it started.

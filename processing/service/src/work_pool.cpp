@@ -17,8 +17,7 @@ WorkPool::~WorkPool() {
     std::lock_guard lock(mutex_);
     stopping_ = true;
     dropped.swap(ready_);
-    for (const auto& [number, job] : dropped)
-      waiting_.erase(std::find(waiting_.begin(), waiting_.end(), number));
+    for (const auto& [number, job] : dropped) Unqueue(number);
   }
   changed_.notify_all();
   for (auto& [number, job] : dropped)
@@ -44,7 +43,7 @@ void WorkPool::Start(Place place, Job job) {
   {
     std::lock_guard lock(mutex_);
     if (stopping_) {
-      waiting_.erase(std::find(waiting_.begin(), waiting_.end(), place.number_));
+      Unqueue(place.number_);
       drop = true;
     } else {
       ready_.emplace(place.number_, std::move(job));
@@ -65,7 +64,7 @@ bool WorkPool::Cancel(std::uint64_t number) {
     if (it == ready_.end()) return false;
     job = std::move(it->second);
     ready_.erase(it);
-    waiting_.erase(std::find(waiting_.begin(), waiting_.end(), number));
+    Unqueue(number);
   }
   changed_.notify_all();
   if (job.dropped) job.dropped();
@@ -77,11 +76,15 @@ WorkPoolStats WorkPool::Stats() const {
   return {workers_, queue_, busy_, static_cast<int>(waiting_.size()), completed_, rejected_};
 }
 
+void WorkPool::Unqueue(std::uint64_t number) {
+  const auto it = std::find(waiting_.begin(), waiting_.end(), number);
+  if (it != waiting_.end()) waiting_.erase(it);
+}
+
 void WorkPool::Leave(std::uint64_t number) {
   {
     std::lock_guard lock(mutex_);
-    const auto it = std::find(waiting_.begin(), waiting_.end(), number);
-    if (it != waiting_.end()) waiting_.erase(it);
+    Unqueue(number);
   }
   changed_.notify_all();
 }
@@ -95,7 +98,7 @@ void WorkPool::Work() {
     if (ready_.empty()) return;  // stopping, nothing left
     auto first = ready_.begin();
     Job job = std::move(first->second);
-    waiting_.erase(std::find(waiting_.begin(), waiting_.end(), first->first));
+    Unqueue(first->first);
     ready_.erase(first);
     ++busy_;
     lock.unlock();

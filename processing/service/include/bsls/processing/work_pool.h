@@ -85,6 +85,8 @@ class WorkPool {
   WorkPoolStats Stats() const;
 
  private:
+  // Takes place `number` out of the waiting ones (the lock held).
+  void Unqueue(std::uint64_t number);
   void Leave(std::uint64_t number);
   void Work();
 
