@@ -165,16 +165,17 @@ TEST_F(LesionFace, CrowdedLinesKeepTheirOwnStrands) {
 // The track chain reports only labels its junction graph proves
 // (docs/decoding.md, "Labels: proven, or reported unlabelled"). On this
 // frame line 0 breaks at the nose's tip and the rows below the nose meet
-// the rows above through single links only: everything below the nose is
-// reported unlabelled, none of it wrong. 0.746 of the junctions are
-// labelled today; the goal is the skeleton chain's 0.95 (with a
-// calibration, the epipolar candidates will join what the image alone
-// cannot).
+// the rows above through few links: what no two links (or line 0's own
+// seeds) join is reported unlabelled, none of it wrong. 0.796 of the
+// junctions are labelled today (0.746 before lines leaning past the row
+// tracks were followed through the column points); the goal is the
+// skeleton chain's 0.95 (with a calibration, the epipolar candidates will
+// join what the image alone cannot).
 TEST_F(LesionFace, TrackChainLabelsOnlyWhatItProves) {
   ASSERT_TRUE(result_->ok) << result_->error;
   const Evaluation e = Evaluate(*frame_, *result_);
   EXPECT_EQ(e.all.Wrong(), 0) << e.all.Summary();
-  EXPECT_GE(e.all.Recall(), 0.74) << e.all.Summary();
+  EXPECT_GE(e.all.Recall(), 0.78) << e.all.Summary();
   EXPECT_GE(result_->unlabelled.size(), 80u);
   // 0.22 px today: line tracks that run on below the last proven junction
   // into the unlabelled part keep their centres (no junction there cuts them).

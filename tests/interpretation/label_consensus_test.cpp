@@ -177,6 +177,19 @@ TEST_F(BrokenLineZero, ItsPartsJoinThroughALinkTheirSeedsConfirm) {
   for (int j : {a0, a1, a2, c0, c1, c2}) ExpectRight(c, j);
 }
 
+TEST_F(BrokenLineZero, APartJoinedOnlyThroughAnotherPartJoinsToo) {
+  // Line 0 in three parts: D joins A through a link its seeds confirm, and
+  // C joins D alone (C's junctions come first, so C is asked before D is
+  // joined).
+  const int d0 = g.Add(0, 10), d1 = g.Add(0, 12), d2 = g.Add(1, 10);
+  g.Link(d0, d1, true);
+  g.Link(d0, d2, true);
+  g.Link(a1, d0, false);
+  g.Link(c1, d0, false);
+  const Consensus c = Run({a0, a1, c0, c1, d0, d1});
+  for (int j : {a0, a1, a2, c0, c1, c2, d0, d1, d2}) ExpectRight(c, j);
+}
+
 TEST_F(BrokenLineZero, ALinkTheSeedsContradictJoinsNothing) {
   g.WrongLink(a3, c2, 2, 0);  // would put C's line 0 at p = 2
   const Consensus c = Run({a0, a1, c0, c1});

@@ -189,6 +189,64 @@ TEST(RidgeTracks, ASegmentWhoseEndsMeetOneLineMakesNoJunction) {
   EXPECT_NE(net.junctions[0].line, net.junctions[1].line);
 }
 
+// Ridge points of a line that leans more and more as it descends: straight
+// down x = 20 over rows 0-9, leaning 0.8 px per row to row 19 (about 39
+// degrees, within the row tracks' step), then, in the column ridge points
+// only, 2 px per row (63 degrees, past the step) over columns 29-40; where
+// `below`, it goes on as a row track again from row 26 at x = 42.
+struct LeaningLine {
+  std::vector<std::pair<float, int>> rows, columns;  // (x, row); (row, column)
+  explicit LeaningLine(bool below) {
+    for (int y = 0; y < 20; ++y) rows.push_back({20.0f + (y < 10 ? 0.0f : 0.8f * (y - 9)), y});
+    for (int c = 29; c <= 40; ++c) columns.push_back({19.0f + (c - 28) / 2.0f, c});
+    if (below)
+      for (int y = 26; y < 46; ++y) rows.push_back({42.0f, y});
+  }
+  TrackNetwork Build() const {
+    return BuildTrackNetwork(Points(46, rows), Points(48, columns), pattern::Side::kLeft);
+  }
+};
+
+TEST(RidgeTracks, ALineLeaningPastTheStepGoesOnThroughTheColumnPoints) {
+  const TrackNetwork net = LeaningLine(true).Build();
+  ASSERT_EQ(net.lines.size(), 2u);
+  const int upper = net.rows.points[net.lines[0].points.front()].y == 0 ? 0 : 1;
+  const int lower = 1 - upper;
+  EXPECT_EQ(net.line_below[upper], lower);
+  EXPECT_EQ(net.line_above[lower], upper);
+  // Its path runs from the upper track's end through the column points to
+  // the lower track's start, by increasing row.
+  const std::vector<cv::Point2d>& path = net.path_below[upper];
+  ASSERT_GE(path.size(), 8u);
+  EXPECT_NEAR(path.front().x, 28.0, 1e-6);
+  EXPECT_NEAR(path.back().x, 42.0, 1e-6);
+  for (size_t k = 1; k < path.size(); ++k) EXPECT_GT(path[k].y, path[k - 1].y);
+  // The piece followed is no segment: it makes no junction.
+  EXPECT_TRUE(net.junctions.empty());
+}
+
+TEST(RidgeTracks, ALineLeaningPastTheStepToItsEndGetsATail) {
+  const TrackNetwork net = LeaningLine(false).Build();
+  ASSERT_EQ(net.lines.size(), 1u);
+  EXPECT_EQ(net.line_below[0], -1);
+  const std::vector<cv::Point2d>& tail = net.path_below[0];
+  ASSERT_GE(tail.size(), 8u);
+  EXPECT_NEAR(tail.back().x, 40.0, 1e-6);
+  EXPECT_NEAR(tail.back().y, 25.0, 1e-6);
+}
+
+TEST(RidgeTracks, ASegmentLeavingALeaningLinesEndIsNotFollowed) {
+  // The same line, but what leaves its end in the column points runs along
+  // row 19: a segment (the frame's segments run along the rows), not the
+  // line leaning on.
+  LeaningLine line(false);
+  line.columns.clear();
+  for (int c = 29; c <= 40; ++c) line.columns.push_back({19.0f, c});
+  const TrackNetwork net = line.Build();
+  EXPECT_TRUE(net.path_below[0].empty());
+  EXPECT_EQ(net.segments.size(), 1u);
+}
+
 TEST(RidgeTracks, InvalidParamsAreRejected) {
   TrackParams bad;
   bad.max_step = 0;

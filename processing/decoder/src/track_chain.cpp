@@ -292,7 +292,8 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
   const bool both_sides = FitLine(above, &a_above, &b_above) && FitLine(below, &a_below, &b_below);
   if (!both_sides || std::abs(b_above - b_below) > params.fold_slope_change) {
     // The track's ridge points, with those of the tracks continuing it
-    // across a gap above and below (joined by a chord).
+    // across a gap above and below (joined by a chord, or by the steep
+    // stretch that carries it on), or of its steep tail.
     std::vector<cv::Point2d> path;
     auto add = [&](int track, bool tail) {
       const auto& pts = net.lines[track].points;
@@ -304,7 +305,10 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
     if (net.line_above[junction.line] >= 0) add(net.line_above[junction.line], true);
     for (int k : net.lines[junction.line].points)
       path.emplace_back(net.rows.points[k].x, net.rows.points[k].y);
+    const std::vector<cv::Point2d>& on = net.path_below[junction.line];
+    if (on.size() > 2) path.insert(path.end(), on.begin() + 1, on.end() - 1);
     if (net.line_below[junction.line] >= 0) add(net.line_below[junction.line], false);
+    if (net.line_below[junction.line] < 0 && on.size() > 2) path.push_back(on.back());
     auto off = [&](const cv::Point2d& q) { return q.y - (a + b * (q.x - x_ref)); };
     std::optional<cv::Point2d> crossing;
     double nearest = fit_rows + 1.0;
@@ -483,10 +487,57 @@ std::vector<UnlabelledJunction> UnlabelledJunctions(const interpretation::TrackN
   return out;
 }
 
+// The centres of line track t's line below its last row where it leans
+// past the row tracks' reach (a steep stretch carries it on: across a gap
+// to the track below, or to its end): each stretch's point measured across
+// the stripe in its column (RidgeCentreInColumn), and the line's x at every
+// row down to the track below (or the stretch's end) read off those, as
+// (x, y) in the working frame. Empty for a chord across a gap, or where
+// the rows beside the stretch have no centre (cut at an edge).
+std::vector<cv::Point2d> SteepCentres(const cv::Mat& working,
+                                      const interpretation::TrackNetwork& net,
+                                      const std::vector<TrackCentres>& centres, int t) {
+  const int b = net.line_below[t];
+  const std::vector<cv::Point2d>& path = net.path_below[t];
+  const std::vector<double>& above = centres[t].output;
+  // The track's last centre, a few rows before its end at most (the last
+  // rows of a leaning line measure badly across the row).
+  int last = static_cast<int>(above.size()) - 1;
+  while (last >= 0 && std::isnan(above[last]) && static_cast<int>(above.size()) - last <= 3) --last;
+  if (path.size() <= 2 || last < 0 || std::isnan(above[last]) ||
+      (b >= 0 && (centres[b].output.empty() || std::isnan(centres[b].output.front()))))
+    return {};
+  std::vector<cv::Point2d> measured;
+  measured.emplace_back(above[last], centres[t].first_row + last);
+  for (size_t k = 1; k < path.size(); ++k) {
+    if (b >= 0 && k + 1 == path.size()) break;  // the track below's first point
+    const int x = static_cast<int>(std::lround(path[k].x));
+    const auto y = extraction::RidgeCentreInColumn(working, x, path[k].y);
+    if (y && std::abs(*y - path[k].y) <= 1.0 && *y > measured.back().y)
+      measured.emplace_back(x, *y);
+  }
+  if (b >= 0) {
+    const cv::Point2d end(centres[b].output.front(), centres[b].first_row);
+    if (end.y <= measured.back().y) return {};
+    measured.push_back(end);
+  }
+  std::vector<cv::Point2d> out;
+  size_t k = 0;
+  for (int y = static_cast<int>(measured.front().y) + 1; y < measured.back().y; ++y) {
+    while (measured[k + 1].y < y) ++k;
+    const cv::Point2d &p0 = measured[k], &p1 = measured[k + 1];
+    out.emplace_back(p0.x + (p1.x - p0.x) * (y - p0.y) / (p1.y - p0.y), y);
+  }
+  return out;
+}
+
 // Lines: the centres of all tracks of one p, one per row of the working
 // frame (`rows` of them; the first labelled track's where two hold one
-// row), in the full frame.
-std::vector<DecodedLine> DecodedLines(const std::vector<int>& labelled,
+// row), with the rows where a steep stretch carries a track of p on
+// (SteepCentres), in the full frame.
+std::vector<DecodedLine> DecodedLines(const cv::Mat& working,
+                                      const interpretation::TrackNetwork& net,
+                                      const std::vector<int>& labelled,
                                       const interpretation::TrackLabels& labels,
                                       const std::vector<TrackCentres>& centres, int rows,
                                       const WorkingScale& scale) {
@@ -506,6 +557,14 @@ std::vector<DecodedLine> DecodedLines(const std::vector<int>& labelled,
           x = c.output[k];
           any = true;
         }
+      }
+    }
+    for (int i : labelled) {
+      const int below = net.line_below[i];
+      if (labels.line_p[i] != p || (below >= 0 && labels.line_p[below] != p)) continue;
+      for (const cv::Point2d& c : SteepCentres(working, net, centres, i)) {
+        double& x = row_x[static_cast<int>(c.y)];
+        if (std::isnan(x)) x = c.x;
       }
     }
     if (!any) continue;
@@ -602,7 +661,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   result->junctions =
       PlaceTrackJunctions(working, net, labels, centres, params, scale, &result->label_conflicts);
   result->unlabelled = UnlabelledJunctions(net, labels, scale);
-  result->lines = DecodedLines(labelled, labels, centres, working.rows, scale);
+  result->lines = DecodedLines(working, net, labelled, labels, centres, working.rows, scale);
   result->times.subpixel_ms = MsSince(t);
   result->ok = true;
 }

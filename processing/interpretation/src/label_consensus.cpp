@@ -238,11 +238,14 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
 // seeds confirm, where those agree on one shift (v) and no link
 // contradicts them. The seeds are the second, independent witness that a
 // single link lacks. `votes`: (component, p shift) -> seeds.
+// Returns whether it joined any; components joined to the main one
+// through another seeded one take rounds.
 template <typename LabelOf>
-void JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::vector<char>& trusted,
+bool JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::vector<char>& trusted,
                           const std::map<std::pair<int, int>, int>& votes, int main_c,
                           int main_shift, int min_seeds, const ConsensusParams& params,
                           LabelOf label_of, Components* comps) {
+  bool joined = false;
   std::map<int, std::pair<int, int>> best;  // component -> (p shift, seeds)
   std::map<int, int> total;                 // component -> seeds
   for (const auto& [key, count] : votes) {
@@ -255,6 +258,7 @@ void JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::ve
       continue;
     // Shifts from c's frame to the main one's root frame that the links give.
     const auto [root, root_shift] = comps->Find(main_c);
+    if (comps->Find(c).first != c || c == root) continue;  // joined already
     std::map<Label, int> shifts;
     int against = 0, count = 0;
     for (size_t k = 0; k < links.size(); ++k) {
@@ -281,7 +285,9 @@ void JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::ve
     const auto& [h, agree] = *shifts.begin();
     if (count - agree > params.max_dissent * agree || against > 0) continue;
     comps->Join(root, c, h);
+    joined = true;
   }
+  return joined;
 }
 
 // One untrusted link between two components as they stand: the shift from
@@ -439,8 +445,11 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
       zero.dissent > params.max_dissent * zero.seeds)
     return out;
   const Label shift{zero.shift, (zero.shift % 2 + 2) % 2};  // keeps p + v's parity
-  JoinSeededComponents(links, trusted, zero.votes, zero.component, zero.shift, min_seeds, params,
-                       label_of, &comps);
+  // The seeds' votes name components as they stood; a component joined
+  // since answers to its root.
+  while (JoinSeededComponents(links, trusted, zero.votes, zero.component, zero.shift, min_seeds,
+                              params, label_of, &comps)) {
+  }
   // Labels in the frame of line 0's component as it now stands: its root
   // may have moved with a join, so they are taken back to the frame of the
   // component the seeds chose.

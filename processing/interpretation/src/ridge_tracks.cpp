@@ -69,34 +69,282 @@ void BridgeLineGaps(const TrackParams& params, TrackNetwork* net) {
   }
   net->line_below.assign(n_lines, -1);
   net->line_above.assign(n_lines, -1);
+  net->path_below.assign(n_lines, {});
   for (int a = 0; a < n_lines; ++a) {
     const int b = nearest_below[a];
     if (b >= 0 && nearest_above[b] == a) {
       net->line_below[a] = b;
       net->line_above[b] = a;
+      const extraction::RidgePoint p0 = last(a), p1 = first(b);
+      net->path_below[a] = {{p0.x, static_cast<double>(p0.y)}, {p1.x, static_cast<double>(p1.y)}};
     }
   }
 }
 
-// A bridged gap crossing a row: its chord's x half a row down, and the line
+int NearestLinePoint(const TrackNetwork& net, int y, double lo, double hi, double at);
+
+// Following a line on where it leans past max_step, through the column
+// ridge points (docs/decoding.md, "Lines that lean past the row tracks").
+constexpr int kLeanRows = 5;          // rows over which a line track's lean is measured
+constexpr double kMinLean = 0.3;      // px per row: a track leaning less ended for another reason
+constexpr int kSlopeColumns = 3;      // columns over which a column track's slope is measured
+constexpr double kMaxTurnDeg = 40.0;  // the column track goes on within this of the line's lean
+constexpr double kMinDescent = 0.15;  // rows per column: flatter, the column track is a segment
+constexpr double kSegmentLike = 0.2;  // rows per column of the frame's typical segment slope
+constexpr double kOtherLine = 1.5;    // px: a row ridge point this close is another line's
+constexpr int kMaxPieces = 8;         // column tracks followed one after another
+
+// A column ridge point in image (x, y).
+cv::Point2d ColumnPoint(const TrackNetwork& net, int k) {
+  const extraction::RidgePoint& c = net.columns.points[k];  // x: image row, y: image column
+  return {static_cast<double>(c.y), c.x};
+}
+
+// The median slope (rows per column) of the segment tracks of 8 points or
+// more: how the frame's segments run. Near 0 where the projector sits
+// beside the camera (the thesis's rig, 2.2), which is taken where fewer
+// than kSlopeSample segments tell.
+double TypicalSegmentSlope(const TrackNetwork& net) {
+  constexpr size_t kSlopeSample = 16;
+  std::vector<double> slopes;
+  for (const Track& t : net.segments) {
+    if (t.points.size() < 8) continue;
+    const cv::Point2d a = ColumnPoint(net, t.points.front()), b = ColumnPoint(net, t.points.back());
+    slopes.push_back((b.y - a.y) / (b.x - a.x));
+  }
+  if (slopes.size() < kSlopeSample) return 0.0;
+  std::nth_element(slopes.begin(), slopes.begin() + slopes.size() / 2, slopes.end());
+  return slopes[slopes.size() / 2];
+}
+
+// Lines leaning past max_step where a surface turns away (the base of the
+// nose, a lump's skirt): the row tracks stop near 50 degrees from the
+// vertical, and the line goes on in the column ridge points, as a steep
+// stretch or a piece of a segment track. A line track leaning at least
+// kMinLean px per row at its end goes on along the column track that starts
+// within steep_reach of its end in the direction it leans (within
+// kMaxTurnDeg, and unlike the frame's segments), for as long as that keeps
+// descending and meets no other line, and on along the next such column
+// track: into the line track that starts on it (a gap bridged), or to its
+// end (a tail). The pieces of column tracks followed are taken out of the
+// steep stretches and segments, so that they make no junctions.
+class LeaningLines {
+ public:
+  LeaningLines(const TrackParams& params, TrackNetwork* net)
+      : params_(params), net_(*net), typical_(TypicalSegmentSlope(*net)) {
+    const int rows = Rows();
+    by_row_.resize(rows);
+    for (int pool = 0; pool < 2; ++pool) {
+      used_[pool].resize(Pool(pool).size());
+      for (int t = 0; t < static_cast<int>(Pool(pool).size()); ++t) {
+        const std::vector<int>& pts = Pool(pool)[t].points;
+        used_[pool][t].assign(pts.size(), 0);
+        for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+          const int y = static_cast<int>(std::lround(ColumnPoint(net_, pts[i]).y));
+          if (y >= 0 && y < rows) by_row_[y].push_back({pool, t, i});
+        }
+      }
+    }
+    starting_.resize(rows);
+    for (int t = 0; t < static_cast<int>(net_.lines.size()); ++t)
+      starting_[FirstOf(net_, t).y].push_back(t);
+  }
+
+  // Follows line track a on where it leans past max_step, if it does:
+  // sets its path_below (and line_below where a track continues it).
+  void Follow(int a) {
+    const std::vector<int>& line = net_.lines[a].points;
+    if (!net_.path_below[a].empty() || static_cast<int>(line.size()) <= kLeanRows) return;
+    const cv::Point2d end = RowPoint(line.back());
+    double lean = (end.x - RowPoint(line[line.size() - 1 - kLeanRows]).x) / kLeanRows;
+    if (std::abs(lean) < kMinLean) return;
+    std::vector<cv::Point2d> path{end};
+    std::vector<std::pair<ColumnPlace, int>> taken;  // pieces followed: (first place, last point)
+    int b = -1;
+    bool stopped = false;  // at another line, or where the line turns into a segment
+    for (int piece = 0; piece < kMaxPieces && b < 0 && !stopped; ++piece) {
+      // A faint line breaks more often further on: twice the reach there.
+      const double reach = (piece == 0 ? 1.0 : 2.0) * params_.steep_reach;
+      const std::optional<ColumnPlace> from = NextPiece(path.back(), lean, reach);
+      if (!from) break;
+      const int last = AlongPiece(*from, a, lean > 0 ? 1 : -1, end.y, &path, &b, &stopped);
+      if (last < 0) break;
+      taken.push_back({*from, last});
+      // The lean where this piece ends, for the next one.
+      const cv::Point2d& back = path[path.size() >= 4 ? path.size() - 4 : 0];
+      if (path.back().y > back.y) lean = (path.back().x - back.x) / (path.back().y - back.y);
+    }
+    if (b >= 0) {
+      path.push_back(RowPoint(net_.lines[b].points.front()));
+      net_.line_below[a] = b;
+      net_.line_above[b] = a;
+    } else if (path.back().y - end.y < params_.steep_columns) {
+      return;  // too short a tail to follow
+    }
+    for (const auto& [from, last] : taken)
+      for (int i = std::min(from.at, last); i <= std::max(from.at, last); ++i)
+        used_[from.pool][from.track][i] = 1;
+    net_.path_below[a] = std::move(path);
+  }
+
+  // Takes the pieces followed out of the steep stretches and segments.
+  void RemoveFollowedPieces() {
+    for (int pool = 0; pool < 2; ++pool) {
+      std::vector<Track> kept;
+      for (size_t t = 0; t < Pool(pool).size(); ++t) {
+        const std::vector<int>& pts = Pool(pool)[t].points;
+        for (size_t i = 0; i < pts.size();) {
+          Track piece;
+          for (; i < pts.size() && !used_[pool][t][i]; ++i) piece.points.push_back(pts[i]);
+          if (static_cast<int>(piece.points.size()) >= params_.min_track)
+            kept.push_back(std::move(piece));
+          while (i < pts.size() && used_[pool][t][i]) ++i;
+        }
+      }
+      Pool(pool).swap(kept);
+    }
+  }
+
+ private:
+  // A place in a column track: which pool (0 the steep stretches, 1 the
+  // segments), which track, which point.
+  struct ColumnPlace {
+    int pool, track, at;
+  };
+
+  int Rows() const {
+    return net_.rows.row_start.empty() ? 0 : static_cast<int>(net_.rows.row_start.size()) - 1;
+  }
+  std::vector<Track>& Pool(int pool) { return pool == 0 ? net_.steep : net_.segments; }
+  cv::Point2d RowPoint(int k) const {
+    return {net_.rows.points[k].x, static_cast<double>(net_.rows.points[k].y)};
+  }
+  // Rows per column from point i of pts kSlopeColumns on in direction d, or
+  // nullopt where the track ends first.
+  std::optional<double> Descent(const std::vector<int>& pts, int i, int d) const {
+    const int ahead = i + d * kSlopeColumns;
+    if (ahead < 0 || ahead >= static_cast<int>(pts.size())) return std::nullopt;
+    return (ColumnPoint(net_, pts[ahead]).y - ColumnPoint(net_, pts[i]).y) / kSlopeColumns;
+  }
+
+  // The column track to go on in from `at`, where the line leans `lean` px
+  // per row: within `reach`, descending the way it leans, unlike the
+  // frame's segments; the least turn.
+  std::optional<ColumnPlace> NextPiece(cv::Point2d at, double lean, double reach) {
+    const int d = lean > 0 ? 1 : -1;
+    std::optional<ColumnPlace> best;
+    double least_turn = kMaxTurnDeg;
+    const int y_at = static_cast<int>(at.y), reach_y = static_cast<int>(std::ceil(reach));
+    for (int y = std::max(0, y_at - reach_y); y <= std::min(Rows() - 1, y_at + reach_y); ++y)
+      for (const ColumnPlace& c : by_row_[y]) {
+        const std::vector<int>& pts = Pool(c.pool)[c.track].points;
+        const cv::Point2d q = ColumnPoint(net_, pts[c.at]);
+        const std::optional<double> descent = Descent(pts, c.at, d);
+        if (used_[c.pool][c.track][c.at] || !descent || q.y < at.y - 1.0 ||
+            std::hypot(q.x - at.x, q.y - at.y) > reach)
+          continue;
+        if (*descent < kMinDescent || std::abs(d * *descent - typical_) < kSegmentLike) continue;
+        const double turn = std::abs(std::atan(lean) - std::atan(d / *descent)) * 180.0 / CV_PI;
+        if (turn < least_turn) {
+          least_turn = turn;
+          best = c;
+        }
+      }
+    return best;
+  }
+
+  // Follows the column track from `from` in direction d, appending its
+  // points to *path, until it ends, turns into a segment or meets another
+  // line (*stopped), or a line track other than a starts on it below row
+  // y0 (*b). Returns the last point taken, or -1.
+  int AlongPiece(const ColumnPlace& from, int a, int d, double y0, std::vector<cv::Point2d>* path,
+                 int* b, bool* stopped) {
+    const std::vector<int>& pts = Pool(from.pool)[from.track].points;
+    int last = -1;
+    for (int i = from.at; i >= 0 && i < static_cast<int>(pts.size()); i += d) {
+      if (used_[from.pool][from.track][i]) break;
+      if (const auto descent = Descent(pts, i, d);
+          i != from.at && descent && *descent < kMinDescent) {
+        *stopped = true;  // it turns into a segment
+        break;
+      }
+      const cv::Point2d q = ColumnPoint(net_, pts[i]);
+      if (q.y <= path->back().y) continue;
+      if ((*b = StartsAt(q, a, y0)) >= 0) break;
+      const int near = NearestLinePoint(net_, static_cast<int>(std::lround(q.y)), q.x - kOtherLine,
+                                        q.x + kOtherLine, q.x);
+      if (near >= 0 && net_.line_of_point[near] != a) {
+        *stopped = true;  // it meets another line
+        break;
+      }
+      path->push_back(q);
+      last = i;
+    }
+    return last;
+  }
+
+  // A line track other than a starting within steep_reach of q below row
+  // y0, and continuing no other, or -1.
+  int StartsAt(cv::Point2d q, int a, double y0) const {
+    const int qy = static_cast<int>(std::lround(q.y));
+    const int reach = static_cast<int>(std::ceil(params_.steep_reach));
+    for (int y = std::max(0, qy - reach); y <= std::min(Rows() - 1, qy + reach); ++y)
+      for (int t : starting_[y]) {
+        const cv::Point2d first = RowPoint(net_.lines[t].points.front());
+        if (t != a && net_.line_above[t] < 0 && first.y > y0 &&
+            std::hypot(first.x - q.x, first.y - q.y) <= params_.steep_reach)
+          return t;
+      }
+    return -1;
+  }
+
+  const TrackParams& params_;
+  TrackNetwork& net_;
+  const double typical_;
+  std::vector<std::vector<ColumnPlace>> by_row_;  // column points of both pools by image row
+  std::vector<std::vector<int>> starting_;        // line tracks by their first row
+  std::vector<std::vector<char>> used_[2];        // per pool, track and point: followed
+};
+
+// Follows every line track that leans past max_step (LeaningLines).
+void FollowLeaningLines(const TrackParams& params, const Cancellation& cancel, TrackNetwork* net) {
+  LeaningLines leaning(params, net);
+  for (int a = 0; a < static_cast<int>(net->lines.size()); ++a) {
+    if (a % 1024 == 0) cancel.ThrowIfRequested("the leaning lines");
+    leaning.Follow(a);
+  }
+  leaning.RemoveFollowedPieces();
+}
+
+// The x of line a's path below at row y (within its rows).
+double PathX(const TrackNetwork& net, int a, double y) {
+  const std::vector<cv::Point2d>& path = net.path_below[a];
+  const auto after = std::partition_point(path.begin() + 1, path.end() - 1,
+                                          [y](const cv::Point2d& q) { return q.y <= y; });
+  const cv::Point2d& p1 = *after;
+  const cv::Point2d& p0 = *std::prev(after);
+  return p1.y == p0.y ? p0.x : p0.x + (p1.x - p0.x) * (y - p0.y) / (p1.y - p0.y);
+}
+
+// A bridged gap crossing a row: its path's x half a row down, and the line
 // track above the gap.
 struct GapAtRow {
   double x;
   int a;
 };
 
-// The bridged gaps by row: gap a (the chord from line a's last point to
+// The bridged gaps by row: gap a (its path from line a's last point to
 // the first of line_below[a]) is listed at every row from its upper end to
 // the row before its lower end, with its x half a row down; each row's by
-// that x. A chord moves at most bridge_distance in x over a row.
+// that x.
 std::vector<std::vector<GapAtRow>> GapsByRow(const TrackNetwork& net) {
   std::vector<std::vector<GapAtRow>> gaps_at(
       net.rows.row_start.empty() ? 0 : net.rows.row_start.size() - 1);
   for (int a = 0; a < static_cast<int>(net.lines.size()); ++a) {
-    if (net.line_below[a] < 0) continue;
-    const extraction::RidgePoint p0 = LastOf(net, a), p1 = FirstOf(net, net.line_below[a]);
-    for (int y = p0.y; y < p1.y; ++y)
-      gaps_at[y].push_back({p0.x + (p1.x - p0.x) * (y + 0.5 - p0.y) / (p1.y - p0.y), a});
+    const std::vector<cv::Point2d>& path = net.path_below[a];
+    if (path.empty()) continue;
+    for (int y = static_cast<int>(path.front().y); y + 0.5 < path.back().y; ++y)
+      gaps_at[y].push_back({PathX(net, a, y + 0.5), a});
   }
   for (std::vector<GapAtRow>& row : gaps_at)
     std::sort(row.begin(), row.end(),
@@ -160,9 +408,9 @@ void MeetAcrossGap(const TrackNetwork& net, double ey, double lo, double hi,
   for (; g != crossing.end() && g->x <= hi + params.bridge_distance; ++g) {
     const int a = g->a;
     if (j->line >= 0 && a > j->line) continue;
-    const extraction::RidgePoint p0 = LastOf(net, a), p1 = FirstOf(net, net.line_below[a]);
-    if (ey <= p0.y || ey >= p1.y) continue;
-    const double x = p0.x + (p1.x - p0.x) * (ey - p0.y) / (p1.y - p0.y);
+    const std::vector<cv::Point2d>& path = net.path_below[a];
+    if (ey <= path.front().y || ey >= path.back().y) continue;
+    const double x = PathX(net, a, ey);
     if (x < lo || x > hi) continue;
     j->line = a;
     j->position = {x, ey};
@@ -204,6 +452,18 @@ std::optional<TrackJunction> JunctionAtEnd(const TrackNetwork& net, int s, bool 
   return j;
 }
 
+// Whether line tracks t and u are one line: the same track, or joined
+// across gaps (line_below) through a few tracks.
+bool OneLine(const TrackNetwork& net, int t, int u) {
+  constexpr int kHops = 4;
+  for (const auto& [from, to] : {std::pair{t, u}, std::pair{u, t}}) {
+    int k = from;
+    for (int hops = 0; k >= 0 && hops <= kHops; ++hops, k = net.line_below[k])
+      if (k == to) return true;
+  }
+  return false;
+}
+
 // The junctions where the segments' ends meet lines, into net->junctions.
 void FindJunctions(pattern::Side side, const TrackParams& params,
                    const std::vector<std::vector<GapAtRow>>& gaps_at, const Cancellation& cancel,
@@ -223,9 +483,10 @@ void FindJunctions(pattern::Side side, const TrackParams& params,
       if (auto j = JunctionAtEnd(*net, s, left_end, middle, towards_p, params, gaps_at, &in))
         net->junctions.push_back(*j);
     // A segment joins two lines; one whose ends both meet the same line
-    // (a speck of light beside it) makes no junction.
+    // (a speck of light beside it, or a piece of that line where it leans
+    // between two of its tracks) makes no junction.
     if (net->junctions.size() == first_junction + 2 &&
-        net->junctions[first_junction].line == net->junctions[first_junction + 1].line)
+        OneLine(*net, net->junctions[first_junction].line, net->junctions[first_junction + 1].line))
       net->junctions.resize(first_junction);
   }
 }
@@ -246,6 +507,7 @@ bool TrackParams::IsValid(std::string* error) const {
   if (bridge_rows < 1) return fail("bridge_rows must be at least 1");
   if (!(bridge_distance > 0)) return fail("bridge_distance must be positive");
   if (!(max_segment_slope > 0)) return fail("max_segment_slope must be positive");
+  if (!(steep_reach > 0)) return fail("steep_reach must be positive");
   if (steep_columns < 2) return fail("steep_columns must be at least 2");
   return true;
 }
@@ -301,7 +563,7 @@ std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const Track
 
 std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
                                      std::vector<Track> segments, const TrackParams& params,
-                                     const Cancellation& cancel) {
+                                     const Cancellation& cancel, std::vector<Track>* steep_out) {
   const auto& cp = columns.points;  // x: image row, y: image column
   const int w = params.steep_columns;
   std::vector<Track> out;
@@ -324,14 +586,14 @@ std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
       continue;
     }
     for (int i = 0; i < n;) {
-      if (steep[i]) {
-        ++i;
-        continue;
-      }
+      const char is_steep = steep[i];
       Track piece;
-      for (; i < n && !steep[i]; ++i) piece.points.push_back(t.points[i]);
-      if (static_cast<int>(piece.points.size()) >= params.min_track)
+      for (; i < n && steep[i] == is_steep; ++i) piece.points.push_back(t.points[i]);
+      if (static_cast<int>(piece.points.size()) < params.min_track) continue;
+      if (!is_steep)
         out.push_back(std::move(piece));
+      else if (steep_out)
+        steep_out->push_back(std::move(piece));
     }
   }
   return out;
@@ -349,11 +611,12 @@ TrackNetwork BuildTrackNetwork(extraction::RidgePoints rows, extraction::RidgePo
   cancel.ThrowIfRequested("the line tracks");
   net.segments = CutSteepStretches(
       net.columns, LinkTracks(net.columns, params, nullptr, cancel, "the segment tracks"), params,
-      cancel);
+      cancel, &net.steep);
   cancel.ThrowIfRequested("the segment tracks");
 
   BridgeLineGaps(params, &net);
   cancel.ThrowIfRequested("the bridges across line gaps");
+  FollowLeaningLines(params, cancel, &net);
   FindJunctions(side, params, GapsByRow(net), cancel, &net);
   net.junctions_on_line.assign(net.lines.size(), {});
   for (int i = 0; i < static_cast<int>(net.junctions.size()); ++i)

@@ -31,6 +31,7 @@ constexpr double kPitchSpread = 1.4;        // and the pitch beside its two ends
 constexpr double kAbruptPitchSpread = 1.7;  // pitch at a link's two ends beyond this: abrupt
 constexpr double kCrowded = 0.55;           // lines closer than this times the frame's pitch crowd
 constexpr double kOwnLine = 2.0;        // px: ridge points this close to a junction are its line's
+constexpr int kGapHops = 4;             // tracks without a junction a gap step passes over
 constexpr double kSpacingSpread = 1.6;  // a line's own row spacing lies within this factor
                                         // of the frame's
 // The row spacing along a line: the dy of a step between junctions of
@@ -312,8 +313,12 @@ class TrackLinks {
   // line's spacing.
   void AddLineGaps() {
     for (size_t t = 0; t < net_.lines.size(); ++t) {
-      const int b = net_.line_below[t];
-      if (b < 0 || net_.junctions_on_line[t].empty() || net_.junctions_on_line[b].empty()) continue;
+      if (net_.junctions_on_line[t].empty()) continue;
+      // The next track down the line with a junction, across tracks without any.
+      int b = net_.line_below[t];
+      for (int hops = 0; b >= 0 && net_.junctions_on_line[b].empty() && hops < kGapHops; ++hops)
+        b = net_.line_below[b];
+      if (b < 0 || net_.junctions_on_line[b].empty()) continue;
       AddGapStep(net_.junctions_on_line[t].back(), net_.junctions_on_line[b].front());
     }
   }

@@ -55,6 +55,11 @@ struct TrackParams {
   // (at a fold); a segment itself runs nearly along its row. > 0 and >= 2.
   double max_segment_slope = 0.6;
   int steep_columns = 4;
+  // px: a line track whose end lies this close to a steep stretch goes on
+  // along it, into the line track that starts this close to it lower down
+  // or to the stretch's lower end (a line leaning past max_step where a
+  // surface turns away: the base of the nose, a lump's skirt), > 0.
+  double steep_reach = 3.0;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
@@ -89,6 +94,16 @@ struct TrackNetwork {
   // Per line track: the track continuing it across a gap below / above it, or -1.
   std::vector<int> line_below;
   std::vector<int> line_above;
+  // Per line track: where its line goes on below its last ridge point, in
+  // image (x, y) by increasing y from that point: across its gap to the
+  // first point of line_below (their chord, or the steep stretch followed
+  // between them), or, with no line below, along a steep stretch where the
+  // line leans past the row tracks' reach down to its end (a tail). Empty
+  // when it goes on nowhere.
+  std::vector<std::vector<cv::Point2d>> path_below;
+  // The stretches cut out of the segment tracks (CutSteepStretches):
+  // pieces of lines leaning too far for the row tracks.
+  std::vector<Track> steep;
 };
 
 // Links ridge points from row to row into tracks: each point to the nearest
@@ -103,11 +118,12 @@ std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const Track
 
 // Cuts the stretches of `segments` (tracks through `columns`) that climb
 // more than max_segment_slope rows per column over steep_columns or more;
-// pieces shorter than min_track are dropped. Asks `cancel` every thousand
-// segments.
+// pieces shorter than min_track are dropped. The stretches cut go to
+// `steep` (optional). Asks `cancel` every thousand segments.
 std::vector<Track> CutSteepStretches(const extraction::RidgePoints& columns,
                                      std::vector<Track> segments, const TrackParams& params,
-                                     const Cancellation& cancel = {});
+                                     const Cancellation& cancel = {},
+                                     std::vector<Track>* steep = nullptr);
 
 // Links both sets of ridge points and finds the junctions of the brick
 // slide of `side`. Throws std::invalid_argument for invalid params and
