@@ -49,12 +49,20 @@ struct Lesion {
   const char* name;
   simulator::LesionParams params;  // rig (simulator world) frame
   // Share of the region the measured surface covers today, less a margin
-  // of about two points for other machines' floating point (OpenCV's SIMD
+  // of about a point for other machines' floating point (OpenCV's SIMD
   // paths differ in the last bits): a floor that keeps what the decoder
-  // reaches (the lump: 88.4 % with stitched strips, the default since
-  // 2026-11-27; with row pairs 82.4 % on 2026-11-26, 78.1 % and 70.8 %
-  // before decoder fixes); the whole region is lit and seen.
+  // reaches; the whole region is lit and seen. The lump: 73.1 % since
+  // surfaces take only labels the track chain proves (2026-11-29,
+  // decoder::KeepProvenLabels: the last rows of lines 9-13 on its steep
+  // lower skirt are seen by the skeleton chain alone, or left unlabelled by
+  // the track chain, and are no longer reported); 88.4 % before, when the
+  // skeleton chain's labels went unproven (the same chain put wrong labels
+  // on the outside corpus's ramps and cavity, docs/decoding.md).
   double min_coverage;
+  // The region is covered enough for its measure without filling holes to
+  // meet the acceptance both ways; else (the lump) only filling does, and
+  // the unfilled area and volume can only fall short.
+  bool whole = true;
 };
 
 // Thesis 7.2, Figures 7.12-7.13: a lump on the cheek near the mouth (Table
@@ -63,7 +71,8 @@ struct Lesion {
 const Lesion kLesions[] = {
     {"cheek lump",
      {.centre_xy_mm = {-42.0, -32.0}, .height_mm = 15.0, .radius_mm = 30.0, .top_radius_mm = 12.0},
-     0.86},
+     0.72,
+     false},
     {"forehead cavity",
      {.centre_xy_mm = {-28.0, 50.0}, .height_mm = -15.0, .radius_mm = 28.0, .top_radius_mm = 11.0},
      0.99},
@@ -243,8 +252,12 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     EXPECT_LT(std::abs(e.peak_mm), 0.15);
     // Area and volume within the acceptance both ways (docs/measurement.md:
     // areas +1.5, -0.6 and -2.0 %).
-    EXPECT_LT(std::abs(e.area_relative), kAreaRelativeTolerance);
-    EXPECT_LT(std::abs(e.volume_relative), kVolumeRelativeTolerance);
+    EXPECT_LT(e.area_relative, kAreaRelativeTolerance);
+    EXPECT_LT(e.volume_relative, kVolumeRelativeTolerance);
+    if (lesion.whole) {
+      EXPECT_GT(e.area_relative, -kAreaRelativeTolerance);
+      EXPECT_GT(e.volume_relative, -kVolumeRelativeTolerance);
+    }
     EXPECT_GE(m.surface_coverage, lesion.min_coverage);
     // With the region's holes filled (LesionMeasurement::filled_*; the
     // lump: 12.5 % of its region, where line 4 passes behind the nasolabial
@@ -277,9 +290,10 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
   }
   // The lump through a perfect decode of the same frames: what any decoder
   // could give the rest of the chain (its baseline scan decoded perfectly
-  // too). Its surface covers 93.6 % of the region; the decoder's (88.4 %)
-  // loses the last rows of lines 10-13 on the lower outer skirt, which lean
-  // 60-75 degrees there (docs/measurement.md), and is held within a few
+  // too). Its surface covers 93.6 % of the region; the decoder's (73.1 %)
+  // loses the last rows of lines 9-13 on the lower outer skirt, which lean
+  // 60-75 degrees there (docs/measurement.md) and whose labels the track
+  // chain does not prove (Lesion::min_coverage), and is held within 22
   // points of it.
   double default_coverage[2] = {0.0, 0.0};  // the lump's: decoder, perfect decode
   {
@@ -293,7 +307,7 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     EXPECT_LT(std::abs(e.area_relative), kAreaRelativeTolerance);
     EXPECT_LT(std::abs(e.volume_relative), kVolumeRelativeTolerance);
     EXPECT_LE(lump->surface_coverage, best.surface_coverage + 0.01);
-    EXPECT_GE(lump->surface_coverage, best.surface_coverage - 0.07);
+    EXPECT_GE(lump->surface_coverage, best.surface_coverage - 0.22);
     default_coverage[0] = lump->surface_coverage;
     default_coverage[1] = best.surface_coverage;
   }

@@ -16,6 +16,7 @@
 
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/decoder/decoder.h"
+#include "bsls/decoder/label_proof.h"
 #include "bsls/geometry/surface_mesh.h"
 #include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/reconstruction/reconstruction.h"
@@ -26,13 +27,17 @@ struct SidePipelineParams {
   // q_offset must stay unset: the calibration fixes it. Its `chain` is
   // replaced by the one below.
   decoder::DecodeParams decode;
-  // The chain that decodes (decoder::ChainFor). nullopt: the skeleton chain
-  // where a surface is reconstructed, the track chain where only the labels
-  // are wanted. On the thesis's lesions the skeleton chain keeps more of the
-  // steep lines on a lump's skirts (86 % of its region covered against
-  // 80 %) and places junctions closer (0.04-0.18 px RMS against 0.07-0.29
-  // px on the plane, ramp and ball): docs/decoding.md, "Which chain".
+  // The chain that decodes (decoder::ChainFor). nullopt: where a surface is
+  // reconstructed, the skeleton chain's junctions and lines under the
+  // labels the track chain proves (decoder::KeepProvenLabels, with `proof`);
+  // where only the labels are wanted, the track chain. The skeleton chain
+  // keeps more of the steep lines on a lump's skirts and places junctions
+  // closer; the track chain never reports a label it cannot prove
+  // (docs/decoding.md, "Which chain"). A chain named here, or the skeleton
+  // chain's own options in `decode` (the thesis's extraction, no repair),
+  // decode alone.
   std::optional<decoder::DecodeChain> chain;
+  decoder::LabelProofParams proof;
   ReconstructionParams reconstruction;
   PlaneModelKind planes = PlaneModelKind::kPerspective;
   SlideRowParams rows;
@@ -52,6 +57,9 @@ struct SideOutcome {
   // Why the rows stayed relative although a calibration was given (empty
   // when they are absolute or no calibration was given).
   std::string rows_note;
+  // Where the skeleton chain's labels were proven by the track chain's:
+  // what was kept (SidePipelineParams::chain).
+  decoder::LabelProofReport proof;
   std::optional<geometry::SurfaceMesh> surface;  // when reconstructed
   ReconstructionReport report;
 };
