@@ -160,7 +160,9 @@ void ProveStepsAlongLines(const DecodeResult& geometry, double spacing, double b
     }
     return nearest;
   };
-  for (auto& [p, js] : on_line) {
+  for (auto& [line_p, line_junctions] : on_line) {
+    const int p = line_p;
+    std::vector<int>& js = line_junctions;  // named: lambdas below take it
     const auto line = line_of.find(p);
     if (line == line_of.end()) continue;
     std::sort(js.begin(), js.end(),
