@@ -109,6 +109,8 @@ void PrintProcessSummary(const ProcessOptions& o, const processing::WorkOutcome&
                         {"q_absolute", s.q_absolute()},
                         {"repairs", s.repairs()},
                         {"label_conflicts", s.label_conflicts()},
+                        {"islands", s.islands()},
+                        {"islands_placed", s.islands_placed()},
                         {"time_ms", StageMs(out.result, "decode")},
                         {"extraction_ms", StageMs(out.result, "extraction")},
                         {"interpretation_ms", StageMs(out.result, "interpretation")},

@@ -2,8 +2,11 @@
 // on objects and faces hold it with the skeleton chain in decoder_test.cpp.
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <opencv2/core/utility.hpp>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "bsls/decoder/decode_output.h"
 #include "bsls/decoder/decoder.h"
@@ -47,6 +50,63 @@ TEST(TrackChain, FrameWithoutReferenceLineIsReportedNotGuessed) {
   const DecodeResult cut = Decode(face.image, Side::kLeft, TrackChain());
   EXPECT_FALSE(cut.ok);
   EXPECT_NE(cut.error.find("line 0"), std::string::npos) << cut.error;
+}
+
+// A calibration's geometry as a script (the real one, from a calibration,
+// is tested in tests/reconstruction/island_placement_test.cpp): asked about
+// line 0's component itself it answers `own`, about an island `island`.
+class ScriptedGeometry final : public LabelGeometry {
+ public:
+  ScriptedGeometry(std::optional<LabelShift> own, std::optional<LabelShift> island)
+      : own_(own), island_(island) {}
+  std::optional<LabelShift> PlaceIsland(const std::vector<FramedJunction>& labelled,
+                                        const std::vector<FramedJunction>& island,
+                                        std::string* why) const override {
+    const bool itself = labelled.size() == island.size();
+    ++asked_[itself];
+    if (why) *why = "scripted";
+    return itself ? own_ : island_;
+  }
+  mutable int asked_[2] = {0, 0};  // islands, line 0's component
+
+ private:
+  std::optional<LabelShift> own_, island_;
+};
+
+TEST(TrackChain, TheGeometryMovesLineZerosComponentOrRefusesItOffTheSlide) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 1);
+  const DecodeResult plain = Decode(frame.image, Side::kLeft, TrackChain());
+  ASSERT_TRUE(plain.ok) << plain.error;
+  int max_p = 0;
+  for (const DecodedJunction& j : plain.junctions) max_p = std::max(max_p, j.p);
+  ASSERT_LE(max_p + 2, 19);
+
+  DecodeParams params = TrackChain();
+  auto confirms = std::make_shared<ScriptedGeometry>(LabelShift{0, 0}, std::nullopt);
+  params.geometry = confirms;
+  const DecodeResult same = Decode(frame.image, Side::kLeft, params);
+  ASSERT_TRUE(same.ok) << same.error;
+  EXPECT_EQ(confirms->asked_[1], 1);
+  EXPECT_EQ(same.line_zero_moved, 0);
+  ASSERT_NO_FATAL_FAILURE(ExpectSameJunctions(plain, same));
+
+  params.geometry = std::make_shared<ScriptedGeometry>(LabelShift{2, 0}, std::nullopt);
+  const DecodeResult moved = Decode(frame.image, Side::kLeft, params);
+  ASSERT_TRUE(moved.ok) << moved.error;
+  EXPECT_EQ(moved.line_zero_moved, 2);
+  ASSERT_EQ(moved.junctions.size(), plain.junctions.size());
+  for (size_t k = 0; k < plain.junctions.size(); ++k) {
+    EXPECT_EQ(moved.junctions[k].p, plain.junctions[k].p + 2);
+    EXPECT_EQ(moved.junctions[k].q, plain.junctions[k].q);
+    EXPECT_EQ(moved.junctions[k].position, plain.junctions[k].position);
+  }
+  ASSERT_EQ(moved.lines.size(), plain.lines.size());
+  EXPECT_EQ(moved.lines.front().p, plain.lines.front().p + 2);
+
+  params.geometry = std::make_shared<ScriptedGeometry>(LabelShift{20, 0}, std::nullopt);
+  const DecodeResult off = Decode(frame.image, Side::kLeft, params);
+  EXPECT_FALSE(off.ok);
+  EXPECT_NE(off.error.find("off the slide"), std::string::npos) << off.error;
 }
 
 TEST(TrackChain, OutputsFollowTheContracts) {

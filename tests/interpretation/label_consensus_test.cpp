@@ -197,5 +197,40 @@ TEST_F(BrokenLineZero, ALinkTheSeedsContradictJoinsNothing) {
   for (int j : {c0, c1, c2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
 }
 
+// Islands: a part not joined to line 0's, proven in itself, comes back
+// labelled relative to itself (for a calibration to place), not labelled.
+TEST_F(TwoPatches, APartNotJoinedIsAnIslandRightUpToOneShift) {
+  ConsensusParams params;
+  params.min_island = 3;
+  const Consensus c = LabelByConsensus(g.OddKind(), g.links, {a0, a1}, 2, params);
+  ASSERT_EQ(c.islands, 1);
+  for (int j : {a0, a1, a2, a3, a4, a5}) EXPECT_EQ(c.island[j], -1) << "junction " << j;
+  for (int j : {b0, b1, b2}) {
+    EXPECT_EQ(c.p[j], kNone) << "junction " << j;
+    ASSERT_EQ(c.island[j], 0) << "junction " << j;
+    // One shift for the whole island, keeping p + v's parity.
+    EXPECT_EQ(c.island_p[j] - c.island_p[b0], g.truth[j].first - g.truth[b0].first);
+    EXPECT_EQ(c.island_v[j] - c.island_v[b0], g.truth[j].second - g.truth[b0].second);
+    EXPECT_EQ(((c.island_p[j] + c.island_v[j]) % 2 + 2) % 2, g.OddKind()[j]);
+  }
+}
+
+TEST_F(TwoPatches, AnIslandSmallerThanTheMinimumIsNotKept) {
+  ConsensusParams params;
+  params.min_island = 4;  // patch B has 3 junctions
+  const Consensus c = LabelByConsensus(g.OddKind(), g.links, {a0, a1}, 2, params);
+  EXPECT_EQ(c.islands, 0);
+  for (int j : {b0, b1, b2}) EXPECT_EQ(c.island[j], -1) << "junction " << j;
+}
+
+TEST_F(TwoPatches, APartJoinedToLineZerosIsNoIsland) {
+  g.Link(a3, b0, false);
+  g.Link(a5, b2, false);
+  ConsensusParams params;
+  params.min_island = 3;
+  const Consensus c = LabelByConsensus(g.OddKind(), g.links, {a0, a1}, 2, params);
+  EXPECT_EQ(c.islands, 0);
+}
+
 }  // namespace
 }  // namespace bsls::interpretation::internal

@@ -286,6 +286,9 @@ DecodeResult KeepProvenLabels(const DecodeResult& geometry, const DecodeResult& 
   out.junctions.clear();
   out.lines.clear();
   out.unlabelled = proof.unlabelled;
+  out.islands = proof.islands;
+  out.islands_placed = proof.islands_placed;
+  out.line_zero_moved = proof.line_zero_moved;
   const int n = static_cast<int>(geometry.junctions.size());
   std::vector<Verdict> verdict(n, Verdict::kUnproven);
   std::vector<DecodedJunction> proven;

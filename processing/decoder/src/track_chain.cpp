@@ -5,6 +5,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <set>
 #include <tuple>
 #include <vector>
 
@@ -621,6 +622,80 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
   return junctions;
 }
 
+// Issue 25 parts 3-4 (docs/decoding.md, "Islands placed by the geometry"):
+// the calibration's `geometry` judges line 0's component first: where it
+// clearly puts the component at another shift (the track taken for line 0
+// was another line in phase with it), the component moves there, or, off
+// the slide, the frame is refused. Then each island of `labels` takes the
+// shift the geometry proves for it; one that the geometry cannot place, or
+// whose labels would repeat one of line 0's component (a slide junction is
+// seen once), fall off the slide or disagree with their kind, stays
+// unlabelled. Counts the islands placed and the component's move in `result`.
+void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::PatternSpec& spec,
+                     const WorkingScale& scale, const LabelGeometry& geometry,
+                     interpretation::TrackLabels* labels, DecodeResult* result) {
+  std::vector<FramedJunction> labelled;
+  std::vector<int> index;
+  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
+    if (labels->p[j] != interpretation::kUnlabelled) {
+      labelled.push_back({scale.ToFull(net.junctions[j].position), labels->p[j], labels->v[j]});
+      index.push_back(j);
+    }
+  auto fits = [&](const std::vector<int>& junctions, const std::vector<int>& p,
+                  const std::vector<int>& v, const std::vector<int>& line_p, LabelShift shift,
+                  const std::set<std::pair<int, int>>& taken) {
+    for (size_t k = 0; k < junctions.size(); ++k)
+      if (pattern::JunctionOnRowParity(spec, p[k] + shift.dp, v[k] + shift.dq) !=
+              net.junctions[junctions[k]].kind ||
+          taken.contains({p[k] + shift.dp, v[k] + shift.dq}))
+        return false;
+    return std::all_of(line_p.begin(), line_p.end(),
+                       [&](int lp) { return lp + shift.dp >= 0 && lp + shift.dp < spec.lines; });
+  };
+
+  std::string why;
+  if (const auto own = geometry.PlaceIsland(labelled, labelled, &why);
+      own && (own->dp != 0 || own->dq != 0)) {
+    std::vector<int> p, v, line_p;
+    for (const FramedJunction& j : labelled) p.push_back(j.p), v.push_back(j.q);
+    for (int lp : labels->line_p)
+      if (lp >= 0) line_p.push_back(lp);
+    if (!fits(index, p, v, line_p, *own, {})) {
+      labels->ok = false;
+      labels->error = "the calibration's geometry puts the labels " + std::to_string(own->dp) +
+                      " lines off, off the slide: the line taken for line 0 is not line 0";
+      return;
+    }
+    for (size_t k = 0; k < index.size(); ++k) {
+      labels->p[index[k]] += own->dp;
+      labels->v[index[k]] += own->dq;
+      labelled[k].p += own->dp;
+      labelled[k].q += own->dq;
+    }
+    for (int& lp : labels->line_p)
+      if (lp >= 0) lp += own->dp;
+    result->line_zero_moved = own->dp;
+  }
+  std::set<std::pair<int, int>> taken;
+  for (const FramedJunction& j : labelled) taken.emplace(j.p, j.q);
+  for (const interpretation::TrackLabels::Island& island : labels->islands) {
+    std::vector<FramedJunction> own;
+    for (size_t k = 0; k < island.junctions.size(); ++k)
+      own.push_back(
+          {scale.ToFull(net.junctions[island.junctions[k]].position), island.p[k], island.v[k]});
+    const std::optional<LabelShift> shift = geometry.PlaceIsland(labelled, own, &why);
+    if (!shift || !fits(island.junctions, island.p, island.v, island.line_p, *shift, taken))
+      continue;
+    for (size_t k = 0; k < island.junctions.size(); ++k) {
+      labels->p[island.junctions[k]] = island.p[k] + shift->dp;
+      labels->v[island.junctions[k]] = island.v[k] + shift->dq;
+    }
+    for (size_t k = 0; k < island.lines.size(); ++k)
+      labels->line_p[island.lines[k]] = island.line_p[k] + shift->dp;
+    ++result->islands_placed;
+  }
+}
+
 }  // namespace
 
 void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams& params,
@@ -634,7 +709,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   auto t = Clock::now();
   const interpretation::TrackNetwork net = interpretation::BuildTrackNetwork(
       std::move(ridges.rows), std::move(ridges.columns), side, tp.tracks, cancel);
-  const interpretation::TrackLabels labels =
+  interpretation::TrackLabels labels =
       interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
@@ -644,6 +719,14 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   if (!labels.ok) {
     result->error = labels.error;
     return;
+  }
+  result->islands = static_cast<int>(labels.islands.size());
+  if (params.geometry) {
+    PlaceByGeometry(net, params.spec, scale, *params.geometry, &labels, result);
+    if (!labels.ok) {
+      result->error = labels.error;
+      return;
+    }
   }
   cancel.ThrowIfRequested("the labelling");
 

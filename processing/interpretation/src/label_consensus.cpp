@@ -415,6 +415,38 @@ LineZeroVote VoteLineZero(const std::vector<int>& seeds, LabelOf label_of) {
   return out;
 }
 
+// The components of at least `min_island` junctions that hold none of
+// the `labelled` ones, each labelled in its own frame, into out's island
+// fields.
+template <typename LabelOf>
+void KeepIslands(const std::vector<char>& labelled, LabelOf label_of, int min_island,
+                 Consensus* out) {
+  const int n = static_cast<int>(labelled.size());
+  out->island.assign(n, -1);
+  out->island_p.assign(n, kNone);
+  out->island_v.assign(n, kNone);
+  if (min_island <= 0) return;
+  std::map<int, int> size;  // component root -> junctions; -1 marks one touching line 0's
+  for (int j = 0; j < n; ++j) {
+    const int c = label_of(j).first;
+    if (labelled[j])
+      size[c] = -1;
+    else if (size[c] >= 0)
+      ++size[c];
+  }
+  std::map<int, int> index;
+  for (const auto& [c, count] : size)
+    if (count >= min_island) index[c] = out->islands++;
+  for (int j = 0; j < n; ++j) {
+    const auto [c, l] = label_of(j);
+    const auto it = index.find(c);
+    if (it == index.end()) continue;
+    out->island[j] = it->second;
+    out->island_p[j] = l.p;
+    out->island_v[j] = l.v;
+  }
+}
+
 }  // namespace
 
 Consensus LabelByConsensus(const std::vector<char>& odd_kind,
@@ -470,6 +502,7 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
       out.p[j] = label[j].p;
       out.v[j] = label[j].v;
     }
+  KeepIslands(labelled, label_of, params.min_island, &out);
   return out;
 }
 

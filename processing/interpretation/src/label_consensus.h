@@ -51,6 +51,10 @@ struct ConsensusParams {
   // Links giving another shift (or an impossible one) allowed per agreeing
   // link, [0, 1).
   double max_dissent = 0.34;
+  // A component not joined to line 0's is kept as an island (labelled
+  // relative to itself, for a calibration to place) from this many
+  // junctions; 0: none kept.
+  int min_island = 12;
 };
 // A lone junction (in no closed brick) at the pattern's edge joins the
 // labelled ones through two agreeing links, or through one smooth step
@@ -60,13 +64,21 @@ struct Consensus {
   std::vector<int> p;          // per junction: line relative to line 0, or kUnlabelled
   std::vector<int> v;          // per junction: row, relative (any even offset), or kUnlabelled
   int contradicted_links = 0;  // trusted links dropped as contradicting their patch
+  // Components not joined to line 0's of at least min_island junctions:
+  // per junction its island (0 .. islands-1) or -1, and its label relative
+  // to the island (p + v keeps the junction's parity, so an island's labels
+  // are known up to one shift with dp + dv even).
+  int islands = 0;
+  std::vector<int> island;
+  std::vector<int> island_p;
+  std::vector<int> island_v;
 };
 
 // Labels `odd_kind.size()` junctions (odd_kind[j]: 1 for a corresponding
 // junction, whose p + v is odd; 0 for a direct one) from `links` and the
 // `seeds` on line 0 (p = 0). Only the component with most seeds agreeing
 // on its p is labelled, and only where it has at least `min_seeds` of
-// them. Pure function.
+// them; the other large components are returned as islands. Pure function.
 Consensus LabelByConsensus(const std::vector<char>& odd_kind,
                            const std::vector<ConsensusLink>& links, const std::vector<int>& seeds,
                            int min_seeds, const ConsensusParams& params);

@@ -455,6 +455,35 @@ void LabelLineTracks(const TrackNetwork& net, TrackLabels* out) {
   }
 }
 
+// The consensus's islands into out->islands: their junctions that kept no
+// label of line 0's component, and the line tracks not labelled from it
+// on which most junctions are one island's, with the p most of them carry.
+void KeepIslands(const TrackNetwork& net, const Consensus& consensus, TrackLabels* out) {
+  out->islands.assign(consensus.islands, {});
+  for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j) {
+    const int k = consensus.island[j];
+    if (k < 0 || out->p[j] != kUnlabelled) continue;
+    TrackLabels::Island& island = out->islands[k];
+    island.junctions.push_back(j);
+    island.p.push_back(consensus.island_p[j]);
+    island.v.push_back(consensus.island_v[j]);
+  }
+  for (size_t t = 0; t < net.lines.size(); ++t) {
+    if (out->line_p[t] >= 0) continue;
+    std::map<std::pair<int, int>, int> votes;  // (island, relative p) -> junctions
+    for (int j : net.junctions_on_line[t])
+      if (consensus.island[j] >= 0 && out->p[j] == kUnlabelled)
+        ++votes[{consensus.island[j], consensus.island_p[j]}];
+    if (votes.empty()) continue;
+    const auto best =
+        std::max_element(votes.begin(), votes.end(),
+                         [](const auto& a, const auto& b) { return a.second < b.second; });
+    TrackLabels::Island& island = out->islands[best->first.first];
+    island.lines.push_back(static_cast<int>(t));
+    island.line_p.push_back(best->first.second);
+  }
+}
+
 }  // namespace
 
 bool TrackLabellingParams::IsValid(std::string* error) const {
@@ -473,6 +502,7 @@ bool TrackLabellingParams::IsValid(std::string* error) const {
   if (min_own_spacings < 1) return fail("min_own_spacings must be at least 1");
   if (min_support < 1) return fail("min_support must be at least 1");
   if (!(max_dissent >= 0 && max_dissent < 1)) return fail("max_dissent must lie in [0, 1)");
+  if (min_island < 0) return fail("min_island must not be negative");
   return true;
 }
 
@@ -534,7 +564,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   for (int j = 0; j < n; ++j) odd_kind[j] = net.junctions[j].kind == JunctionKind::kCorresponding;
   const Consensus consensus =
       LabelByConsensus(odd_kind, links.links(), seeds, params.min_reference_junctions,
-                       {params.min_support, params.max_dissent});
+                       {params.min_support, params.max_dissent, params.min_island});
   cancel.ThrowIfRequested("the consensus of labels");
   if (consensus.p.empty() || std::none_of(consensus.p.begin(), consensus.p.end(),
                                           [](int p) { return p != kUnlabelled; })) {
@@ -556,6 +586,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
 
   SetPointO(net, seeds, centre_row, &out);
   LabelLineTracks(net, &out);
+  KeepIslands(net, consensus, &out);
   out.ok = true;
   return out;
 }

@@ -16,7 +16,7 @@ bool SidePipelineParams::IsValid(std::string* error) const {
     return false;
   }
   return decode.IsValid(error) && proof.IsValid(error) && reconstruction.IsValid(error) &&
-         rows.IsValid(error);
+         rows.IsValid(error) && islands.IsValid(error);
 }
 
 SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeometry& geometry,
@@ -41,6 +41,7 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
   // for labels alone.
   const bool surface = params.reconstruct && !std::holds_alternative<std::monostate>(geometry);
   decoder::DecodeParams decode = params.decode;
+  if (calibration) decode.geometry = LabelGeometryOfCalibration(**calibration, params.islands);
   decode.chain = decoder::DecodeChain::kTracks;
   // The thesis's extraction or no repair: the skeleton chain's own options.
   const bool skeleton_options =
@@ -50,7 +51,7 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
   SideOutcome outcome;
   outcome.decode = decoder::Decode(grey, side, decode, cancel);
   if (surface && !params.chain && !skeleton_options) {
-    decoder::DecodeParams proof = params.decode;
+    decoder::DecodeParams proof = decode;
     proof.chain = decoder::DecodeChain::kTracks;
     outcome.decode = decoder::KeepProvenLabels(
         outcome.decode, decoder::Decode(grey, side, proof, cancel), params.proof, &outcome.proof);

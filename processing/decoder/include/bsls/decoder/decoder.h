@@ -26,12 +26,14 @@
 #define BSLS_DECODER_DECODER_H_
 
 #include <map>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "bsls/common/cancellation.h"
+#include "bsls/decoder/label_geometry.h"
 #include "bsls/extraction/feature_extraction.h"
 #include "bsls/extraction/ridge_points.h"
 #include "bsls/extraction/stripe_centre.h"
@@ -161,6 +163,10 @@ struct DecodeParams {
   // Even offset added to every q to make it the slide row; known only from a
   // calibration (slide-1 views). Unset: q is relative (thesis point O).
   std::optional<int> q_offset;
+  // A calibrated side's geometry (label_geometry.h): the track chain asks it
+  // to place the parts not joined to line 0 (islands). Unset: they stay
+  // unlabelled.
+  std::shared_ptr<const LabelGeometry> geometry;
 
   // True when every part is usable; otherwise says which and why.
   bool IsValid(std::string* error) const;
@@ -216,6 +222,13 @@ struct DecodeResult {
   int centres_measured_ahead = 0;
   int repairs = 0;
   int label_conflicts = 0;
+  // Parts not joined to line 0, proven in themselves (the track chain), and
+  // those of them the geometry placed (DecodeParams::geometry).
+  int islands = 0;
+  int islands_placed = 0;
+  // Lines the geometry moved line 0's component by, where it clearly put it
+  // elsewhere (0: it confirmed the labels, could not tell, or was not given).
+  int line_zero_moved = 0;
   std::map<interpretation::LoopClass, int> loop_classes;
   // The repaired skeleton, CV_8UC1 0/255, frame size (redrawn when binned);
   // for the track chain, the ridge points of its line and segment tracks.

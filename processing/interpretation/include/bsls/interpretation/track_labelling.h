@@ -60,6 +60,10 @@ struct TrackLabellingParams {
   // at most max_dissent links per agreeing one join otherwise, [0, 1).
   int min_support = 2;
   double max_dissent = 0.34;
+  // A part not joined to line 0's of at least this many junctions is kept
+  // as an island, labelled relative to itself for a calibration to place
+  // (TrackLabels::islands); 0 keeps none.
+  int min_island = 12;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
@@ -76,6 +80,18 @@ struct TrackLabels {
   std::vector<int> reference;  // the line tracks taken for line 0
   int conflicts = 0;           // labels dropped because their neighbours disagreed
   double row_spacing = 0;      // px between rows along a line: the median over the frame
+
+  // A part of the network not joined to line 0's, proven in itself: its
+  // junctions and line tracks labelled relative to one another, so the
+  // labels are known up to one shift (dp, dv) with dp + dv even. Without a
+  // calibration to place it, it stays unlabelled.
+  struct Island {
+    std::vector<int> junctions;  // indices into the network's junctions
+    std::vector<int> p, v;       // per entry of `junctions`: its relative label
+    std::vector<int> lines;      // line tracks most of whose junctions are the island's
+    std::vector<int> line_p;     // per entry of `lines`: its relative p
+  };
+  std::vector<Island> islands;
 };
 
 // Labels the junctions and line tracks of `network` for the brick slide of

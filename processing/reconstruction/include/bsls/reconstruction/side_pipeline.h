@@ -19,6 +19,7 @@
 #include "bsls/decoder/label_proof.h"
 #include "bsls/geometry/surface_mesh.h"
 #include "bsls/reconstruction/calibrated_model.h"
+#include "bsls/reconstruction/island_placement.h"
 #include "bsls/reconstruction/reconstruction.h"
 
 namespace bsls::reconstruction {
@@ -41,6 +42,9 @@ struct SidePipelineParams {
   ReconstructionParams reconstruction;
   PlaneModelKind planes = PlaneModelKind::kPerspective;
   SlideRowParams rows;
+  // With a calibration that has a projector matrix, the track chain places
+  // the parts not joined to line 0 by the geometry (island_placement.h).
+  IslandPlacementParams islands;
   bool reconstruct = true;  // false: decode (and absolute rows) only
 
   // True when every part is usable; otherwise names the part and why.
