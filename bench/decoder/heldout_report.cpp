@@ -22,7 +22,12 @@
 //     DIR/<seed>.png; --cache  keep each rendered frame and its visible truth in
 //     DIR (<seed>.png, <seed>.truth) and read them back on later runs (the
 //     render is 99 % of a run; the drawing code must not have changed);
-//     --quiet  totals only.
+//     --quiet  totals only; --geometry  decode with a calibration of the
+//     drawn rig as an exact session would give it
+//     (reconstruction::CalibrationOfKnownDevices, screens at 0 and 150 mm):
+//     the track chain then places the parts not joined to line 0 and checks
+//     line 0's own by the geometry (reconstruction/island_placement.h);
+//     --wrong  lists every wrongly labelled junction before its frame's line.
 // Exit status 0 when every frame ran, 2 on bad arguments, 1 on an error.
 #include <algorithm>
 #include <chrono>
@@ -39,6 +44,8 @@
 #include <vector>
 
 #include "bsls/decoder/decoder.h"
+#include "bsls/reconstruction/calibrated_model.h"
+#include "bsls/reconstruction/island_placement.h"
 #include "bsls/simulator/evaluation.h"
 #include "bsls/simulator/random_scene.h"
 #include "bsls/simulator/renderer.h"
@@ -62,6 +69,8 @@ struct Options {
   // (a frame is rendered once, then read back); empty: none.
   std::string cache;
   bool quiet = false;
+  bool geometry = false;
+  bool list_wrong = false;
 };
 
 struct FrameResult {
@@ -190,7 +199,14 @@ FrameResult RunFrame(std::uint32_t seed, const Options& o) {
     const std::string path = o.images + "/" + std::to_string(seed) + ".png";
     if (!cv::imwrite(path, image)) throw std::runtime_error("could not write " + path);
   }
-  const bsls::decoder::DecodeResult r = bsls::decoder::Decode(image, random.scene.side);
+  bsls::decoder::DecodeParams params;
+  if (o.geometry) {
+    const sim::Scene& scene = random.scene;
+    params.geometry = bsls::reconstruction::LabelGeometryOfCalibration(
+        bsls::reconstruction::CalibrationOfKnownDevices(scene.side, scene.camera, scene.projector,
+                                                        scene.pattern, image.cols, image.rows));
+  }
+  const bsls::decoder::DecodeResult r = bsls::decoder::Decode(image, random.scene.side, params);
   const auto t2 = std::chrono::steady_clock::now();
   f.render_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
   f.decode_ms = std::chrono::duration<double, std::milli>(t2 - t1).count();
@@ -218,6 +234,17 @@ FrameResult RunFrame(std::uint32_t seed, const Options& o) {
     *score = sim::ScoreLabels(*part, decoded, kMatchReach);
   }
   f.right = f.score.found - f.score.Wrong();
+  if (o.list_wrong)
+    for (const sim::PointLabel& w : f.score.wrong) {
+      const sim::PointLabel* near = nullptr;
+      for (const sim::PointLabel& d : decoded)
+        if (cv::norm(d.position - w.position) <= kMatchReach) near = &d;
+      if (!near) continue;
+      std::printf(
+          "  seed %u wrong label at (%.1f, %.1f): decoded p %d q %d, truth p %d v %d (rows offset "
+          "%d)\n",
+          seed, w.position.x, w.position.y, near->p, near->v, w.p, w.v, f.score.v_offset);
+    }
   return f;
 }
 
@@ -256,7 +283,7 @@ nlohmann::json FrameJson(const FrameResult& f) {
 int Usage(const char* argv0) {
   std::fprintf(stderr,
                "usage: %s [--set tuning|heldout] [--count N] [--first I] [--worst K] "
-               "[--json FILE] [--images DIR] [--cache DIR] [--quiet]\n",
+               "[--json FILE] [--images DIR] [--cache DIR] [--quiet] [--geometry] [--wrong]\n",
                argv0);
   return 2;
 }
@@ -290,6 +317,10 @@ int main(int argc, char** argv) {
       o.cache = argv[++i];
     } else if (a == "--quiet") {
       o.quiet = true;
+    } else if (a == "--geometry") {
+      o.geometry = true;
+    } else if (a == "--wrong") {
+      o.list_wrong = true;
     } else {
       return Usage(argv[0]);
     }
@@ -303,8 +334,9 @@ int main(int argc, char** argv) {
   try {
     const std::uint32_t first_seed = sim::SeedOf(o.set, o.first);
     const std::uint32_t last_seed = sim::SeedOf(o.set, o.first + o.count - 1);
-    std::printf("heldout_report: %s set, seeds %u..%u, default decoder, reach %.1f px\n",
-                std::string(sim::ToString(o.set)).c_str(), first_seed, last_seed, kMatchReach);
+    std::printf("heldout_report: %s set, seeds %u..%u, default decoder%s, reach %.1f px\n",
+                std::string(sim::ToString(o.set)).c_str(), first_seed, last_seed,
+                o.geometry ? " with the rig's geometry" : "", kMatchReach);
     if (!o.quiet)
       std::printf("%6s %-8s %-5s %-9s %s\n", "seed", "object", "side", "size",
                   "pitch target/measured ...");

@@ -111,6 +111,7 @@ void PrintProcessSummary(const ProcessOptions& o, const processing::WorkOutcome&
                         {"label_conflicts", s.label_conflicts()},
                         {"islands", s.islands()},
                         {"islands_placed", s.islands_placed()},
+                        {"ruled_out", s.ruled_out()},
                         {"time_ms", StageMs(out.result, "decode")},
                         {"extraction_ms", StageMs(out.result, "extraction")},
                         {"interpretation_ms", StageMs(out.result, "interpretation")},

@@ -2,6 +2,7 @@
 // on objects and faces hold it with the skeleton chain in decoder_test.cpp.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <opencv2/core/utility.hpp>
 #include <optional>
@@ -67,6 +68,14 @@ class ScriptedGeometry final : public LabelGeometry {
     if (why) *why = "scripted";
     return itself ? own_ : island_;
   }
+  // Rules out every label on line rule_out_p (-1: none), or every one.
+  std::vector<char> RuleOut(const std::vector<FramedJunction>& labelled) const override {
+    std::vector<char> out;
+    for (const FramedJunction& j : labelled) out.push_back(rule_out_all || j.p == rule_out_p);
+    return out;
+  }
+  int rule_out_p = -1;
+  bool rule_out_all = false;
   mutable int asked_[2] = {0, 0};  // islands, line 0's component
 
  private:
@@ -107,6 +116,31 @@ TEST(TrackChain, TheGeometryMovesLineZerosComponentOrRefusesItOffTheSlide) {
   const DecodeResult off = Decode(frame.image, Side::kLeft, params);
   EXPECT_FALSE(off.ok);
   EXPECT_NE(off.error.find("off the slide"), std::string::npos) << off.error;
+}
+
+TEST(TrackChain, LabelsTheGeometryRulesOutAreReportedUnlabelled) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 1);
+  const DecodeResult plain = Decode(frame.image, Side::kLeft, TrackChain());
+  ASSERT_TRUE(plain.ok) << plain.error;
+  const auto on_line_3 = std::count_if(plain.junctions.begin(), plain.junctions.end(),
+                                       [](const DecodedJunction& j) { return j.p == 3; });
+  ASSERT_GT(on_line_3, 5);
+  DecodeParams params = TrackChain();
+  auto geometry = std::make_shared<ScriptedGeometry>(LabelShift{0, 0, {}}, std::nullopt);
+  geometry->rule_out_p = 3;
+  params.geometry = geometry;
+  const DecodeResult judged = Decode(frame.image, Side::kLeft, params);
+  ASSERT_TRUE(judged.ok) << judged.error;
+  EXPECT_EQ(judged.junctions.size() + on_line_3, plain.junctions.size());
+  EXPECT_EQ(judged.unlabelled.size(), plain.unlabelled.size() + on_line_3);
+  EXPECT_EQ(judged.ruled_out, on_line_3);
+  for (const DecodedJunction& j : judged.junctions) EXPECT_NE(j.p, 3);
+
+  // Most of line 0's component off its rows: its labels are refuted.
+  geometry->rule_out_all = true;
+  const DecodeResult refuted = Decode(frame.image, Side::kLeft, params);
+  EXPECT_FALSE(refuted.ok);
+  EXPECT_NE(refuted.error.find("geometry refutes the labels"), std::string::npos) << refuted.error;
 }
 
 TEST(TrackChain, OutputsFollowTheContracts) {

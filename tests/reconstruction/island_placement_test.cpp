@@ -1,18 +1,18 @@
 // Islands placed by the geometry (island_placement.h): the simulator's plane
 // scene, its exact junctions split into line 0's part and an island whose
 // labels are shifted, under a calibration made of the scene's own devices
-// (the light planes fitted to points of the projector's planes, as step 3 of
-// a calibration fits them).
+// (CalibrationOfKnownDevices).
 #include "bsls/reconstruction/island_placement.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <string>
 #include <vector>
 
-#include "bsls/calibration/projector_calibration.h"
+#include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/simulator/ground_truth.h"
 #include "bsls/simulator/scene.h"
 
@@ -35,24 +35,8 @@ const PlaneRig& Rig(Side side) {
   const simulator::Scene scene = simulator::ThesisScene(side, simulator::SurfaceKind::kPlane);
   const simulator::GroundTruth truth = simulator::ComputeGroundTruth(scene);
   PlaneRig rig;
-  calibration::SideCalibration& cal = rig.calibration;
-  cal.side = side;
-  cal.width = truth.width;
-  cal.height = truth.height;
-  cal.pattern = truth.pattern;
-  cal.camera.model = truth.camera;
-  cal.projector_matrix = calibration::ProjectorMatrixFit{};
-  cal.projector_matrix->model = truth.projector;
-  std::vector<calibration::StripePoint> points;
-  for (int p = 0; p < truth.pattern.lines; ++p)
-    for (double z : {0.0, 50.0, 100.0})
-      for (double t : {-20.0, 0.0, 20.0}) {
-        const geometry::Ray ray = truth.projector.BackProject({pattern::SFromU(side, p), t});
-        const double k = (z - ray.origin.z()) / ray.direction.z();
-        points.push_back({ray.origin + k * ray.direction, p});
-      }
-  cal.perspective = calibration::FitPerspectivePlaneModel(points);
-  for (double z : {0.0, 100.0}) cal.screen_views.push_back({"", z});
+  rig.calibration = CalibrationOfKnownDevices(side, truth.camera, truth.projector, truth.pattern,
+                                              truth.width, truth.height, {0.0, 100.0});
   for (const simulator::TruthJunction& j : truth.junctions)
     if (j.visible) rig.visible.push_back(j);
   return cache.emplace(side, std::move(rig)).first->second;
@@ -113,6 +97,28 @@ TEST_P(IslandPlacement, LineZerosPartTakenTwoLinesOffIsMovedBack) {
   ASSERT_TRUE(none.has_value()) << why;
   EXPECT_EQ(none->dp, 0);
   EXPECT_EQ(none->dq, 0);
+}
+
+TEST_P(IslandPlacement, ALabelOffItsRowIsRuledOutTheOthersKept) {
+  const PlaneRig& rig = Rig(GetParam());
+  const auto geometry = LabelGeometryOfCalibration(rig.calibration);
+  std::vector<decoder::FramedJunction> labelled;
+  for (const simulator::TruthJunction& j : rig.visible)
+    if (j.p <= 8) labelled.push_back(At(j, j.p, j.v - 2));
+  ASSERT_GE(labelled.size(), 40u);
+  std::vector<char> out = geometry->RuleOut(labelled);
+  EXPECT_EQ(std::count(out.begin(), out.end(), 1), 0);
+  labelled[10].q += 2;  // two rows off: the same kind, another row
+  labelled[20].p += 1;  // one line off: the ray meets that plane off every row of the parity
+  labelled[20].q += 1;
+  out = geometry->RuleOut(labelled);
+  EXPECT_EQ(out[10], 1);
+  EXPECT_EQ(out[20], 1);
+  EXPECT_EQ(std::count(out.begin(), out.end(), 1), 2);
+  // Too few junctions to fix the rows: nothing is judged.
+  labelled.resize(5);
+  out = geometry->RuleOut(labelled);
+  EXPECT_EQ(std::count(out.begin(), out.end(), 1), 0);
 }
 
 TEST_P(IslandPlacement, NoiseOfAPixelStillPlacesIt) {

@@ -626,14 +626,18 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
 // the calibration's `geometry` judges line 0's component first: where it
 // clearly puts the component at another shift (the track taken for line 0
 // was another line in phase with it), the component moves there, or, off
-// the slide, the frame is refused. Then each island of `labels` takes the
-// shift the geometry proves for it; one that the geometry cannot place, or
-// whose labels would repeat one of line 0's component (a slide junction is
-// seen once), fall off the slide or disagree with their kind, stays
-// unlabelled. Counts the islands placed and the component's move in `result`.
+// the slide, the frame is refused; its junctions the geometry rules out lose
+// their labels. Then each island of `labels` takes the shift the geometry
+// proves for it, less the junctions it rules out and those whose labels
+// another junction already holds (a slide junction is seen once); where those
+// are more than a tenth of the island, or any label would fall off the slide
+// or disagree with its kind, the island stays unlabelled. Counts the islands
+// placed and the component's move in `result`.
 void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::PatternSpec& spec,
                      const WorkingScale& scale, const LabelGeometry& geometry,
                      interpretation::TrackLabels* labels, DecodeResult* result) {
+  constexpr double kMaxDropped = 0.1;
+  constexpr double kMaxRefuted = 1.0 / 3.0;
   std::vector<FramedJunction> labelled;
   std::vector<int> index;
   for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
@@ -641,26 +645,28 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
       labelled.push_back({scale.ToFull(net.junctions[j].position), labels->p[j], labels->v[j]});
       index.push_back(j);
     }
-  auto fits = [&](const std::vector<int>& junctions, const std::vector<int>& p,
-                  const std::vector<int>& v, const std::vector<int>& line_p, LabelShift shift,
-                  const std::set<std::pair<int, int>>& taken) {
-    for (size_t k = 0; k < junctions.size(); ++k)
-      if (pattern::JunctionOnRowParity(spec, p[k] + shift.dp, v[k] + shift.dq) !=
-              net.junctions[junctions[k]].kind ||
-          taken.contains({p[k] + shift.dp, v[k] + shift.dq}))
-        return false;
+  auto on_slide = [&](int j, int p, int v) {
+    return pattern::JunctionOnRowParity(spec, p, v) == net.junctions[j].kind;
+  };
+  // A geometry that judges no junction one by one rules none out.
+  auto ruled_out = [](const LabelShift& shift, size_t k) {
+    return k < shift.ruled_out.size() && shift.ruled_out[k];
+  };
+  auto lines_on_slide = [&](const std::vector<int>& line_p, int dp) {
     return std::all_of(line_p.begin(), line_p.end(),
-                       [&](int lp) { return lp + shift.dp >= 0 && lp + shift.dp < spec.lines; });
+                       [&](int lp) { return lp + dp >= 0 && lp + dp < spec.lines; });
   };
 
   std::string why;
   if (const auto own = geometry.PlaceIsland(labelled, labelled, &why);
       own && (own->dp != 0 || own->dq != 0)) {
-    std::vector<int> p, v, line_p;
-    for (const FramedJunction& j : labelled) p.push_back(j.p), v.push_back(j.q);
+    std::vector<int> line_p;
     for (int lp : labels->line_p)
       if (lp >= 0) line_p.push_back(lp);
-    if (!fits(index, p, v, line_p, *own, {})) {
+    bool fits = lines_on_slide(line_p, own->dp);
+    for (size_t k = 0; k < index.size() && fits; ++k)
+      fits = on_slide(index[k], labelled[k].p + own->dp, labelled[k].q + own->dq);
+    if (!fits) {
       labels->ok = false;
       labels->error = "the calibration's geometry puts the labels " + std::to_string(own->dp) +
                       " lines off, off the slide: the line taken for line 0 is not line 0";
@@ -676,6 +682,27 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
       if (lp >= 0) lp += own->dp;
     result->line_zero_moved = own->dp;
   }
+  // A label the geometry rules out is not reported; where it rules out more
+  // than a third of the component, the component's labels are refuted.
+  const std::vector<char> out = geometry.RuleOut(labelled);
+  const auto refuted = std::count(out.begin(), out.end(), 1);
+  if (refuted > kMaxRefuted * static_cast<double>(labelled.size())) {
+    labels->ok = false;
+    labels->error = "the calibration's geometry refutes the labels: " + std::to_string(refuted) +
+                    " of " + std::to_string(labelled.size()) +
+                    " junctions of line 0's part are off their rows";
+    return;
+  }
+  std::vector<FramedJunction> kept;
+  for (size_t k = 0; k < index.size(); ++k) {
+    if (k < out.size() && out[k]) {
+      labels->p[index[k]] = labels->v[index[k]] = interpretation::kUnlabelled;
+      ++result->ruled_out;
+    } else {
+      kept.push_back(labelled[k]);
+    }
+  }
+  labelled = std::move(kept);
   std::set<std::pair<int, int>> taken;
   for (const FramedJunction& j : labelled) taken.emplace(j.p, j.q);
   for (const interpretation::TrackLabels::Island& island : labels->islands) {
@@ -684,16 +711,51 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
       own.push_back(
           {scale.ToFull(net.junctions[island.junctions[k]].position), island.p[k], island.v[k]});
     const std::optional<LabelShift> shift = geometry.PlaceIsland(labelled, own, &why);
-    if (!shift || !fits(island.junctions, island.p, island.v, island.line_p, *shift, taken))
-      continue;
+    if (!shift || !lines_on_slide(island.line_p, shift->dp)) continue;
+    std::vector<char> keep(island.junctions.size(), 0);
+    bool fits = true;
+    size_t dropped = 0;
+    for (size_t k = 0; k < island.junctions.size() && fits; ++k) {
+      const int p = island.p[k] + shift->dp, v = island.v[k] + shift->dq;
+      fits = on_slide(island.junctions[k], p, v);
+      keep[k] = !ruled_out(*shift, k) && !taken.contains({p, v});
+      dropped += !keep[k];
+    }
+    if (!fits || dropped > kMaxDropped * static_cast<double>(island.junctions.size())) continue;
     for (size_t k = 0; k < island.junctions.size(); ++k) {
+      if (!keep[k]) continue;
       labels->p[island.junctions[k]] = island.p[k] + shift->dp;
       labels->v[island.junctions[k]] = island.v[k] + shift->dq;
     }
+    result->ruled_out += static_cast<int>(dropped);
     for (size_t k = 0; k < island.lines.size(); ++k)
       labels->line_p[island.lines[k]] = island.line_p[k] + shift->dp;
     ++result->islands_placed;
   }
+}
+
+// The junctions as they leave the decoder, at their sub-pixel places: a
+// label the geometry rules out there is taken back and the junction listed
+// unlabelled (its place can differ from the track junction's judged before).
+void RuleOutPlaced(const LabelGeometry& geometry, DecodeResult* result) {
+  std::vector<FramedJunction> placed;
+  for (const DecodedJunction& j : result->junctions) placed.push_back({j.position, j.p, j.q});
+  const std::vector<char> out = geometry.RuleOut(placed);
+  std::vector<DecodedJunction> kept;
+  for (size_t k = 0; k < result->junctions.size(); ++k) {
+    const DecodedJunction& j = result->junctions[k];
+    if (k < out.size() && out[k]) {
+      result->unlabelled.push_back({j.position, j.kind});
+      ++result->ruled_out;
+    } else {
+      kept.push_back(j);
+    }
+  }
+  result->junctions = std::move(kept);
+  std::sort(result->unlabelled.begin(), result->unlabelled.end(),
+            [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
+              return a.position.y < b.position.y;
+            });
 }
 
 }  // namespace
@@ -744,6 +806,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   result->junctions =
       PlaceTrackJunctions(working, net, labels, centres, params, scale, &result->label_conflicts);
   result->unlabelled = UnlabelledJunctions(net, labels, scale);
+  if (params.geometry) RuleOutPlaced(*params.geometry, result);
   result->lines = DecodedLines(working, net, labelled, labels, centres, working.rows, scale);
   result->times.subpixel_ms = MsSince(t);
   result->ok = true;

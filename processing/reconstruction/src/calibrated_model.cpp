@@ -49,6 +49,39 @@ TriangulationModel ModelOfKnownDevices(pattern::Side side, const geometry::Pinho
   return model;
 }
 
+calibration::SideCalibration CalibrationOfKnownDevices(pattern::Side side,
+                                                       const geometry::PinholeModel& camera,
+                                                       const geometry::PinholeModel& projector,
+                                                       const pattern::PatternSpec& pattern,
+                                                       int width, int height,
+                                                       const std::vector<double>& screen_z_mm) {
+  if (screen_z_mm.size() < 2)
+    throw std::invalid_argument("CalibrationOfKnownDevices: two screen heights are needed");
+  calibration::SideCalibration cal;
+  cal.side = side;
+  cal.width = width;
+  cal.height = height;
+  cal.pattern = pattern;
+  cal.camera.model = camera;
+  cal.projector_matrix = calibration::ProjectorMatrixFit{};
+  cal.projector_matrix->model = projector;
+  // Points of every line's plane: the projector's rays through the line's
+  // top, middle and bottom, cut at each screen height.
+  std::vector<calibration::StripePoint> points;
+  for (int p = 0; p < pattern.lines; ++p)
+    for (double z : screen_z_mm)
+      for (double t :
+           {-static_cast<double>(pattern.rows), 0.0, static_cast<double>(pattern.rows)}) {
+        const geometry::Ray ray = projector.BackProject({pattern::SFromU(side, p), t});
+        if (std::abs(ray.direction.z()) < 1e-9) continue;
+        const double k = (z - ray.origin.z()) / ray.direction.z();
+        points.push_back({ray.origin + k * ray.direction, p});
+      }
+  cal.perspective = calibration::FitPerspectivePlaneModel(points);
+  for (double z : screen_z_mm) cal.screen_views.push_back({"", z});
+  return cal;
+}
+
 bool SlideRowParams::IsValid(std::string* error) const {
   if (!(agreement_rows > 0.0 && agreement_rows < 1.0))
     return Fail(error, "SlideRowParams.agreement_rows must lie in (0, 1) rows");

@@ -48,6 +48,7 @@ class EpipolarGeometry final : public decoder::LabelGeometry {
   std::optional<decoder::LabelShift> PlaceIsland(
       const std::vector<decoder::FramedJunction>& labelled,
       const std::vector<decoder::FramedJunction>& island, std::string* why) const override;
+  std::vector<char> RuleOut(const std::vector<decoder::FramedJunction>& labelled) const override;
 
  private:
   // The slide row of the junction at `image` on the light plane of line p,
@@ -154,7 +155,26 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
   if (rival < std::max(params_.min_rival_ratio * best_fit.rms, params_.min_rival_rms_rows))
     return fail("two shifts fit (" + std::to_string(best_fit.rms) + " and " +
                 std::to_string(rival) + " rows RMS)");
-  return decoder::LabelShift{*best, best_fit.dv - *offset};
+  decoder::LabelShift shift{*best, best_fit.dv - *offset, {}};
+  shift.ruled_out.reserve(island.size());
+  for (const decoder::FramedJunction& j : island) {
+    const auto row = SlideRow(j.position, j.p + *best);
+    shift.ruled_out.push_back(
+        !row || std::abs(row->first - j.q - best_fit.dv) > params_.max_junction_rows);
+  }
+  return shift;
+}
+
+std::vector<char> EpipolarGeometry::RuleOut(
+    const std::vector<decoder::FramedJunction>& labelled) const {
+  std::vector<char> out(labelled.size(), 0);
+  const auto offset = RowOffset(labelled, nullptr);
+  if (!offset) return out;
+  for (size_t k = 0; k < labelled.size(); ++k) {
+    const auto row = SlideRow(labelled[k].position, labelled[k].p);
+    out[k] = !row || std::abs(row->first - labelled[k].q - *offset) > params_.max_junction_rows;
+  }
+  return out;
 }
 
 }  // namespace
@@ -172,6 +192,8 @@ bool IslandPlacementParams::IsValid(std::string* error) const {
   if (!(min_rival_ratio >= 1)) return fail("IslandPlacementParams.min_rival_ratio must be >= 1");
   if (!(min_rival_rms_rows > 0))
     return fail("IslandPlacementParams.min_rival_rms_rows must be positive");
+  if (!(max_junction_rows > 0))
+    return fail("IslandPlacementParams.max_junction_rows must be positive");
   return true;
 }
 

@@ -244,6 +244,7 @@ void FillSide(const reconstruction::SideOutcome& o, pattern::Side side, v1::Side
   out->set_label_conflicts(static_cast<std::uint32_t>(d.label_conflicts));
   out->set_islands(static_cast<std::uint32_t>(d.islands));
   out->set_islands_placed(static_cast<std::uint32_t>(d.islands_placed));
+  out->set_ruled_out(static_cast<std::uint32_t>(d.ruled_out));
   out->set_dropped_samples(static_cast<std::uint32_t>(o.report.dropped_samples));
   out->set_surface_junctions(static_cast<std::uint32_t>(o.report.junctions));
   out->set_junctions_by_projector(static_cast<std::uint32_t>(o.report.junctions_by_projector));

@@ -229,6 +229,8 @@ struct DecodeResult {
   // Lines the geometry moved line 0's component by, where it clearly put it
   // elsewhere (0: it confirmed the labels, could not tell, or was not given).
   int line_zero_moved = 0;
+  // Junctions whose labels the geometry ruled out (reported unlabelled).
+  int ruled_out = 0;
   std::map<interpretation::LoopClass, int> loop_classes;
   // The repaired skeleton, CV_8UC1 0/255, frame size (redrawn when binned);
   // for the track chain, the ridge points of its line and segment tracks.

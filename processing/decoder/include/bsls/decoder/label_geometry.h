@@ -32,10 +32,14 @@ struct FramedJunction {
   int q = 0;
 };
 
-// A shift of labels: (p + dp, q + dq), dp + dq even.
+// A shift of labels: (p + dp, q + dq), dp + dq even, and the junctions
+// whose own place the geometry rules out under it.
 struct LabelShift {
   int dp = 0;
   int dq = 0;
+  // Per junction of the island judged: 1 where, shifted, it does not land on
+  // its row (a label inside the island that is wrong) or cannot be placed.
+  std::vector<char> ruled_out;
 };
 
 // A calibrated side's judgement of labels.
@@ -45,11 +49,19 @@ class LabelGeometry {
 
   // The one shift that takes `island`'s relative labels into the frame of
   // `labelled` (line 0's component, p absolute, q relative to its own even
-  // offset), where the geometry allows exactly one; nullopt, with the
-  // reason in `why`, where it allows none or cannot tell the candidates apart.
+  // offset), where the geometry allows exactly one, with the junctions it
+  // rules out; nullopt, with the reason in `why`, where it allows none or
+  // cannot tell the candidates apart. Asked with `island` == `labelled`, it
+  // judges line 0's component itself ({0, 0} where it confirms it).
   virtual std::optional<LabelShift> PlaceIsland(const std::vector<FramedJunction>& labelled,
                                                 const std::vector<FramedJunction>& island,
                                                 std::string* why) const = 0;
+
+  // Per junction of `labelled` (labels in one frame, p absolute): 1 where
+  // the geometry rules its label out (its junction does not land on its
+  // row, or on the slide, under the frame's own rows); all 0 where there are
+  // too few junctions to fix the rows.
+  virtual std::vector<char> RuleOut(const std::vector<FramedJunction>& labelled) const = 0;
 };
 
 }  // namespace bsls::decoder

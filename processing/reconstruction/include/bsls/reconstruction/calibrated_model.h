@@ -13,6 +13,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/decoder/decoder.h"
@@ -39,6 +40,18 @@ TriangulationModel ModelOfCalibration(const calibration::SideCalibration& calibr
 // and the projector for junctions; default uncertainty params.
 TriangulationModel ModelOfKnownDevices(pattern::Side side, const geometry::PinholeModel& camera,
                                        const geometry::PinholeModel& projector);
+
+// The calibration a perfect session on a camera and a projector known
+// exactly (e.g. the simulator's rig) would give: the camera, the projector
+// as its matrix, the perspective light planes fitted (thesis 6.2.2) to
+// points of the projector's planes between the heights of `screen_z_mm`
+// (listed as screen views), for a frame of width x height and `pattern`.
+// Without measuring errors; for reports and tests that need a calibration of
+// a drawn rig.
+calibration::SideCalibration CalibrationOfKnownDevices(
+    pattern::Side side, const geometry::PinholeModel& camera,
+    const geometry::PinholeModel& projector, const pattern::PatternSpec& pattern, int width,
+    int height, const std::vector<double>& screen_z_mm = {0.0, 150.0});
 
 struct SlideRowParams {
   // A junction agrees with the offset when its projected slide row lies

@@ -44,6 +44,9 @@ struct IslandPlacementParams {
   double min_rival_ratio = 3.0;
   // and at least this far, rows, > 0.
   double min_rival_rms_rows = 0.15;
+  // Under the shift chosen, a junction farther than this from its row is
+  // ruled out (a wrong label inside the island), rows, > 0.
+  double max_junction_rows = 0.2;
 
   // True when the numbers are usable; otherwise names the field.
   bool IsValid(std::string* error) const;
