@@ -159,8 +159,8 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
   shift.ruled_out.reserve(island.size());
   for (const decoder::FramedJunction& j : island) {
     const auto row = SlideRow(j.position, j.p + *best);
-    shift.ruled_out.push_back(
-        !row || std::abs(row->first - j.q - best_fit.dv) > params_.max_junction_rows);
+    shift.ruled_out.push_back(!row ||
+                              std::abs(row->first - j.q - best_fit.dv) > params_.max_junction_rows);
   }
   return shift;
 }
