@@ -473,6 +473,14 @@ std::vector<int> JunctionPerLabel(const interpretation::TrackNetwork& net,
   return placed;
 }
 
+// Orders unlabelled junctions by y, as DecodeResult::unlabelled is.
+void SortByRow(std::vector<UnlabelledJunction>* junctions) {
+  std::sort(junctions->begin(), junctions->end(),
+            [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
+              return a.position.y < b.position.y;
+            });
+}
+
 // Junctions seen whose label could not be proven: reported at their ridge
 // points (full frame), not placed, ordered by y.
 std::vector<UnlabelledJunction> UnlabelledJunctions(const interpretation::TrackNetwork& net,
@@ -482,9 +490,7 @@ std::vector<UnlabelledJunction> UnlabelledJunctions(const interpretation::TrackN
   for (int j = 0; j < static_cast<int>(net.junctions.size()); ++j)
     if (labels.p[j] == interpretation::kUnlabelled)
       out.push_back({scale.ToFull(net.junctions[j].position), net.junctions[j].kind});
-  std::sort(out.begin(), out.end(), [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
-    return a.position.y < b.position.y;
-  });
+  SortByRow(&out);
   return out;
 }
 
@@ -622,6 +628,13 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
   return junctions;
 }
 
+// Whether verdict k of a geometry's per-junction list rules its junction
+// out; a geometry that judges no junction one by one (a shorter list) rules
+// none out.
+bool RuledOut(const std::vector<char>& verdicts, size_t k) {
+  return k < verdicts.size() && verdicts[k];
+}
+
 // Issue 25 parts 3-4 (docs/decoding.md, "Islands placed by the geometry"):
 // the calibration's `geometry` judges line 0's component first: where it
 // clearly puts the component at another shift (the track taken for line 0
@@ -647,10 +660,6 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
     }
   auto on_slide = [&](int j, int p, int v) {
     return pattern::JunctionOnRowParity(spec, p, v) == net.junctions[j].kind;
-  };
-  // A geometry that judges no junction one by one rules none out.
-  auto ruled_out = [](const LabelShift& shift, size_t k) {
-    return k < shift.ruled_out.size() && shift.ruled_out[k];
   };
   auto lines_on_slide = [&](const std::vector<int>& line_p, int dp) {
     return std::all_of(line_p.begin(), line_p.end(),
@@ -695,7 +704,7 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
   }
   std::vector<FramedJunction> kept;
   for (size_t k = 0; k < index.size(); ++k) {
-    if (k < out.size() && out[k]) {
+    if (RuledOut(out, k)) {
       labels->p[index[k]] = labels->v[index[k]] = interpretation::kUnlabelled;
       ++result->ruled_out;
     } else {
@@ -718,7 +727,7 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
     for (size_t k = 0; k < island.junctions.size() && fits; ++k) {
       const int p = island.p[k] + shift->dp, v = island.v[k] + shift->dq;
       fits = on_slide(island.junctions[k], p, v);
-      keep[k] = !ruled_out(*shift, k) && !taken.contains({p, v});
+      keep[k] = !RuledOut(shift->ruled_out, k) && !taken.contains({p, v});
       dropped += !keep[k];
     }
     if (!fits || dropped > kMaxDropped * static_cast<double>(island.junctions.size())) continue;
@@ -744,7 +753,7 @@ void RuleOutPlaced(const LabelGeometry& geometry, DecodeResult* result) {
   std::vector<DecodedJunction> kept;
   for (size_t k = 0; k < result->junctions.size(); ++k) {
     const DecodedJunction& j = result->junctions[k];
-    if (k < out.size() && out[k]) {
+    if (RuledOut(out, k)) {
       result->unlabelled.push_back({j.position, j.kind});
       ++result->ruled_out;
     } else {
@@ -752,10 +761,7 @@ void RuleOutPlaced(const LabelGeometry& geometry, DecodeResult* result) {
     }
   }
   result->junctions = std::move(kept);
-  std::sort(result->unlabelled.begin(), result->unlabelled.end(),
-            [](const UnlabelledJunction& a, const UnlabelledJunction& b) {
-              return a.position.y < b.position.y;
-            });
+  SortByRow(&result->unlabelled);
 }
 
 }  // namespace
