@@ -8,6 +8,8 @@
 
 #include <cerrno>
 #include <cstring>
+#include <string>
+#include <vector>
 
 namespace bsls::store {
 
@@ -185,25 +187,25 @@ Result<std::string> ReadWholeFile(FileSystem& fs, const std::string& path,
                                   std::uint64_t max_bytes) {
   auto fd = fs.Open(path, O_RDONLY, 0);
   if (!fd.ok()) return Prefixed(fd.status(), "opening " + path);
+  // Read through one modest buffer and append: the string grows with what
+  // the file holds, never zero-filled ahead of it.
+  constexpr std::size_t kChunk = 64 * 1024;
+  std::vector<char> chunk(kChunk);
   std::string bytes;
   Status status;
-  constexpr std::size_t kChunk = 1 << 20;
   while (status.ok()) {
-    const std::size_t old_size = bytes.size();
-    if (old_size > max_bytes) {
+    if (bytes.size() > max_bytes) {
       status = Status(ErrorCode::kDataLoss,
                       path + " is larger than " + std::to_string(max_bytes) + " bytes");
       break;
     }
-    bytes.resize(old_size + kChunk);
-    auto got = fs.Read(*fd, bytes.data() + old_size, kChunk);
+    auto got = fs.Read(*fd, chunk.data(), kChunk);
     if (!got.ok()) {
       status = Prefixed(got.status(), "reading " + path);
-      bytes.resize(old_size);
       break;
     }
-    bytes.resize(old_size + *got);
     if (*got == 0) break;
+    bytes.append(chunk.data(), *got);
   }
   fs.Close(*fd);  // read-only: nothing to lose on a failed close
   if (!status.ok()) return status;
