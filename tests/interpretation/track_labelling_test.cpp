@@ -6,6 +6,7 @@
 
 #include "bsls/simulator/evaluation.h"
 #include "bsls/testing/synthetic_brick.h"
+#include "label_votes.h"
 
 namespace bsls::interpretation {
 namespace {
@@ -156,6 +157,32 @@ TEST(TrackLabelling, LineOneMistakenForLineZeroIsRejected) {
   const Labelled l = Label(RenderGrey(b), params.side);
   EXPECT_FALSE(l.labels.ok);
   EXPECT_NE(l.labels.error.find("line 0"), std::string::npos) << l.labels.error;
+}
+
+// Consistency along the line (label_votes.h): junctions down one line
+// labelled p 0, 0, 2, 2, 0 cannot all be right; the run of 2 between the
+// runs of 0 is dropped (held-out seed 100900: three junctions of line 0 at
+// the ball's shadow were labelled p 2 through a segment into the ball).
+TEST(LineRuns, ARunBetweenTwoRunsOfAnotherPIsDropped) {
+  constexpr int U = kUnlabelled;
+  std::vector<int> p = {0, 0, 2, U, 2, 0, 5, 5};
+  std::vector<int> v = {-4, -2, 0, U, 4, 6, 0, 2};
+  const std::vector<std::vector<int>> lines = {{0, 1, 2, 3, 4, 5}, {6, 7}};
+  EXPECT_EQ(internal::DropRunsBetweenOneP(lines, &p, &v, U), 2);
+  EXPECT_EQ(p, (std::vector<int>{0, 0, U, U, U, 0, 5, 5}));
+  EXPECT_EQ(v, (std::vector<int>{-4, -2, U, U, U, 6, 0, 2}));
+}
+
+// A line may cross onto another surface once (the base plane beside an
+// object, both parts labelled right): its p changes and stays changed, and
+// nothing is dropped; nor at either end of the line.
+TEST(LineRuns, APChangingOnceOrAtAnEndIsKept) {
+  std::vector<int> p = {0, 0, 0, 3, 3, 1, 4, 4};
+  std::vector<int> v = {0, 2, 4, 6, 8, 0, 2, 4};
+  const std::vector<int> p_before = p, v_before = v;
+  EXPECT_EQ(internal::DropRunsBetweenOneP({{0, 1, 2, 3, 4}, {5, 6, 7}}, &p, &v, kUnlabelled), 0);
+  EXPECT_EQ(p, p_before);
+  EXPECT_EQ(v, v_before);
 }
 
 TEST(TrackLabelling, InvalidParamsAreRejected) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <utility>
 #include <vector>
 
 namespace bsls::interpretation::internal {
@@ -63,6 +64,31 @@ int DropDisagreeingLabels(const std::vector<std::vector<Link>>& adj, LabelOf lab
     }
     for (int j : drop) unlabel(j);
     dropped += static_cast<int>(drop.size());
+  }
+  return dropped;
+}
+
+// Consistency along the line: going down a line (junctions_on_line[t], by
+// increasing y), its labelled junctions fall into runs of one p. A line may
+// cross from one surface to another (the base plane beside an object) and
+// its p change there, but a run between two runs of one other p would have
+// the line leave its p and come back: such a run's labels are set to
+// `unlabelled` in *p and *v. Returns how many were dropped.
+inline int DropRunsBetweenOneP(const std::vector<std::vector<int>>& junctions_on_line,
+                               std::vector<int>* p, std::vector<int>* v, int unlabelled) {
+  int dropped = 0;
+  for (const std::vector<int>& line : junctions_on_line) {
+    std::vector<std::pair<int, std::vector<int>>> runs;  // (p, junctions), down the line
+    for (int j : line) {
+      if ((*p)[j] == unlabelled) continue;
+      if (runs.empty() || runs.back().first != (*p)[j]) runs.push_back({(*p)[j], {}});
+      runs.back().second.push_back(j);
+    }
+    for (size_t r = 1; r + 1 < runs.size(); ++r) {
+      if (runs[r - 1].first != runs[r + 1].first) continue;
+      for (int j : runs[r].second) (*p)[j] = (*v)[j] = unlabelled;
+      dropped += static_cast<int>(runs[r].second.size());
+    }
   }
   return dropped;
 }

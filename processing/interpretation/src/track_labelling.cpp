@@ -585,6 +585,8 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
       [&](int j) { out.p[j] = out.v[j] = kUnlabelled; });
 
   SetPointO(net, seeds, centre_row, &out);
+  out.conflicts +=
+      internal::DropRunsBetweenOneP(net.junctions_on_line, &out.p, &out.v, kUnlabelled);
   LabelLineTracks(net, &out);
   KeepIslands(net, consensus, &out);
   out.ok = true;
