@@ -51,13 +51,23 @@ bool ParseInt(std::string_view text, long* value) {
 MeshLoadError::MeshLoadError(const std::filesystem::path& path, const std::string& reason)
     : std::runtime_error(path.string() + ": " + reason), path_(path), reason_(reason) {}
 
-IndexedMesh LoadObj(const std::filesystem::path& path) {
+namespace {
+
+// `path` open for reading; MeshLoadError saying whether it is missing or unreadable.
+std::ifstream OpenMeshFile(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) {
     std::error_code ec;
     const bool exists = std::filesystem::exists(path, ec);
     throw MeshLoadError(path, exists ? "cannot be opened for reading" : "no such file");
   }
+  return in;
+}
+
+}  // namespace
+
+IndexedMesh LoadObj(const std::filesystem::path& path) {
+  std::ifstream in = OpenMeshFile(path);
   IndexedMesh mesh;
   std::string line;
   int line_number = 0;
@@ -110,12 +120,7 @@ IndexedMesh LoadObj(const std::filesystem::path& path) {
 }
 
 IndexedMesh LoadMeshJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) {
-    std::error_code ec;
-    const bool exists = std::filesystem::exists(path, ec);
-    throw MeshLoadError(path, exists ? "cannot be opened for reading" : "no such file");
-  }
+  std::ifstream in = OpenMeshFile(path);
   nlohmann::json doc;
   try {
     doc = nlohmann::json::parse(in);
