@@ -174,8 +174,8 @@ TEST_P(IslandPlacement, TooFewJunctionsAreNotJudged) {
 }
 
 INSTANTIATE_TEST_SUITE_P(BothSides, IslandPlacement, ::testing::Values(Side::kLeft, Side::kRight),
-                         [](const auto& info) {
-                           return std::string(pattern::ToString(info.param));
+                         [](const ::testing::TestParamInfo<Side>& side) {
+                           return std::string(pattern::ToString(side.param));
                          });
 
 TEST(IslandPlacementParams, NeedsAProjectorMatrixAndValidNumbers) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <stdexcept>
 #include <vector>
 
@@ -93,6 +94,23 @@ bool SlideRowParams::IsValid(std::string* error) const {
 
 // Contracts section 2: q is known up to an even offset; the projector matrix
 // (thesis eq. 2.16) says which slide row each seen junction came from.
+std::optional<SlidePoint> JunctionOnSlide(const calibration::SideCalibration& calibration,
+                                          const cv::Point2d& image, int p) {
+  if (!calibration.projector_matrix) return std::nullopt;
+  const calibration::LightPlane plane = calibration.perspective.model.PlaneOfLine(p);
+  const auto world = plane.Intersect(calibration.camera.model.BackProject({image.x, image.y}));
+  if (!world) return std::nullopt;
+  const auto slide = calibration.projector_matrix->model.Project(*world);
+  if (!slide) return std::nullopt;
+  return SlidePoint{*world, *slide};
+}
+
+int EvenRowOffset(std::vector<double>* residues) {
+  const auto mid = residues->begin() + static_cast<std::ptrdiff_t>(residues->size() / 2);
+  std::nth_element(residues->begin(), mid, residues->end());
+  return 2 * static_cast<int>(std::lround(*mid / 2.0));
+}
+
 std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
                                   const calibration::SideCalibration& calibration, std::string* why,
                                   const SlideRowParams& params) {
@@ -105,17 +123,11 @@ std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
     Fail(why, "the calibration has no projector matrix (its manifest had no reference views)");
     return std::nullopt;
   }
-  const geometry::PinholeModel& camera = calibration.camera.model;
-  const geometry::PinholeModel& projector = calibration.projector_matrix->model;
   std::vector<double> residue;  // slide row t minus the decoded q, per junction
   for (const decoder::DecodedJunction& j : decode.junctions) {
     if (j.interpolated) continue;
-    const calibration::LightPlane plane = calibration.perspective.model.PlaneOfLine(j.p);
-    const auto world = plane.Intersect(camera.BackProject({j.position.x, j.position.y}));
-    if (!world) continue;
-    const auto slide = projector.Project(*world);
-    if (!slide) continue;
-    residue.push_back(slide->y() - j.q);
+    if (const auto on = JunctionOnSlide(calibration, j.position, j.p))
+      residue.push_back(on->slide.y() - j.q);
   }
   if (static_cast<int>(residue.size()) < params.min_junctions) {
     Fail(why, std::to_string(residue.size()) + " junctions could be placed on the slide, " +
@@ -123,9 +135,8 @@ std::optional<int> SlideRowOffset(const decoder::DecodeResult& decode,
     return std::nullopt;
   }
   std::vector<double> sorted = residue;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const int offset = EvenRowOffset(&sorted);
   const double median = sorted[sorted.size() / 2];
-  const int offset = 2 * static_cast<int>(std::lround(median / 2.0));
   const auto agree = std::count_if(residue.begin(), residue.end(), [&](double r) {
     return std::abs(r - offset) <= params.agreement_rows;
   });

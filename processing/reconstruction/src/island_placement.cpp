@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "bsls/reconstruction/calibrated_model.h"
+
 namespace bsls::reconstruction {
 
 namespace {
@@ -30,11 +32,7 @@ class EpipolarGeometry final : public decoder::LabelGeometry {
  public:
   EpipolarGeometry(const calibration::SideCalibration& calibration,
                    const IslandPlacementParams& params)
-      : camera_(calibration.camera.model),
-        projector_(calibration.projector_matrix->model),
-        planes_(calibration.perspective.model),
-        lines_(calibration.pattern.lines),
-        params_(params) {
+      : calibration_(calibration), lines_(calibration.pattern.lines), params_(params) {
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (const auto& v : calibration.camera_views)
       lo = std::min(lo, v.z_mm), hi = std::max(hi, v.z_mm);
@@ -55,15 +53,17 @@ class EpipolarGeometry final : public decoder::LabelGeometry {
   // and whether that point lies in the measuring volume; nullopt where the
   // ray misses the plane or the projector.
   std::optional<std::pair<double, bool>> SlideRow(const cv::Point2d& image, int p) const;
+  // Whether the junction at `image`, labelled (p, q), misses its slide row
+  // under `offset` (slide row = q + offset) by more than max_junction_rows,
+  // or cannot be placed on the slide.
+  bool OffItsRow(const cv::Point2d& image, int p, int q, int offset) const;
   // The rows of line 0's component: the even offset from its q to slide rows.
   std::optional<int> RowOffset(const std::vector<decoder::FramedJunction>& labelled,
                                std::string* why) const;
   // The fit of `island` shifted by dp.
   Fit FitShift(const std::vector<decoder::FramedJunction>& island, int dp) const;
 
-  geometry::PinholeModel camera_;
-  geometry::PinholeModel projector_;
-  calibration::PerspectivePlaneModel planes_;
+  calibration::SideCalibration calibration_;
   int lines_;
   IslandPlacementParams params_;
   double z_min_ = 0.0, z_max_ = 0.0;
@@ -71,11 +71,14 @@ class EpipolarGeometry final : public decoder::LabelGeometry {
 
 std::optional<std::pair<double, bool>> EpipolarGeometry::SlideRow(const cv::Point2d& image,
                                                                   int p) const {
-  const auto world = planes_.PlaneOfLine(p).Intersect(camera_.BackProject({image.x, image.y}));
-  if (!world) return std::nullopt;
-  const auto slide = projector_.Project(*world);
-  if (!slide) return std::nullopt;
-  return std::make_pair(slide->y(), world->z() >= z_min_ && world->z() <= z_max_);
+  const auto on = JunctionOnSlide(calibration_, image, p);
+  if (!on) return std::nullopt;
+  return std::make_pair(on->slide.y(), on->world.z() >= z_min_ && on->world.z() <= z_max_);
+}
+
+bool EpipolarGeometry::OffItsRow(const cv::Point2d& image, int p, int q, int offset) const {
+  const auto row = SlideRow(image, p);
+  return !row || std::abs(row->first - q - offset) > params_.max_junction_rows;
 }
 
 // As SlideRowOffset (calibrated_model.h), on the junctions the decoder has.
@@ -89,7 +92,7 @@ std::optional<int> EpipolarGeometry::RowOffset(const std::vector<decoder::Framed
       *why = "line 0's part has " + std::to_string(residue.size()) + " junctions on the slide";
     return std::nullopt;
   }
-  return 2 * static_cast<int>(std::lround(MedianOf(&residue) / 2.0));
+  return EvenRowOffset(&residue);
 }
 
 Fit EpipolarGeometry::FitShift(const std::vector<decoder::FramedJunction>& island, int dp) const {
@@ -157,11 +160,8 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
                 std::to_string(rival) + " rows RMS)");
   decoder::LabelShift shift{*best, best_fit.dv - *offset, {}};
   shift.ruled_out.reserve(island.size());
-  for (const decoder::FramedJunction& j : island) {
-    const auto row = SlideRow(j.position, j.p + *best);
-    shift.ruled_out.push_back(!row ||
-                              std::abs(row->first - j.q - best_fit.dv) > params_.max_junction_rows);
-  }
+  for (const decoder::FramedJunction& j : island)
+    shift.ruled_out.push_back(OffItsRow(j.position, j.p + *best, j.q, best_fit.dv));
   return shift;
 }
 
@@ -170,10 +170,8 @@ std::vector<char> EpipolarGeometry::RuleOut(
   std::vector<char> out(labelled.size(), 0);
   const auto offset = RowOffset(labelled, nullptr);
   if (!offset) return out;
-  for (size_t k = 0; k < labelled.size(); ++k) {
-    const auto row = SlideRow(labelled[k].position, labelled[k].p);
-    out[k] = !row || std::abs(row->first - labelled[k].q - *offset) > params_.max_junction_rows;
-  }
+  for (size_t k = 0; k < labelled.size(); ++k)
+    out[k] = OffItsRow(labelled[k].position, labelled[k].p, labelled[k].q, *offset);
   return out;
 }
 

@@ -11,6 +11,8 @@
 #ifndef BSLS_RECONSTRUCTION_CALIBRATED_MODEL_H_
 #define BSLS_RECONSTRUCTION_CALIBRATED_MODEL_H_
 
+#include <Eigen/Core>
+#include <opencv2/core/types.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,6 +66,22 @@ struct SlideRowParams {
   // True when the numbers are in range; otherwise names the field.
   bool IsValid(std::string* error) const;
 };
+
+// Where the camera ray through `image` meets the light plane of line p (the
+// calibration's perspective model), and where that point falls on the
+// slide through its projector matrix (x: s, y: the slide row t); nullopt
+// where the ray misses the plane or the projector, or the calibration has
+// no projector matrix.
+struct SlidePoint {
+  Eigen::Vector3d world;
+  Eigen::Vector2d slide;
+};
+std::optional<SlidePoint> JunctionOnSlide(const calibration::SideCalibration& calibration,
+                                          const cv::Point2d& image, int p);
+
+// The even offset nearest the median of `residues` (slide row t - q, one per
+// junction; reordered); `residues` must not be empty.
+int EvenRowOffset(std::vector<double>* residues);
 
 // The even offset that makes the relative q of `decode` the slide row: each
 // seen junction is triangulated on the light plane of its p, projected into
