@@ -236,9 +236,12 @@ FrameResult RunFrame(std::uint32_t seed, const Options& o) {
   f.right = f.score.found - f.score.Wrong();
   if (o.list_wrong)
     for (const sim::PointLabel& w : f.score.wrong) {
+      // The decoded junction nearest the truth, as the scoring matched it.
       const sim::PointLabel* near = nullptr;
       for (const sim::PointLabel& d : decoded)
-        if (cv::norm(d.position - w.position) <= kMatchReach) near = &d;
+        if (cv::norm(d.position - w.position) <= kMatchReach &&
+            (!near || cv::norm(d.position - w.position) < cv::norm(near->position - w.position)))
+          near = &d;
       if (!near) continue;
       std::printf(
           "  seed %u wrong label at (%.1f, %.1f): decoded p %d q %d, truth p %d v %d (rows offset "
