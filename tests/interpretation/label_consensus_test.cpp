@@ -27,6 +27,12 @@ struct Graph {
     links.push_back({a, b, truth[b].first - truth[a].first, truth[b].second - truth[a].second,
                      trusted, smooth});
   }
+  // A step across a break in a line whose rows were counted over the gap,
+  // off by dv rows from the truth.
+  void GapLink(int a, int b, int dv = 0) {
+    links.push_back({a, b, truth[b].first - truth[a].first, truth[b].second - truth[a].second + dv,
+                     false, false, false, true});
+  }
   // A link whose change is off by (dp, dv) from the truth: a wrong one.
   void WrongLink(int a, int b, int dp, int dv, bool trusted = false) {
     links.push_back({a, b, truth[b].first - truth[a].first + dp,
@@ -173,6 +179,22 @@ struct BrokenLineZero : TwoPatches {
 
 TEST_F(BrokenLineZero, ItsPartsJoinThroughALinkTheirSeedsConfirm) {
   g.Link(a1, c0, false);  // the row count across the gap
+  const Consensus c = Run({a0, a1, c0, c1});
+  for (int j : {a0, a1, a2, c0, c1, c2}) ExpectRight(c, j);
+}
+
+TEST_F(BrokenLineZero, OneRowCountAcrossAGapDoesNotFixItsRows) {
+  // The seeds confirm p, not v: a single count over a gap (which an
+  // occluding edge shifts by whole rows) is half a vote, and no join.
+  g.GapLink(a1, c0, 2);
+  const Consensus c = Run({a0, a1, c0, c1});
+  for (int j : {a0, a1, a2}) ExpectRight(c, j);
+  for (int j : {c0, c1, c2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
+}
+
+TEST_F(BrokenLineZero, TwoRowCountsAcrossGapsThatAgreeJoinIt) {
+  g.GapLink(a1, c0);
+  g.GapLink(a4, c2);
   const Consensus c = Run({a0, a1, c0, c1});
   for (int j : {a0, a1, a2, c0, c1, c2}) ExpectRight(c, j);
 }

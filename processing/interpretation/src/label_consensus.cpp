@@ -237,7 +237,10 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
 // main one through the links between them whose shift of p the two sets of
 // seeds confirm, where those agree on one shift (v) and no link
 // contradicts them. The seeds are the second, independent witness that a
-// single link lacks. `votes`: (component, p shift) -> seeds.
+// single link lacks, but for p only: the rows (v) rest on the links alone,
+// so they must carry at least one whole vote (a step across a line's gap,
+// whose rows an occluding edge may shift, is half of one).
+// `votes`: (component, p shift) -> seeds.
 // Returns whether it joined any; components joined to the main one
 // through another seeded one take rounds.
 template <typename LabelOf>
@@ -261,6 +264,7 @@ bool JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::ve
     if (comps->Find(c).first != c || c == root) continue;  // joined already
     std::map<Label, int> shifts;
     int against = 0, count = 0;
+    int half_votes = 0;  // of the links giving a possible shift
     for (size_t k = 0; k < links.size(); ++k) {
       if (trusted[k]) continue;
       const ConsensusLink& l = links[k];
@@ -276,12 +280,14 @@ bool JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::ve
       ++count;
       // c's p is its own label plus b.first; through the link, plus h.p
       // back to main_c's frame and its shift.
-      if (h.p - root_shift.p + main_shift != b.first || OddSum(h))
+      if (h.p - root_shift.p + main_shift != b.first || OddSum(h)) {
         ++against;
-      else
+      } else {
         ++shifts[h];
+        half_votes += l.gap ? 1 : 2;
+      }
     }
-    if (shifts.size() != 1) continue;
+    if (shifts.size() != 1 || half_votes < 2) continue;
     const auto& [h, agree] = *shifts.begin();
     if (count - agree > params.max_dissent * agree || against > 0) continue;
     comps->Join(root, c, h);
