@@ -189,6 +189,24 @@ TEST(TrackLabelling, InvalidParamsAreRejected) {
   TrackLabellingParams bad;
   bad.max_row_miss = 0.7;
   EXPECT_THROW(LabelTracks({}, pattern::Side::kLeft, {}, bad), std::invalid_argument);
+  bad = {};
+  bad.reference_choice = -1;
+  EXPECT_THROW(LabelTracks({}, pattern::Side::kLeft, {}, bad), std::invalid_argument);
+}
+
+// A clean brick offers one chain of line-0 candidates: the first is line 0,
+// and asking for another labels nothing rather than guessing.
+TEST(TrackLabelling, OnlyTheChainsOfCandidatesThereAreAreTaken) {
+  SyntheticBrickParams params;
+  const SyntheticBrick b = DrawSyntheticBrick(params);
+  Labelled l = Label(RenderGrey(b), params.side);
+  ASSERT_TRUE(l.labels.ok) << l.labels.error;
+  EXPECT_EQ(l.labels.reference_choices, 1);
+  TrackLabellingParams second;
+  second.reference_choice = 1;
+  const TrackLabels other = LabelTracks(l.net, params.side, {}, second);
+  EXPECT_FALSE(other.ok);
+  EXPECT_NE(other.error.find("no candidate 1"), std::string::npos) << other.error;
 }
 
 }  // namespace

@@ -616,6 +616,7 @@ bool TrackChainParams::IsValid(std::string* error) const {
   if (centre_fit_rows < 1 || centre_fit_rows > 50)
     return fail("track_chain.centre_fit_rows must lie in 1..50");
   if (segment_columns < 2) return fail("track_chain.segment_columns must be at least 2");
+  if (reference_tries < 0) return fail("track_chain.reference_tries must not be negative");
   if (!(tuned_pitch > 0)) return fail("track_chain.tuned_pitch must be positive");
   if (!(native_pitch_min > 0.0 && native_pitch_min <= tuned_pitch &&
         tuned_pitch <= native_pitch_max))

@@ -645,9 +645,10 @@ bool RuledOut(const std::vector<char>& verdicts, size_t k) {
 // another junction already holds (a slide junction is seen once); where those
 // are more than a tenth of the island, or any label would fall off the slide
 // or disagree with its kind, the island stays unlabelled. Counts the islands
-// placed and the component's move in `result`.
+// placed and the component's move in `result`. With `may_move` false, a
+// component the geometry does not confirm where it stands is refused.
 void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::PatternSpec& spec,
-                     const WorkingScale& scale, const LabelGeometry& geometry,
+                     const WorkingScale& scale, const LabelGeometry& geometry, bool may_move,
                      interpretation::TrackLabels* labels, DecodeResult* result) {
   constexpr double kMaxDropped = 0.1;
   constexpr double kMaxRefuted = 1.0 / 3.0;
@@ -667,8 +668,15 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
   };
 
   std::string why;
-  if (const auto own = geometry.PlaceIsland(labelled, labelled, &why);
-      own && (own->dp != 0 || own->dq != 0)) {
+  const auto own = geometry.PlaceIsland(labelled, labelled, &why);
+  if (!may_move && (!own || own->dp != 0 || own->dq != 0)) {
+    labels->ok = false;
+    labels->error = own ? "the calibration's geometry puts the labels " + std::to_string(own->dp) +
+                              " lines and " + std::to_string(own->dq) + " rows off"
+                        : "the calibration's geometry cannot confirm the labels: " + why;
+    return;
+  }
+  if (own && (own->dp != 0 || own->dq != 0)) {
     std::vector<int> line_p;
     for (int lp : labels->line_p)
       if (lp >= 0) line_p.push_back(lp);
@@ -743,6 +751,42 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
   }
 }
 
+// Labels with a calibration: line 0's chain of candidates nearest the
+// centre row (thesis 5.2.1), its component judged by the geometry
+// (PlaceByGeometry). Where that fails, the other chains are tried in turn
+// (track_chain.reference_tries), each kept only where the geometry confirms
+// its labels where they stand: a line whose inner neighbours are hidden
+// looks like line 0 in the image, but not in depth. The first chain's
+// failure is the one reported.
+interpretation::TrackLabels LabelWithGeometry(const interpretation::TrackNetwork& net,
+                                              pattern::Side side, const DecodeParams& params,
+                                              const WorkingScale& scale,
+                                              const LabelGeometry& geometry,
+                                              const Cancellation& cancel, DecodeResult* result) {
+  interpretation::TrackLabellingParams lp = params.track_chain.labelling;
+  interpretation::TrackLabels first;
+  for (int choice = 0; choice <= params.track_chain.reference_tries; ++choice) {
+    lp.reference_choice = choice;
+    interpretation::TrackLabels labels = interpretation::LabelTracks(net, side, params.spec, lp, cancel);
+    if (labels.ok) {
+      DecodeResult placed;
+      PlaceByGeometry(net, params.spec, scale, geometry, /*may_move=*/choice == 0, &labels,
+                      &placed);
+      if (labels.ok) {
+        result->line_zero_moved = placed.line_zero_moved;
+        result->ruled_out += placed.ruled_out;
+        result->islands_placed += placed.islands_placed;
+        result->reference_choice = choice;
+        return labels;
+      }
+    }
+    cancel.ThrowIfRequested("the labelling");
+    if (choice == 0) first = std::move(labels);
+    if (choice + 1 >= first.reference_choices) break;
+  }
+  return first;
+}
+
 // The junctions as they leave the decoder, at their sub-pixel places: a
 // label the geometry rules out there is taken back and the junction listed
 // unlabelled (its place can differ from the track junction's judged before).
@@ -778,7 +822,8 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   const interpretation::TrackNetwork net = interpretation::BuildTrackNetwork(
       std::move(ridges.rows), std::move(ridges.columns), side, tp.tracks, cancel);
   interpretation::TrackLabels labels =
-      interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
+      params.geometry ? LabelWithGeometry(net, side, params, scale, *params.geometry, cancel, result)
+                      : interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
   cancel.ThrowIfRequested("the labelling");
@@ -789,14 +834,6 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
     return;
   }
   result->islands = static_cast<int>(labels.islands.size());
-  if (params.geometry) {
-    PlaceByGeometry(net, params.spec, scale, *params.geometry, &labels, result);
-    if (!labels.ok) {
-      result->error = labels.error;
-      return;
-    }
-  }
-  cancel.ThrowIfRequested("the labelling");
 
   t = Clock::now();
   // Centres of every labelled line track, in parallel.

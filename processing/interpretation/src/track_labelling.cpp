@@ -47,10 +47,13 @@ double RowSpacing(const TrackJunction& a, const TrackJunction& b) {
 // centre row up and down through the candidates that start (end) within
 // follow_distance of where it ends (starts), as the thesis follows it
 // through its gaps; its junctions must be direct but for max_inner_fraction
-// of them (a stray segment's end at a fold), or it is not line 0. Empty
-// when nothing passes; `why` says what failed.
+// of them (a stray segment's end at a fold), or it is not line 0. With
+// params.reference_choice k > 0, the chain is followed from the k-th
+// nearest candidate that no earlier chain took. Empty when nothing passes;
+// `why` says what failed. `choices`: the chains the candidates make.
 std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
-                                 const TrackLabellingParams& params, std::string* why) {
+                                 const TrackLabellingParams& params, std::string* why,
+                                 int* choices) {
   const int towards_p = pattern::ImageDirectionOfIncreasingP(side);
   const int n_lines = static_cast<int>(net.lines.size());
   std::vector<int> outermost(n_lines, 0);
@@ -70,49 +73,63 @@ std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
         outermost[t] >= params.reference_share * static_cast<double>(net.lines[t].points.size());
   auto first = [&](int t) { return net.rows.points[net.lines[t].points.front()]; };
   auto last = [&](int t) { return net.rows.points[net.lines[t].points.back()]; };
-  // The candidate nearest the centre row (covering it, or closest to it).
+  // The candidates by their distance from the centre row (0 covering it),
+  // the longer first among equals.
   const double centre_row = (rows - 1) / 2.0;
-  int centre = -1;
-  double centre_miss = 0;
-  for (int t = 0; t < n_lines; ++t) {
-    if (!candidate[t]) continue;
-    const double miss = std::max({0.0, first(t).y - centre_row, centre_row - last(t).y});
-    if (centre < 0 || miss < centre_miss ||
-        (miss == centre_miss && net.lines[t].points.size() > net.lines[centre].points.size())) {
-      centre = t;
-      centre_miss = miss;
+  std::vector<std::pair<double, int>> by_miss;
+  for (int t = 0; t < n_lines; ++t)
+    if (candidate[t])
+      by_miss.emplace_back(std::max({0.0, first(t).y - centre_row, centre_row - last(t).y}), t);
+  std::sort(by_miss.begin(), by_miss.end(), [&](const auto& a, const auto& b) {
+    if (a.first != b.first) return a.first < b.first;
+    if (net.lines[a.second].points.size() != net.lines[b.second].points.size())
+      return net.lines[a.second].points.size() > net.lines[b.second].points.size();
+    return a.second < b.second;
+  });
+  // The chain through `start`: followed down, then up, through candidates
+  // no chain has taken.
+  std::vector<char> taken(n_lines, 0);
+  auto follow = [&](int start) {
+    std::vector<int> chain{start};
+    taken[start] = 1;
+    for (const bool down : {true, false}) {
+      for (int cur = start;;) {
+        int next = -1;
+        double next_d = 0;
+        for (int t = 0; t < n_lines; ++t) {
+          if (!candidate[t] || taken[t]) continue;
+          const extraction::RidgePoint from = down ? last(cur) : first(cur);
+          const extraction::RidgePoint to = down ? first(t) : last(t);
+          const int dy = down ? to.y - from.y : from.y - to.y;
+          if (dy < 1) continue;
+          const double d = std::hypot(to.x - from.x, static_cast<double>(dy));
+          if (d > params.follow_distance) continue;
+          if (next < 0 || d < next_d) {
+            next = t;
+            next_d = d;
+          }
+        }
+        if (next < 0) break;
+        taken[next] = 1;
+        chain.push_back(next);
+        cur = next;
+      }
     }
-  }
-  if (centre < 0) {
+    return chain;
+  };
+  std::vector<std::vector<int>> chains;
+  for (const auto& [miss, t] : by_miss)
+    if (!taken[t]) chains.push_back(follow(t));
+  *choices = static_cast<int>(chains.size());
+  if (chains.empty()) {
     *why = "no reference line (line 0) found";
     return {};
   }
-  std::vector<int> chain{centre};
-  std::vector<char> taken(n_lines, 0);
-  taken[centre] = 1;
-  for (const bool down : {true, false}) {
-    for (int cur = centre;;) {
-      int next = -1;
-      double next_d = 0;
-      for (int t = 0; t < n_lines; ++t) {
-        if (!candidate[t] || taken[t]) continue;
-        const extraction::RidgePoint from = down ? last(cur) : first(cur);
-        const extraction::RidgePoint to = down ? first(t) : last(t);
-        const int dy = down ? to.y - from.y : from.y - to.y;
-        if (dy < 1) continue;
-        const double d = std::hypot(to.x - from.x, static_cast<double>(dy));
-        if (d > params.follow_distance) continue;
-        if (next < 0 || d < next_d) {
-          next = t;
-          next_d = d;
-        }
-      }
-      if (next < 0) break;
-      taken[next] = 1;
-      chain.push_back(next);
-      cur = next;
-    }
+  if (params.reference_choice >= static_cast<int>(chains.size())) {
+    *why = "no reference line (line 0): no candidate " + std::to_string(params.reference_choice);
+    return {};
   }
+  const std::vector<int>& chain = chains[params.reference_choice];
   int direct = 0, corresponding = 0;
   for (int t : chain)
     for (int j : net.junctions_on_line[t])
@@ -503,6 +520,7 @@ bool TrackLabellingParams::IsValid(std::string* error) const {
   if (min_support < 1) return fail("min_support must be at least 1");
   if (!(max_dissent >= 0 && max_dissent < 1)) return fail("max_dissent must lie in [0, 1)");
   if (min_island < 0) return fail("min_island must not be negative");
+  if (reference_choice < 0) return fail("reference_choice must not be negative");
   return true;
 }
 
@@ -521,7 +539,7 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // Line 0 (thesis 5.2.1): found first, since its segments all leave
   // towards p = 1: a corresponding junction on it is a stray segment's end.
   std::string why;
-  out.reference = ReferenceTracks(net, side, params, &why);
+  out.reference = ReferenceTracks(net, side, params, &why, &out.reference_choices);
   if (out.reference.empty()) {
     out.error = why;
     return out;

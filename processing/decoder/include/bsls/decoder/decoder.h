@@ -88,6 +88,12 @@ struct TrackChainParams {
   int centre_fit_rows = 5;
   // Columns of a segment measured next to its junction to place it, >= 2.
   int segment_columns = 10;
+  // With a calibration (DecodeParams::geometry): where the chain of line-0
+  // candidates nearest the centre row fails (its line has inner segments:
+  // line 0 hidden there on a turned face) or the geometry refutes it, up to
+  // this many other chains are tried in turn, each kept only where the
+  // geometry confirms its labels where they stand, >= 0.
+  int reference_tries = 4;
 
   // True when every part is usable; otherwise says which and why.
   bool IsValid(std::string* error) const;
@@ -229,6 +235,10 @@ struct DecodeResult {
   // Lines the geometry moved line 0's component by, where it clearly put it
   // elsewhere (0: it confirmed the labels, could not tell, or was not given).
   int line_zero_moved = 0;
+  // The chain of line-0 candidates taken (TrackLabellingParams::
+  // reference_choice): 0 the one nearest the centre row; more where the
+  // geometry confirmed another (TrackChainParams::reference_tries).
+  int reference_choice = 0;
   // Junctions whose labels the geometry ruled out (reported unlabelled).
   int ruled_out = 0;
   std::map<interpretation::LoopClass, int> loop_classes;

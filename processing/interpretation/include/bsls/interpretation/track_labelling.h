@@ -40,6 +40,13 @@ struct TrackLabellingParams {
   // A line track is a candidate for line 0 when it is the outermost on the
   // unlit side in at least this fraction of its rows, (0, 1].
   double reference_share = 0.5;
+  // Which chain of candidates is taken for line 0, >= 0: 0 the one through
+  // the candidate nearest the centre row (thesis 5.2.1), k the one through
+  // the k-th nearest candidate not in an earlier chain. Without a
+  // calibration only 0 is safe: a line whose inner neighbours are hidden
+  // looks like line 0; a calibration tries the others and keeps one only
+  // where its geometry confirms the labels (decoder: reference_tries).
+  int reference_choice = 0;
   // Line 0 is followed from candidate to candidate across gaps of up to
   // this (px from one's end to the next's start, the next starting lower), > 0;
   double follow_distance = 24.0;
@@ -79,6 +86,7 @@ struct TrackLabels {
   std::vector<int> line_p;     // per line track: the p most of its labelled junctions carry, or -1
   std::vector<int> reference;  // the line tracks taken for line 0
   int conflicts = 0;           // labels dropped because their neighbours disagreed
+  int reference_choices = 0;   // chains of line-0 candidates the frame offers
   double row_spacing = 0;      // px between rows along a line: the median over the frame
 
   // A part of the network not joined to line 0's, proven in itself: its
