@@ -289,6 +289,7 @@ DecodeResult KeepProvenLabels(const DecodeResult& geometry, const DecodeResult& 
   out.islands = proof.islands;
   out.islands_placed = proof.islands_placed;
   out.line_zero_moved = proof.line_zero_moved;
+  out.reference_choice = proof.reference_choice;
   out.ruled_out = proof.ruled_out;
   const int n = static_cast<int>(geometry.junctions.size());
   std::vector<Verdict> verdict(n, Verdict::kUnproven);
