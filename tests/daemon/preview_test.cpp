@@ -25,7 +25,14 @@ using Clock = std::chrono::steady_clock;
 struct StreamFigures {
   int frames = 0;  // received inside the window
   std::uint64_t dropped = 0;
+  // Camera sequence numbers of the first and last frame inside the window:
+  // the frames the camera made meanwhile, whoever read them.
+  std::uint64_t first_sequence = 0;
+  std::uint64_t last_sequence = 0;
   bool ok = true;
+
+  // Frames the camera made from the first to the last one received.
+  std::uint64_t Made() const { return frames ? last_sequence - first_sequence + 1 : 0; }
 };
 
 // A client connection whose receive window holds about one 512 x 512
@@ -65,6 +72,8 @@ StreamFigures ReadPreview(v1::CaptureDaemon::Stub& stub, Clock::time_point windo
   v1::PreviewFrame frame;
   while (Clock::now() < end && reader->Read(&frame)) {
     if (Clock::now() >= window_start) {
+      if (figures.frames == 0) figures.first_sequence = frame.frame().sequence();
+      figures.last_sequence = frame.frame().sequence();
       ++figures.frames;
       figures.dropped += frame.dropped();
     }
@@ -77,7 +86,12 @@ StreamFigures ReadPreview(v1::CaptureDaemon::Stub& stub, Clock::time_point windo
   return figures;
 }
 
-TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
+// The simulated camera makes 25 frames a second. A client that reads as
+// fast as it can gets every frame the camera made, however slowly a fourth
+// reads: what the slow one costs the others is asserted as frames missed,
+// not as a frame rate, which a loaded test machine lowers for everyone
+// alike (the camera's own rate is only checked to be a preview's at all).
+TEST(BslsdPreview, FourClientsOneSlowTheOthersGetEveryFrame) {
   const fs::path dir = MakeDaemonDir("preview");
   const fs::path config = WriteDaemonConfig(dir, "roles:\n  admin: [root]\n");
   DaemonProcess daemon(dir, config);
@@ -106,9 +120,12 @@ TEST(BslsdPreview, FourClientsOneSlowTheOthersKeep24FramesPerSecond) {
   for (std::thread& t : clients) t.join();
   for (int i = 0; i < 3; ++i) {
     const double fps = figures[i].frames / kWindowSeconds;
-    std::printf("[ figures  ] client %d: %.1f frames/s, %llu dropped\n", i, fps,
+    std::printf("[ figures  ] client %d: %.1f frames/s, %d of %llu made, %llu dropped\n", i, fps,
+                figures[i].frames, static_cast<unsigned long long>(figures[i].Made()),
                 static_cast<unsigned long long>(figures[i].dropped));
-    EXPECT_GE(fps, 24.0) << "client " << i;
+    EXPECT_EQ(static_cast<std::uint64_t>(figures[i].frames), figures[i].Made()) << "client " << i;
+    EXPECT_EQ(figures[i].dropped, 0u) << "client " << i;
+    EXPECT_GE(fps, 15.0) << "client " << i;
   }
   const double slow_fps = figures[3].frames / kWindowSeconds;
   std::printf("[ figures  ] slow client: %.1f frames/s, %llu dropped\n", slow_fps,
