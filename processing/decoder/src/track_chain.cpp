@@ -781,8 +781,9 @@ interpretation::TrackLabels LabelWithGeometry(const interpretation::TrackNetwork
       }
     }
     cancel.ThrowIfRequested("the labelling");
+    const bool more = choice + 1 < labels.reference_choices;
     if (choice == 0) first = std::move(labels);
-    if (choice + 1 >= first.reference_choices) break;
+    if (!more) break;
   }
   return first;
 }

@@ -50,7 +50,8 @@ double RowSpacing(const TrackJunction& a, const TrackJunction& b) {
 // of them (a stray segment's end at a fold), or it is not line 0. With
 // params.reference_choice k > 0, the chain is followed from the k-th
 // nearest candidate that no earlier chain took. Empty when nothing passes;
-// `why` says what failed. `choices`: the chains the candidates make.
+// `why` says what failed. `choices`: the chains followed, and one more where
+// a candidate is left for another.
 std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
                                  const TrackLabellingParams& params, std::string* why,
                                  int* choices) {
@@ -117,19 +118,27 @@ std::vector<int> ReferenceTracks(const TrackNetwork& net, pattern::Side side,
     }
     return chain;
   };
-  std::vector<std::vector<int>> chains;
-  for (const auto& [miss, t] : by_miss)
-    if (!taken[t]) chains.push_back(follow(t));
-  *choices = static_cast<int>(chains.size());
-  if (chains.empty()) {
+  // Chains are followed only up to the one asked for; `choices` counts
+  // them, and one more where a candidate is left over.
+  std::vector<int> chain;
+  int followed = 0;
+  auto next = by_miss.begin();
+  for (; next != by_miss.end() && followed <= params.reference_choice; ++next) {
+    if (taken[next->second]) continue;
+    std::vector<int> c = follow(next->second);
+    if (followed++ == params.reference_choice) chain = std::move(c);
+  }
+  const bool more =
+      std::any_of(next, by_miss.end(), [&](const auto& m) { return !taken[m.second]; });
+  *choices = followed + (more ? 1 : 0);
+  if (followed == 0) {
     *why = "no reference line (line 0) found";
     return {};
   }
-  if (params.reference_choice >= static_cast<int>(chains.size())) {
+  if (chain.empty()) {
     *why = "no reference line (line 0): no candidate " + std::to_string(params.reference_choice);
     return {};
   }
-  const std::vector<int>& chain = chains[params.reference_choice];
   int direct = 0, corresponding = 0;
   for (int t : chain)
     for (int j : net.junctions_on_line[t])

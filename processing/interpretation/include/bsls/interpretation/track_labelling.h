@@ -86,7 +86,9 @@ struct TrackLabels {
   std::vector<int> line_p;     // per line track: the p most of its labelled junctions carry, or -1
   std::vector<int> reference;  // the line tracks taken for line 0
   int conflicts = 0;           // labels dropped because their neighbours disagreed
-  int reference_choices = 0;   // chains of line-0 candidates the frame offers
+  // Chains of line-0 candidates known to the frame: those followed up to
+  // reference_choice, and one more where a candidate is left for another.
+  int reference_choices = 0;
   double row_spacing = 0;      // px between rows along a line: the median over the frame
 
   // A part of the network not joined to line 0's, proven in itself: its
