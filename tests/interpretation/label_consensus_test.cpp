@@ -192,6 +192,16 @@ TEST_F(BrokenLineZero, OneRowCountAcrossAGapDoesNotFixItsRows) {
   for (int j : {c0, c1, c2}) EXPECT_EQ(c.p[j], kNone) << "junction " << j;
 }
 
+TEST_F(BrokenLineZero, OneRowCountJoinsWhereTheRowsAreCheckedAfter) {
+  // With a calibration the geometry checks every junction's row, and the
+  // decoder asks for one half vote.
+  g.GapLink(a1, c0);
+  ConsensusParams params;
+  params.min_seeded_half_votes = 1;
+  const Consensus c = LabelByConsensus(g.OddKind(), g.links, {a0, a1, c0, c1}, 2, params);
+  for (int j : {a0, a1, a2, c0, c1, c2}) ExpectRight(c, j);
+}
+
 TEST_F(BrokenLineZero, TwoRowCountsAcrossGapsThatAgreeJoinIt) {
   g.GapLink(a1, c0);
   g.GapLink(a4, c2);

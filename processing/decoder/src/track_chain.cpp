@@ -764,10 +764,14 @@ interpretation::TrackLabels LabelWithGeometry(const interpretation::TrackNetwork
                                               const LabelGeometry& geometry,
                                               const Cancellation& cancel, DecodeResult* result) {
   interpretation::TrackLabellingParams lp = params.track_chain.labelling;
+  // The geometry checks every junction's row: one row count across a gap
+  // joins a part of line 0 (TrackLabellingParams::min_seeded_half_votes).
+  lp.min_seeded_half_votes = 1;
   interpretation::TrackLabels first;
   for (int choice = 0; choice <= params.track_chain.reference_tries; ++choice) {
     lp.reference_choice = choice;
-    interpretation::TrackLabels labels = interpretation::LabelTracks(net, side, params.spec, lp, cancel);
+    interpretation::TrackLabels labels =
+        interpretation::LabelTracks(net, side, params.spec, lp, cancel);
     if (labels.ok) {
       DecodeResult placed;
       PlaceByGeometry(net, params.spec, scale, geometry, /*may_move=*/choice == 0, &labels,
@@ -823,8 +827,9 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   const interpretation::TrackNetwork net = interpretation::BuildTrackNetwork(
       std::move(ridges.rows), std::move(ridges.columns), side, tp.tracks, cancel);
   interpretation::TrackLabels labels =
-      params.geometry ? LabelWithGeometry(net, side, params, scale, *params.geometry, cancel, result)
-                      : interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
+      params.geometry
+          ? LabelWithGeometry(net, side, params, scale, *params.geometry, cancel, result)
+          : interpretation::LabelTracks(net, side, params.spec, tp.labelling, cancel);
   result->times.interpretation_ms = MsSince(t);
   result->label_conflicts = labels.conflicts;
   cancel.ThrowIfRequested("the labelling");

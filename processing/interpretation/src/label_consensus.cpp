@@ -238,8 +238,8 @@ void AttachLoneJunctions(const std::vector<char>& odd_kind, const std::vector<Co
 // seeds confirm, where those agree on one shift (v) and no link
 // contradicts them. The seeds are the second, independent witness that a
 // single link lacks, but for p only: the rows (v) rest on the links alone,
-// so they must carry at least one whole vote (a step across a line's gap,
-// whose rows an occluding edge may shift, is half of one).
+// so they must carry params.min_seeded_half_votes (a step across a line's
+// gap, whose rows an occluding edge may shift, is one; a whole link two).
 // `votes`: (component, p shift) -> seeds.
 // Returns whether it joined any; components joined to the main one
 // through another seeded one take rounds.
@@ -287,7 +287,7 @@ bool JoinSeededComponents(const std::vector<ConsensusLink>& links, const std::ve
         half_votes += l.gap ? 1 : 2;
       }
     }
-    if (shifts.size() != 1 || half_votes < 2) continue;
+    if (shifts.size() != 1 || half_votes < params.min_seeded_half_votes) continue;
     const auto& [h, agree] = *shifts.begin();
     if (count - agree > params.max_dissent * agree || against > 0) continue;
     comps->Join(root, c, h);

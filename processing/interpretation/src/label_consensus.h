@@ -55,6 +55,10 @@ struct ConsensusParams {
   // relative to itself, for a calibration to place) from this many
   // junctions; 0: none kept.
   int min_island = 12;
+  // A part of line 0 joins through links whose shift of rows carries at
+  // least this many half votes (a step across a gap is one, any other link
+  // two), >= 1: the seeds confirm p, not v.
+  int min_seeded_half_votes = 2;
 };
 // A lone junction (in no closed brick) at the pattern's edge joins the
 // labelled ones through two agreeing links, or through one smooth step

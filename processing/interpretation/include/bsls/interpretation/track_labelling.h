@@ -71,6 +71,13 @@ struct TrackLabellingParams {
   // as an island, labelled relative to itself for a calibration to place
   // (TrackLabels::islands); 0 keeps none.
   int min_island = 12;
+  // A part of line 0 cut off from the rest (the nose's tip) joins it where
+  // both sets of seeds confirm p and the links give its rows with at least
+  // this many half votes (a row count across a gap is one, another link
+  // two), >= 1. Without a calibration a whole vote: one count across a gap
+  // an occluding edge hides may be rows off. With one, the geometry checks
+  // every junction's row, and one count is enough (the decoder sets 1).
+  int min_seeded_half_votes = 2;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
@@ -89,7 +96,7 @@ struct TrackLabels {
   // Chains of line-0 candidates known to the frame: those followed up to
   // reference_choice, and one more where a candidate is left for another.
   int reference_choices = 0;
-  double row_spacing = 0;      // px between rows along a line: the median over the frame
+  double row_spacing = 0;  // px between rows along a line: the median over the frame
 
   // A part of the network not joined to line 0's, proven in itself: its
   // junctions and line tracks labelled relative to one another, so the
