@@ -669,14 +669,15 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
 
   std::string why;
   const auto own = geometry.PlaceIsland(labelled, labelled, &why);
-  if (!may_move && (!own || own->dp != 0 || own->dq != 0)) {
+  const bool moves = own && (own->dp != 0 || own->dq != 0);
+  if (!may_move && (!own || moves)) {
     labels->ok = false;
     labels->error = own ? "the calibration's geometry puts the labels " + std::to_string(own->dp) +
                               " lines and " + std::to_string(own->dq) + " rows off"
                         : "the calibration's geometry cannot confirm the labels: " + why;
     return;
   }
-  if (own && (own->dp != 0 || own->dq != 0)) {
+  if (moves) {
     std::vector<int> line_p;
     for (int lp : labels->line_p)
       if (lp >= 0) line_p.push_back(lp);
