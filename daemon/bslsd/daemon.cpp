@@ -1,7 +1,7 @@
 #include "daemon.h"
 
 #include <grp.h>
-#include <grpcpp/security/server_credentials.h>
+#include <grpcpp/server_builder.h>
 #include <spdlog/spdlog.h>
 
 #include <tuple>
@@ -131,20 +131,20 @@ Status ConfigureServer(const Config& config, grpc::Service* service, rpc::TcpLis
   builder.SetResourceQuota(quota);
   builder.RegisterService(service);
   if (!config.listen.tcp.empty()) {
-    // Mutual TLS only: a client without a certificate signed by the CA fails the handshake.
-    std::shared_ptr<grpc::ServerCredentials> tls;
+    // Mutual TLS only, ended by the HTTP/2 guard: a client without a
+    // certificate signed by the CA fails the handshake and never reaches gRPC.
+    rpc::TcpListenerOptions options;
+    options.acceptor.address = config.listen.tcp;
+    options.acceptor.connections = config.listen.connections;
+    options.guard = config.listen.guard;
+    options.tls = rpc::TlsFiles{config.listen.tls_client_ca, config.listen.tls_certificate,
+                                config.listen.tls_key,       "listen.tls_client_ca",
+                                "listen.tls_certificate",    "listen.tls_key"};
+    options.handshake_timeout_ms = config.listen.http2.handshake_timeout_ms;
     try {
-      tls = rpc::MutualTlsServerCredentials(
-          {config.listen.tls_client_ca, config.listen.tls_certificate, config.listen.tls_key,
-           "listen.tls_client_ca", "listen.tls_certificate", "listen.tls_key"});
+      *tcp = rpc::ListenTcp(options);
     } catch (const rpc::TlsFileError& e) {
       return Status(ErrorCode::kInvalidArgument, e.what());
-    }
-    rpc::TcpAcceptorOptions options;
-    options.address = config.listen.tcp;
-    options.connections = config.listen.connections;
-    try {
-      *tcp = rpc::ListenTcp(options, tls, builder);
     } catch (const std::runtime_error& e) {
       return Status(ErrorCode::kUnavailable, e.what());
     }
@@ -161,6 +161,7 @@ Result<std::unique_ptr<service::UnixListener>> OpenUnixListener(const Config& co
   options.mode = static_cast<mode_t>(config.listen.socket_mode);
   options.connections = config.listen.connections;
   options.http2_guard = config.listen.guard;
+  options.handshake_timeout_ms = config.listen.http2.handshake_timeout_ms;
   const std::string& group = config.listen.socket_group;
   if (!group.empty()) {
     if (group.find_first_not_of("0123456789") == std::string::npos && group.size() <= 9) {
@@ -221,7 +222,7 @@ Result<std::unique_ptr<Daemon>> Daemon::Start(const Config& config, PrivilegedDe
   d->server_ = builder.BuildAndStart();
   if (d->server_ && d->tcp_.acceptor) {
     d->tcp_port_ = d->tcp_.acceptor->port();
-    d->tcp_.Start();
+    service::StartTcpListener(d->tcp_, d->server_.get(), &d->peers_, &d->policy_);
   }
   if (!d->server_ || (!config.listen.tcp.empty() && d->tcp_port_ == 0))
     return Status(ErrorCode::kUnavailable,

@@ -47,24 +47,24 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     socket.mode = 0660;
     socket.connections = config.listen.connections;
     socket.http2_guard = config.listen.guard;  // new streams, resets, pings at a bounded rate
+    socket.handshake_timeout_ms = config.listen.http2.handshake_timeout_ms;
     rpc::UnixAcceptorError error;
     s->acceptor_ = rpc::UnixAcceptor::Create(socket, &error);
     if (!s->acceptor_) throw std::runtime_error("listen.unix_socket: " + error.message);
   }
   if (!config.listen.tcp.empty()) {
-    rpc::TlsFiles tls{config.listen.tls_client_ca, config.listen.tls_certificate,
-                      config.listen.tls_key,       "listen.tls_client_ca",
-                      "listen.tls_certificate",    "listen.tls_key"};
-    rpc::TcpAcceptorOptions tcp;
-    tcp.address = config.listen.tcp;
-    tcp.connections = config.listen.connections;
+    rpc::TcpListenerOptions tcp;
+    tcp.acceptor.address = config.listen.tcp;
+    tcp.acceptor.connections = config.listen.connections;
     // Plain TCP: a name that also resolves to a network address is refused.
-    tcp.loopback_only = config.listen.plaintext_loopback;
-    s->tcp_ =
-        rpc::ListenTcp(tcp,
-                       config.listen.plaintext_loopback ? grpc::InsecureServerCredentials()
-                                                        : rpc::MutualTlsServerCredentials(tls),
-                       builder);
+    tcp.acceptor.loopback_only = config.listen.plaintext_loopback;
+    tcp.guard = config.listen.guard;  // new streams, resets, pings at a bounded rate
+    if (!config.listen.plaintext_loopback)
+      tcp.tls = rpc::TlsFiles{config.listen.tls_client_ca, config.listen.tls_certificate,
+                              config.listen.tls_key,       "listen.tls_client_ca",
+                              "listen.tls_certificate",    "listen.tls_key"};
+    tcp.handshake_timeout_ms = config.listen.http2.handshake_timeout_ms;
+    s->tcp_ = rpc::ListenTcp(tcp);
     s->tcp_port_ = s->tcp_.acceptor->port();
   }
   s->server_ = builder.BuildAndStart();
@@ -74,9 +74,11 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
         (config.listen.tcp.empty() ? std::string() : " on TCP " + config.listen.tcp) +
         (config.listen.unix_socket.empty() ? std::string()
                                            : " (socket " + config.listen.unix_socket + ")"));
-  if (s->tcp_.acceptor) s->tcp_.Start();
+  grpc::Server* server = s->server_.get();
+  if (s->tcp_.acceptor)
+    s->tcp_.Start(
+        [server](int fd, const std::string&) { grpc::AddInsecureChannelFromFd(server, fd); });
   if (s->acceptor_) {
-    grpc::Server* server = s->server_.get();
     s->acceptor_->Start(
         [server](int fd, const ucred&) { grpc::AddInsecureChannelFromFd(server, fd); });
   }

@@ -2,6 +2,9 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <pthread.h>
+#include <signal.h>
+#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
@@ -9,6 +12,9 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <utility>
+
+#include "bsls/rpc/tls_session.h"
 
 namespace bsls::rpc {
 namespace {
@@ -69,7 +75,13 @@ bool HungUp(const pollfd& fd) {
 // One relayed connection.
 struct Http2Guard::Link {
   int client = -1;
-  int inner = -1;            // the guard's end of the pair; gRPC has the other
+  int inner = -1;                   // the guard's end of the pair; gRPC has the other
+  int grpc_end = -1;                // the other end while it waits for a verified handshake
+  HandOver hand_over;               // TLS: who takes grpc_end once the client is verified
+  std::unique_ptr<TlsSession> tls;  // TLS ended here; none for plaintext
+  std::int64_t handshake_deadline_ns = 0;
+  bool want_read = false;    // TLS: a step waits for the client to be readable
+  bool want_write = false;   // TLS: a step waits for the client to be writable
   std::string up;            // client to gRPC, read and not yet written
   std::size_t admitted = 0;  // bytes at the front of `up` let through
   std::string down;          // gRPC to client, read and not yet written
@@ -79,17 +91,30 @@ struct Http2Guard::Link {
   double tokens = 0;
   std::int64_t refilled_ns = 0;
 
+  // Whether gRPC has its end (always without TLS).
+  bool handed() const { return grpc_end < 0; }
+  // Whether the client has said it speaks HTTP/2 (its preface is through).
+  bool begun() const { return handed() && preface_left == 0; }
+
   ~Link() {
-    if (client >= 0) ::close(client);
-    if (inner >= 0) ::close(inner);
+    if (tls) tls->Close();
+    for (const int fd : {client, inner, grpc_end})
+      if (fd >= 0) ::close(fd);
   }
 };
 
-Http2Guard::Http2Guard(const Http2GuardLimits& limits)
-    : limits_(limits), total_tokens_(limits.total_burst), total_refilled_ns_(NowNs()) {}
+Http2Guard::Http2Guard(const Http2GuardLimits& limits, std::shared_ptr<const TlsServerContext> tls,
+                       int handshake_timeout_ms)
+    : limits_(limits),
+      tls_(std::move(tls)),
+      handshake_timeout_ms_(handshake_timeout_ms),
+      total_tokens_(limits.total_burst),
+      total_refilled_ns_(NowNs()) {}
 
-std::unique_ptr<Http2Guard> Http2Guard::Create(const Http2GuardLimits& limits, std::string* error) {
-  std::unique_ptr<Http2Guard> guard(new Http2Guard(limits));
+std::unique_ptr<Http2Guard> Http2Guard::Create(const Http2GuardLimits& limits, std::string* error,
+                                               std::shared_ptr<const TlsServerContext> tls,
+                                               int handshake_timeout_ms) {
+  std::unique_ptr<Http2Guard> guard(new Http2Guard(limits, std::move(tls), handshake_timeout_ms));
   if (::pipe2(guard->wake_, O_CLOEXEC | O_NONBLOCK) != 0) {
     *error = std::string("HTTP/2 guard: pipe: ") + std::strerror(errno);
     return nullptr;
@@ -110,18 +135,26 @@ Http2Guard::~Http2Guard() {
     if (end >= 0) ::close(end);
 }
 
-int Http2Guard::Guard(int client, std::string* error) {
+bool Http2Guard::Guard(int client, HandOver hand_over, std::string* error) {
   int pair[2];
   if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC | SOCK_NONBLOCK, 0, pair) != 0) {
     *error = std::string("HTTP/2 guard: socketpair: ") + std::strerror(errno);
     ::close(client);
-    return -1;
+    return false;
   }
   auto link = std::make_unique<Link>();
   link->client = client;
   link->inner = pair[0];
   link->tokens = limits_.burst;
   link->refilled_ns = NowNs();
+  link->handshake_deadline_ns = link->refilled_ns + std::int64_t{handshake_timeout_ms_} * 1000000;
+  if (tls_) {
+    link->tls = std::make_unique<TlsSession>(*tls_, client);
+    link->grpc_end = pair[1];
+    link->hand_over = std::move(hand_over);
+  } else {
+    hand_over(pair[1], "");
+  }
   {
     std::lock_guard lock(mutex_);
     incoming_.push_back(std::move(link));
@@ -129,12 +162,19 @@ int Http2Guard::Guard(int client, std::string* error) {
   ++relayed_;
   const char byte = 0;
   [[maybe_unused]] const ssize_t n = ::write(wake_[1], &byte, 1);
-  return pair[1];
+  return true;
 }
 
 std::size_t Http2Guard::relayed() const { return relayed_; }
 
 void Http2Guard::Relay() {
+  // OpenSSL writes to the client's socket without MSG_NOSIGNAL: a client
+  // gone would raise SIGPIPE, which ends the process. Blocked on this
+  // thread, the signal stays pending here and the write fails with EPIPE.
+  sigset_t pipe;
+  sigemptyset(&pipe);
+  sigaddset(&pipe, SIGPIPE);
+  pthread_sigmask(SIG_BLOCK, &pipe, nullptr);
   std::vector<pollfd> fds;
   while (!stopping_) {
     {
@@ -144,31 +184,56 @@ void Http2Guard::Relay() {
     }
     // Per link: the client, then gRPC's end; the wake pipe last.
     fds.clear();
-    bool any_waiting = false;
+    int timeout_ms = -1;
+    const std::int64_t now = NowNs();
     for (const auto& link : links_) {
       const bool room_up = link->up.size() < kBufferBytes;
-      fds.push_back(
-          {link->client,
-           static_cast<short>((room_up ? POLLIN : 0) | (link->down.empty() ? 0 : POLLOUT)), 0});
+      short client_events = 0;
+      if (!link->handed()) {
+        // Handshaking: the direction the handshake waits for.
+        client_events = link->want_write ? POLLOUT : POLLIN;
+      } else {
+        client_events =
+            static_cast<short>(((room_up || link->want_read) ? POLLIN : 0) |
+                               ((!link->down.empty() || link->want_write) ? POLLOUT : 0));
+      }
+      if (!link->begun()) {  // woken at its deadline
+        const std::int64_t left_ms =
+            std::max<std::int64_t>((link->handshake_deadline_ns - now) / 1000000 + 1, 0);
+        timeout_ms = static_cast<int>(timeout_ms < 0 ? left_ms
+                                                     : std::min<std::int64_t>(left_ms, timeout_ms));
+      }
+      fds.push_back({link->client, client_events, 0});
       fds.push_back({link->inner,
                      static_cast<short>((link->down.size() < kBufferBytes ? POLLIN : 0) |
                                         (link->admitted > 0 ? POLLOUT : 0)),
                      0});
-      any_waiting = any_waiting || link->waiting;
+      // Decrypted bytes waiting inside TLS wake no poll: look again at once.
+      if (link->handed() && link->tls && room_up && link->tls->buffered()) timeout_ms = 0;
+      if (link->waiting)
+        timeout_ms = timeout_ms < 0 ? kThrottledPollMs : std::min(timeout_ms, kThrottledPollMs);
     }
     fds.push_back({wake_[0], POLLIN, 0});
-    if (::poll(fds.data(), fds.size(), any_waiting ? kThrottledPollMs : -1) < 0 && errno != EINTR)
-      break;
+    if (::poll(fds.data(), fds.size(), timeout_ms) < 0 && errno != EINTR) break;
     if (fds.back().revents != 0) {
       char drain[64];
       while (::read(wake_[0], drain, sizeof drain) > 0) {
       }
     }
     std::size_t kept = 0;
+    const std::int64_t polled = NowNs();
     for (std::size_t i = 0; i < links_.size(); ++i) {
-      const bool active = fds[2 * i].revents != 0 || fds[2 * i + 1].revents != 0;
-      if (HungUp(fds[2 * i]) || HungUp(fds[2 * i + 1]) ||
-          ((active || links_[i]->waiting) && !Pump(*links_[i]))) {
+      Link& link = *links_[i];
+      const bool active = fds[2 * i].revents != 0 || fds[2 * i + 1].revents != 0 ||
+                          (link.handed() && link.tls && link.tls->buffered());
+      const bool keep = !HungUp(fds[2 * i]) && !HungUp(fds[2 * i + 1]) &&
+                        (!(active || link.waiting) || Pump(link));
+      const bool late = keep && !link.begun() && polled >= link.handshake_deadline_ns;
+      if (late)
+        LogRefusal(std::string(link.handed() ? "no HTTP/2 preface" : "no TLS handshake") +
+                   " within " + std::to_string(handshake_timeout_ms_) + " ms");
+      if (!keep || late) {
+        if (late || !link.handed()) ++refused_;
         links_[i].reset();  // closes both ends
         --relayed_;
         continue;
@@ -181,8 +246,86 @@ void Http2Guard::Relay() {
   links_.clear();
 }
 
+bool Http2Guard::Handshake(Link& link) {
+  link.want_read = link.want_write = false;
+  switch (link.tls->Handshake()) {
+    case TlsSession::Step::kDone: {
+      const int fd = std::exchange(link.grpc_end, -1);
+      link.hand_over(fd, link.tls->common_name());
+      return true;
+    }
+    case TlsSession::Step::kWantRead:
+      link.want_read = true;
+      return true;
+    case TlsSession::Step::kWantWrite:
+      link.want_write = true;
+      return true;
+    case TlsSession::Step::kClosed:
+      LogRefusal("the client closed the connection during the TLS handshake");
+      return false;
+    case TlsSession::Step::kFailed:
+      break;
+  }
+  LogRefusal(link.tls->error());
+  return false;
+}
+
+bool Http2Guard::ReadClient(Link& link) {
+  if (link.up.size() >= kBufferBytes) return true;
+  if (!link.tls) return ReadSome(link.client, &link.up);
+  link.want_read = false;
+  switch (link.tls->Read(&link.up, kBufferBytes - link.up.size())) {
+    case TlsSession::Step::kDone:
+    case TlsSession::Step::kWantRead:
+      return true;
+    case TlsSession::Step::kWantWrite:
+      link.want_write = true;
+      return true;
+    case TlsSession::Step::kClosed:
+    case TlsSession::Step::kFailed:
+      break;
+  }
+  return false;
+}
+
+bool Http2Guard::WriteClient(Link& link) {
+  if (link.down.empty()) return true;
+  if (!link.tls) return WriteSome(link.client, &link.down, link.down.size());
+  link.want_write = false;
+  switch (link.tls->Write(&link.down, link.down.size())) {
+    case TlsSession::Step::kDone:
+      return true;
+    case TlsSession::Step::kWantWrite:
+      link.want_write = true;
+      return true;
+    case TlsSession::Step::kWantRead:
+      link.want_read = true;
+      return true;
+    case TlsSession::Step::kClosed:
+    case TlsSession::Step::kFailed:
+      break;
+  }
+  return false;
+}
+
+void Http2Guard::LogRefusal(const std::string& why) {
+  ++refusals_unlogged_;
+  const std::int64_t now = NowNs();
+  if (now - last_refusal_log_ns_ < 1000000000) return;
+  spdlog::warn("connection closed before it began: {}{}", why,
+               refusals_unlogged_ > 1
+                   ? " (" + std::to_string(refusals_unlogged_) + " since the last such line)"
+                   : std::string());
+  refusals_unlogged_ = 0;
+  last_refusal_log_ns_ = now;
+}
+
 bool Http2Guard::Pump(Link& link) {
-  const bool client_open = link.up.size() >= kBufferBytes || ReadSome(link.client, &link.up);
+  if (!link.handed()) {
+    if (!Handshake(link)) return false;
+    if (!link.handed()) return true;  // the handshake waits for the client
+  }
+  const bool client_open = ReadClient(link);
   Admit(link);
   if (link.admitted > 0) {
     const std::size_t before = link.up.size();
@@ -190,7 +333,7 @@ bool Http2Guard::Pump(Link& link) {
     link.admitted -= before - link.up.size();
   }
   const bool inner_open = link.down.size() >= kBufferBytes || ReadSome(link.inner, &link.down);
-  if (!link.down.empty() && !WriteSome(link.client, &link.down, link.down.size())) return false;
+  if (!WriteClient(link)) return false;
   // A side that ended ends the link; what gRPC said last went out above if
   // the client was reading.
   return client_open && inner_open;

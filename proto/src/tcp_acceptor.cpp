@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "acceptor.h"
+#include "bsls/rpc/tls_session.h"
 
 namespace bsls::rpc {
 namespace {
@@ -216,8 +217,7 @@ TcpAcceptor::~TcpAcceptor() { Stop(); }
 
 void TcpAcceptor::Start(HandOver hand_over) {
   core_->Start([hand_over = std::move(hand_over)](int fd, int listener_fd, const Peer&) {
-    hand_over(fd, listener_fd);
-    return true;
+    return hand_over(fd, listener_fd);
   });
 }
 
@@ -229,13 +229,11 @@ std::uint64_t TcpAcceptor::shed() const { return core_->shed(); }
 
 std::uint64_t TcpAcceptor::refused() const { return core_->refused(); }
 
-void TcpListener::Start() {
-  grpc::experimental::ExternalConnectionAcceptor* grpc_end = to_grpc.get();
-  acceptor->Start([grpc_end](int fd, int listener_fd) {
-    grpc::experimental::ExternalConnectionAcceptor::NewConnectionParameters connection;
-    connection.listener_fd = listener_fd;
-    connection.fd = fd;
-    grpc_end->HandleNewConnection(&connection);
+void TcpListener::Start(Http2Guard::HandOver hand_over) {
+  guard->Start();
+  acceptor->Start([guard = guard.get(), hand_over = std::move(hand_over)](int fd, int) {
+    std::string ignored;  // the only reason: no descriptors for the socket pair
+    return guard->Guard(fd, hand_over, &ignored);
   });
 }
 
@@ -243,16 +241,16 @@ void TcpListener::Stop() {
   if (acceptor) acceptor->Stop();
 }
 
-TcpListener ListenTcp(const TcpAcceptorOptions& options,
-                      std::shared_ptr<grpc::ServerCredentials> credentials,
-                      grpc::ServerBuilder& builder) {
+TcpListener ListenTcp(const TcpListenerOptions& options) {
+  std::shared_ptr<const TlsServerContext> tls;
+  if (options.tls) tls = TlsServerContext::Create(*options.tls);
   TcpListener listener;
   std::string error;
-  listener.acceptor = TcpAcceptor::Create(options, &error);
+  listener.guard =
+      Http2Guard::Create(options.guard, &error, std::move(tls), options.handshake_timeout_ms);
+  if (!listener.guard) throw std::runtime_error("listen.tcp: " + error);
+  listener.acceptor = TcpAcceptor::Create(options.acceptor, &error);
   if (!listener.acceptor) throw std::runtime_error("listen.tcp: " + error);
-  listener.to_grpc = builder.experimental().AddExternalConnectionAcceptor(
-      grpc::ServerBuilder::experimental_type::ExternalConnectionType::FROM_FD,
-      std::move(credentials));
   return listener;
 }
 

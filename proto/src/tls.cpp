@@ -18,14 +18,6 @@ std::string ReadPemFile(const std::string& path, const std::string& setting) {
   return text.str();
 }
 
-std::shared_ptr<grpc::ServerCredentials> MutualTlsServerCredentials(const TlsFiles& files) {
-  grpc::SslServerCredentialsOptions tls(GRPC_SSL_REQUEST_AND_REQUIRE_CLIENT_CERTIFICATE_AND_VERIFY);
-  tls.pem_root_certs = ReadPemFile(files.ca, files.ca_setting);
-  tls.pem_key_cert_pairs.push_back({ReadPemFile(files.key, files.key_setting),
-                                    ReadPemFile(files.certificate, files.certificate_setting)});
-  return grpc::SslServerCredentials(tls);
-}
-
 std::shared_ptr<grpc::ChannelCredentials> MutualTlsChannelCredentials(const TlsFiles& files) {
   grpc::SslCredentialsOptions tls;
   tls.pem_root_certs = ReadPemFile(files.ca, files.ca_setting);

@@ -93,7 +93,7 @@ std::unique_ptr<UnixAcceptor> UnixAcceptor::Create(const UnixAcceptorOptions& op
   if (!core) return fail_bound(UnixAcceptorError::Kind::kSystem, options.path + ": " + why);
   std::unique_ptr<Http2Guard> guard;
   if (options.http2_guard) {
-    guard = Http2Guard::Create(*options.http2_guard, &why);
+    guard = Http2Guard::Create(*options.http2_guard, &why, nullptr, options.handshake_timeout_ms);
     if (!guard) return fail_bound(UnixAcceptorError::Kind::kSystem, options.path + ": " + why);
   }
   return std::unique_ptr<UnixAcceptor>(
@@ -106,14 +106,13 @@ void UnixAcceptor::Start(HandOver hand_over) {
   if (guard_) guard_->Start();
   core_->Start(
       [hand_over = std::move(hand_over), guard = guard_.get()](int client, int, const Peer& peer) {
-        int fd = client;
-        if (guard) {
-          std::string ignored;  // the only reason: no descriptors for the socket pair
-          fd = guard->Guard(client, &ignored);
-          if (fd < 0) return false;
+        if (!guard) {
+          hand_over(client, peer.credentials);
+          return true;
         }
-        hand_over(fd, peer.credentials);
-        return true;
+        std::string ignored;  // the only reason: no descriptors for the socket pair
+        return guard->Guard(
+            client, [&](int fd, const std::string&) { hand_over(fd, peer.credentials); }, &ignored);
       });
 }
 

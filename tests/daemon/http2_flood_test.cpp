@@ -30,7 +30,9 @@
 #include <utility>
 #include <vector>
 
+#include "bsls/testing/certificates.h"
 #include "bsls/testing/raw_connections.h"
+#include "bsls/testing/tls_tunnel.h"
 #include "bsls/v1/processing.grpc.pb.h"
 #include "daemon_process.h"
 #include "processd_process.h"
@@ -99,18 +101,18 @@ std::vector<std::pair<std::string, Batch>> Floods(const std::string& path) {
            }}};
 }
 
-// Floods `service` (a process whose Unix socket is `socket`) with each of
-// Floods(`path`) and expects its memory back within 20 % of before, its
-// peak below kPeakKib, and `answers()` true afterwards.
+// Floods `service` (a process whose connections `connect` opens) with
+// `floods` and expects its memory back within 20 % of before, its peak
+// below kPeakKib, and `answers()` true afterwards.
 void ExpectMemoryBackAfterFloods(const std::string& service, ChildProcess& process,
-                                 const std::string& socket, const std::string& path,
+                                 const std::function<int()>& connect,
+                                 const std::vector<std::pair<std::string, Batch>>& floods,
                                  const std::function<bool()>& answers) {
   const pid_t pid = process.pid();
   // At rest: a few calls made (gRPC's first-call allocations), then one trim.
   for (int i = 0; i < 5; ++i) ASSERT_TRUE(answers()) << service;
   std::this_thread::sleep_for(seconds(11));
-  const auto connect = [&socket] { return ConnectUnixAs(0, socket); };
-  for (const auto& flood : Floods(path)) {
+  for (const auto& flood : floods) {
     const auto& [name, batch] = flood;
     SCOPED_TRACE(service + ", " + name);
     const long before = processing::test::ResidentKib(pid);
@@ -141,31 +143,60 @@ TEST(BslsdHttp2Flood, MemoryReturnsWithin20PercentAfterPingAndRapidResetFloods) 
   DaemonProcess daemon(
       dir, WriteDaemonConfig(dir, "roles:\n  viewer: ['" + std::to_string(::geteuid()) + "']\n"));
   ASSERT_TRUE(daemon.ready()) << daemon.Log();
+  const std::string socket = daemon.socket().string();
   ExpectMemoryBackAfterFloods(
-      "bslsd", daemon, daemon.socket().string(), "/bsls.v1.CaptureDaemon/GetStatus", [&] {
+      "bslsd", daemon, [&socket] { return ConnectUnixAs(0, socket); },
+      Floods("/bsls.v1.CaptureDaemon/GetStatus"),
+      [&] {
         v1::DeviceStatus status;
         return daemon.Stub()->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok();
       });
   EXPECT_EQ(daemon.Terminate(seconds(10)), 0) << daemon.Log();
 }
 
+// A daemon's mutual-TLS listener for the floods: a CA, the server's
+// certificate, a client "flooder" of the CA (no role: its calls are refused,
+// its frames still reach gRPC), and the options that open the listener.
+struct TlsListener {
+  explicit TlsListener(const fs::path& dir) : pki(dir / "pki", "clinic") {
+    const PemFiles server = pki.Issue("localhost", true);
+    client = pki.Issue("flooder");
+    port = FreeLoopbackPort();
+    args = {"--tcp", "127.0.0.1:" + std::to_string(port),
+            "--set", "listen.tls_certificate=" + server.certificate.string(),
+            "--set", "listen.tls_key=" + server.key.string(),
+            "--set", "listen.tls_client_ca=" + pki.ca().string()};
+  }
+  bool ok() const { return pki.ok() && port > 0; }
+
+  TestPki pki;
+  PemFiles client;
+  int port = 0;
+  std::vector<std::string> args;
+};
+
 // PING acknowledgements bslsd sends within `window` for 100 PINGs written at
-// once on one connection of its Unix socket, started with `args`. The ping
-// strikes are raised so that they do not close the connection first.
+// once on one connection, started with `args`: of its Unix socket, or with
+// `tls` of its mutual-TLS listener. The ping strikes are raised so that they
+// do not close the connection first.
 long PingAcksWithin(const std::string& name, std::vector<std::string> args,
-                    std::chrono::milliseconds window) {
+                    std::chrono::milliseconds window, bool tls = false) {
   const fs::path dir = MakeDaemonDir(name);
   for (const char* key : {"listen.max_ping_strikes=100", "listen.min_ping_interval_ms=1000"}) {
     args.push_back("--set");
     args.push_back(key);
   }
+  TlsListener listener(dir);
+  EXPECT_TRUE(listener.ok()) << "openssl could not make the test certificates";
+  if (tls) args.insert(args.end(), listener.args.begin(), listener.args.end());
   // This test's user may call GetStatus (viewer: the start-up probe), whoever runs it.
   DaemonProcess daemon(
       dir, WriteDaemonConfig(dir, "roles:\n  viewer: ['" + std::to_string(::geteuid()) + "']\n"),
       args, seconds(60));
   EXPECT_TRUE(daemon.ready()) << daemon.Log();
   if (!daemon.ready()) return -1;
-  const int fd = ConnectUnixAs(0, daemon.socket().string());
+  TlsTunnels tunnels(listener.client, listener.pki.ca());
+  const int fd = tls ? tunnels.Open(listener.port) : ConnectUnixAs(0, daemon.socket().string());
   EXPECT_GE(fd, 0);
   std::string pings = h2::Preface();
   for (int i = 0; i < 100; ++i) pings += h2::Ping(static_cast<std::uint64_t>(i));
@@ -180,15 +211,15 @@ long PingAcksWithin(const std::string& name, std::vector<std::string> args,
   return counts.ping_acks;
 }
 
+const std::vector<std::string> kTenFramesASecond = {
+    "--set", "listen.guard_frames_per_second=10",       "--set", "listen.guard_burst=10",
+    "--set", "listen.guard_total_frames_per_second=10", "--set", "listen.guard_total_burst=10"};
+
 // The guard's budgets are configuration keys that reach bslsd's socket:
 // with 10 frames a second (burst 10) at most about 10 + 2 x 10 of 100 PINGs
 // are answered in 2 s; with the defaults (200 a second, burst 400) all are.
 TEST(BslsdHttp2Guard, TheConfiguredFrameBudgetHoldsOnTheSocket) {
-  const long limited = PingAcksWithin(
-      "guard_limited",
-      {"--set", "listen.guard_frames_per_second=10", "--set", "listen.guard_burst=10", "--set",
-       "listen.guard_total_frames_per_second=10", "--set", "listen.guard_total_burst=10"},
-      milliseconds(2000));
+  const long limited = PingAcksWithin("guard_limited", kTenFramesASecond, milliseconds(2000));
   const long defaults = PingAcksWithin("guard_defaults", {}, milliseconds(2000));
   std::printf("ping acks in 2 s: %ld with a budget of 10/s, %ld with the defaults\n", limited,
               defaults);
@@ -197,6 +228,42 @@ TEST(BslsdHttp2Guard, TheConfiguredFrameBudgetHoldsOnTheSocket) {
   // the second's edges.
   EXPECT_LE(limited, 35);
   EXPECT_EQ(defaults, 100);
+}
+
+// The same budget holds on the mutual-TLS listener: TLS is ended by the
+// guard, so a caller with a certificate of the CA is counted like any other
+// (before, TLS was opaque to the guard and every PING was answered).
+TEST(BslsdHttp2Guard, TheConfiguredFrameBudgetHoldsOnTheTlsListener) {
+  const long limited =
+      PingAcksWithin("guard_tls_limited", kTenFramesASecond, milliseconds(2000), true);
+  const long defaults = PingAcksWithin("guard_tls_defaults", {}, milliseconds(2000), true);
+  std::printf("ping acks over TLS in 2 s: %ld with a budget of 10/s, %ld with the defaults\n",
+              limited, defaults);
+  EXPECT_GE(limited, 1);
+  EXPECT_LE(limited, 35);
+  EXPECT_EQ(defaults, 100);
+}
+
+// A rapid-reset flood through the mutual-TLS listener, by a caller holding a
+// certificate of the clinic's CA: memory back within 20 % as on the socket.
+TEST(BslsdHttp2Flood, MemoryReturnsWithin20PercentAfterARapidResetFloodOverTls) {
+  const fs::path dir = MakeDaemonDir("http2_flood_tls");
+  TlsListener listener(dir);
+  ASSERT_TRUE(listener.ok()) << "openssl could not make the test certificates";
+  DaemonProcess daemon(
+      dir, WriteDaemonConfig(dir, "roles:\n  viewer: ['" + std::to_string(::geteuid()) + "']\n"),
+      listener.args);
+  ASSERT_TRUE(daemon.ready()) << daemon.Log();
+  TlsTunnels tunnels(listener.client, listener.pki.ca());
+  std::vector<std::pair<std::string, Batch>> floods = Floods("/bsls.v1.CaptureDaemon/GetStatus");
+  floods.erase(floods.begin());  // the rapid reset only: the ping flood is no different inside TLS
+  ExpectMemoryBackAfterFloods(
+      "bslsd over TLS", daemon, [&] { return tunnels.Open(listener.port); }, floods,
+      [&] {
+        v1::DeviceStatus status;
+        return daemon.Stub()->GetStatus(Deadline(milliseconds(5000)).get(), {}, &status).ok();
+      });
+  EXPECT_EQ(daemon.Terminate(seconds(10)), 0) << daemon.Log();
 }
 
 #ifdef BSLS_PROCESSD_PATH
@@ -210,7 +277,9 @@ TEST(ProcessdHttp2Flood, MemoryReturnsWithin20PercentAfterPingAndRapidResetFlood
   auto stub = v1::Processing::NewStub(
       grpc::CreateChannel("unix:" + socket, grpc::InsecureChannelCredentials()));
   ExpectMemoryBackAfterFloods(
-      "bsls-processd", processd, socket, "/bsls.v1.Processing/GetServerInfo", [&] {
+      "bsls-processd", processd, [&socket] { return ConnectUnixAs(0, socket); },
+      Floods("/bsls.v1.Processing/GetServerInfo"),
+      [&] {
         v1::ServerInfo info;
         return stub->GetServerInfo(Deadline(milliseconds(5000)).get(), {}, &info).ok();
       });

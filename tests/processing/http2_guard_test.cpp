@@ -40,8 +40,10 @@ void Connect(Http2Guard& guard, Guarded* out) {
   ASSERT_EQ(::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, pair), 0);
   out->client = pair[0];
   std::string error;
-  out->server = guard.Guard(pair[1], &error);
-  ASSERT_GE(out->server, 0) << error;
+  ASSERT_TRUE(guard.Guard(
+      pair[1], [out](int fd, const std::string&) { out->server = fd; }, &error))
+      << error;
+  ASSERT_GE(out->server, 0);
 }
 
 // Writes all of `bytes` to `fd`.
@@ -171,6 +173,33 @@ TEST(Http2Guard, EitherSideClosingEndsTheOther) {
   while (guard->relayed() > 0 && std::chrono::steady_clock::now() < until)
     std::this_thread::sleep_for(milliseconds(10));
   EXPECT_EQ(guard->relayed(), 0u);
+}
+
+// A client that connects and never sends the HTTP/2 preface is closed at
+// the handshake timeout (the Unix socket and plain loopback TCP: gRPC takes
+// these connections from a descriptor and times no handshake itself); one
+// that sends it in time stays.
+TEST(Http2Guard, AClientWithoutAPrefaceIsClosedAtTheHandshakeTimeout) {
+  std::string error;
+  auto guard = Http2Guard::Create({}, &error, nullptr, /*handshake_timeout_ms=*/300);
+  ASSERT_NE(guard, nullptr) << error;
+  guard->Start();
+  Guarded silent, speaking;
+  Connect(*guard, &silent);
+  Connect(*guard, &speaking);
+  Send(speaking.client, h2::Preface());
+  const auto start = std::chrono::steady_clock::now();
+  bool ended = false;
+  ReadFor(silent.client, 3000, &ended);
+  const auto waited =
+      std::chrono::duration_cast<milliseconds>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_TRUE(ended) << "a silent client kept its connection 3 s past a 300 ms timeout";
+  EXPECT_GE(waited, 200);
+  EXPECT_LE(waited, 1500);
+  EXPECT_EQ(guard->refused(), 1u);
+  ReadFor(speaking.client, 200, &ended);
+  EXPECT_FALSE(ended) << "a client that sent its preface was closed";
+  EXPECT_EQ(guard->relayed(), 1u);
 }
 
 }  // namespace

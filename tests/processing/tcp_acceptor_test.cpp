@@ -87,6 +87,7 @@ TEST(TcpAcceptor, BindsEveryAddressTheHostResolvesToOnOnePort) {
     listeners.insert(listener_fd);
     ::close(fd);
     ++handed;
+    return true;
   });
   const int v4 = Connect("127.0.0.1", acceptor->port());
   const int v6 = Connect("::1", acceptor->port());

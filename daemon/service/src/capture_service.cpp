@@ -100,21 +100,9 @@ void CaptureService::FillCapture(const store::CaptureInfo& info, v1::CaptureInfo
 grpc::Status CaptureService::Authorize(const grpc::ServerContextBase* context,
                                        std::string_view method, Caller* caller) {
   const std::string full = std::string(kMethodPrefix) + std::string(method);
-  std::optional<Caller> found = peers_->Find(context->peer());
-  if (!found) {
-    // A TCP caller: its identity is the verified client certificate.
-    const std::shared_ptr<const grpc::AuthContext> auth = context->auth_context();
-    if (auth && auth->IsPeerAuthenticated()) {
-      for (const grpc::string_ref& cn : auth->FindPropertyValues("x509_common_name")) {
-        Caller tcp;
-        tcp.name.assign(cn.data(), cn.size());
-        tcp.transport = "tcp";
-        tcp.role = policy_->RoleOfCertificate(tcp.name);
-        found = tcp;
-        break;
-      }
-    }
-  }
+  // Every connection was accepted by the daemon itself and its caller
+  // recorded: by uid on the Unix socket, by verified client certificate on TCP.
+  const std::optional<Caller> found = peers_->Find(context->peer());
   if (!found)
     return {grpc::StatusCode::UNAUTHENTICATED,
             "bslsd cannot tell who is calling on " + context->peer() +

@@ -50,6 +50,7 @@ Result<std::unique_ptr<UnixListener>> UnixListener::Create(const UnixListenerOpt
   socket.backlog = options.backlog;
   socket.connections = options.connections;
   socket.http2_guard = options.http2_guard;
+  socket.handshake_timeout_ms = options.handshake_timeout_ms;
   rpc::UnixAcceptorError error;
   std::unique_ptr<rpc::UnixAcceptor> acceptor = rpc::UnixAcceptor::Create(socket, &error);
   if (!acceptor) {
@@ -84,5 +85,17 @@ void UnixListener::Start(grpc::Server* server, PeerRegistry* registry, const Rol
 }
 
 void UnixListener::Stop() { acceptor_->Stop(); }
+
+void StartTcpListener(rpc::TcpListener& tcp, grpc::Server* server, PeerRegistry* registry,
+                      const RolePolicy* policy) {
+  tcp.Start([server, registry, policy](int fd, const std::string& common_name) {
+    Caller caller;
+    caller.name = common_name;
+    caller.transport = "tcp";
+    caller.role = policy->RoleOfCertificate(common_name);
+    registry->Add("fd:" + std::to_string(fd), std::move(caller));
+    grpc::AddInsecureChannelFromFd(server, fd);
+  });
+}
 
 }  // namespace bsls::service

@@ -13,18 +13,28 @@
 // connections together so that many connections are not many budgets.
 // Data, WINDOW_UPDATE and continuation frames pass as they come.
 //
-// The guard reads frame headers only; TLS connections are opaque to it and
-// are not guarded (bslsd's TCP listener is mutual TLS: its callers hold a
-// certificate of the clinic's CA).
+// Mutual TLS (the services' TCP listeners) is ended here, not by gRPC, so
+// that a caller holding a certificate of the clinic's CA is counted like
+// any other: the guard runs each TLS handshake without blocking on its
+// relay thread (rpc::TlsSession), verifies the client certificate, and only
+// then hands gRPC its plaintext end together with the certificate's common
+// name (the caller's identity; gRPC itself sees a plaintext connection). A
+// client that has not finished its handshake and sent the HTTP/2 preface
+// within the handshake timeout is closed, TLS or not: a peer that connects
+// and sends nothing holds a descriptor and a connection slot that long at
+// most. Connections closed so are logged at most once a second with their
+// count.
 //
 // Thread-safety: Create and Start from one thread, Guard from any one
 // thread (the accept loop), the counters from any thread. The relay runs on
-// a thread of its own; connections given before Start wait for it.
+// a thread of its own; connections given before Start wait for it. A TLS
+// connection's hand-over runs on the relay thread.
 #ifndef BSLS_RPC_HTTP2_GUARD_H_
 #define BSLS_RPC_HTTP2_GUARD_H_
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -32,6 +42,8 @@
 #include <vector>
 
 namespace bsls::rpc {
+
+class TlsServerContext;
 
 // Frames that make the server work (HEADERS, PRIORITY, RST_STREAM,
 // SETTINGS, PING) let through per second, and in one burst after a quiet
@@ -45,10 +57,19 @@ struct Http2GuardLimits {
 
 class Http2Guard {
  public:
+  // Takes gRPC's end of a relayed connection (owned from then on) and the
+  // verified common name of its client's certificate ("" without TLS).
+  using HandOver = std::function<void(int fd, const std::string& common_name)>;
+
   // A guard, its relay not started yet (a daemon may still need to be
-  // single-threaded); nullptr with `error` naming the reason when its wake
-  // pipe cannot be had.
-  static std::unique_ptr<Http2Guard> Create(const Http2GuardLimits& limits, std::string* error);
+  // single-threaded), ending TLS on every connection when `tls` is given
+  // (the server's certificate, the clients' CA). A client that has not
+  // finished its TLS handshake and sent the HTTP/2 connection preface within
+  // `handshake_timeout_ms` of Guard is closed. nullptr with `error` naming
+  // the reason when its wake pipe cannot be had.
+  static std::unique_ptr<Http2Guard> Create(const Http2GuardLimits& limits, std::string* error,
+                                            std::shared_ptr<const TlsServerContext> tls = nullptr,
+                                            int handshake_timeout_ms = 10000);
   // Stops the relay and closes every connection still relayed (both ends).
   ~Http2Guard();
   Http2Guard(const Http2Guard&) = delete;
@@ -57,29 +78,46 @@ class Http2Guard {
   // Starts the relay on a thread of its own (once; later calls do nothing).
   void Start();
   // Relays the client connection `client` (owned from now on, closed when
-  // either side ends) and returns the descriptor to hand to gRPC in its
-  // place; -1 with `error` naming the reason (and `client` closed) when no
-  // socket pair can be had.
-  int Guard(int client, std::string* error);
+  // either side ends) and gives `hand_over` the descriptor for gRPC in its
+  // place: at once without TLS (on this thread), after a verified handshake
+  // with TLS (on the relay thread; never when it fails). False with `error`
+  // naming the reason (and `client` closed) when no socket pair can be had.
+  bool Guard(int client, HandOver hand_over, std::string* error);
 
   // Connections being relayed.
   std::size_t relayed() const;
   // Times a connection had spent its budget and was made to wait (once per wait).
   std::uint64_t throttled() const { return throttled_; }
+  // Connections closed before they began: a failed TLS handshake, an
+  // unverified certificate, or no handshake and preface within the timeout.
+  std::uint64_t refused() const { return refused_; }
 
  private:
   struct Link;
-  explicit Http2Guard(const Http2GuardLimits& limits);
+  Http2Guard(const Http2GuardLimits& limits, std::shared_ptr<const TlsServerContext> tls,
+             int handshake_timeout_ms);
   void Relay();
-  // Moves what can move on `link` (reads, writes, lets frames through);
-  // false when the link has ended.
+  // Moves what can move on `link` (handshake, reads, writes, lets frames
+  // through); false when the link has ended.
   bool Pump(Link& link);
+  // Moves `link`'s TLS handshake on and hands its gRPC end over once the
+  // client is verified; false when the handshake failed.
+  bool Handshake(Link& link);
+  // Reads what the client sent into link.up; false at its end or on an error.
+  bool ReadClient(Link& link);
+  // Writes link.down to the client; false when the client is gone.
+  bool WriteClient(Link& link);
+  // Logs a connection closed before it began, at most once a second with
+  // the count since the last line.
+  void LogRefusal(const std::string& why);
   // Lets through the frames of `link`'s read bytes its budget allows.
   void Admit(Link& link);
   // Takes one frame from the budgets of `link` and of all; false when either is empty.
   bool TakeToken(Link& link);
 
   Http2GuardLimits limits_;
+  std::shared_ptr<const TlsServerContext> tls_;
+  int handshake_timeout_ms_;
   int wake_[2] = {-1, -1};  // written to by Guard (a new link) and the destructor
   std::atomic<bool> stopping_{false};
   mutable std::mutex mutex_;                     // guards incoming_
@@ -87,8 +125,11 @@ class Http2Guard {
   std::vector<std::unique_ptr<Link>> links_;     // relay thread only
   std::atomic<std::size_t> relayed_{0};
   std::atomic<std::uint64_t> throttled_{0};
+  std::atomic<std::uint64_t> refused_{0};
   double total_tokens_ = 0;  // relay thread only
   std::int64_t total_refilled_ns_ = 0;
+  std::uint64_t refusals_unlogged_ = 0;  // relay thread only
+  std::int64_t last_refusal_log_ns_ = 0;
   std::thread thread_;
 };
 

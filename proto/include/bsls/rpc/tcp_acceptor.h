@@ -1,7 +1,7 @@
 // The TCP front door of both services (bslsd, bsls-processd): the service
-// accepts its TCP connections itself and hands each to its gRPC server
-// through grpc::experimental::ExternalConnectionAcceptor, which runs the
-// TLS handshake (or none, for plain loopback) as if gRPC had accepted it.
+// accepts its TCP connections itself and relays each through rpc::Http2Guard,
+// which ends mutual TLS (or none, for plain loopback) and lets gRPC have the
+// plaintext end once the client is verified (grpc::AddInsecureChannelFromFd).
 // Like gRPC's own listener, it binds every address the host name resolves
 // to ("localhost" may be both ::1 and 127.0.0.1), all on one port (the one
 // the first picked when the address gives port 0); an address that cannot be
@@ -19,24 +19,25 @@
 //  - out of descriptors (EMFILE, ENFILE), the waiting caller is shed
 //    through a descriptor kept spare for it and the loop waits a moment
 //    instead of spinning.
-// A peer that opens a connection and never finishes the handshake holds its
-// slot only until gRPC's handshake deadline (listen.handshake_timeout_ms,
-// rpc::Http2Limits) closes it.
+// A peer that opens a connection and never finishes the TLS handshake holds
+// its slot only until the guard's handshake deadline
+// (listen.handshake_timeout_ms) closes it.
 //
 // Thread-safety: Create, Start and Stop from one thread; the counters from
 // any thread. The hand-over function runs on the accept thread.
 #ifndef BSLS_RPC_TCP_ACCEPTOR_H_
 #define BSLS_RPC_TCP_ACCEPTOR_H_
 
-#include <grpcpp/server_builder.h>
-
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "bsls/rpc/http2_guard.h"
 #include "bsls/rpc/server_limits.h"
+#include "bsls/rpc/tls.h"
 
 namespace bsls::rpc {
 
@@ -55,8 +56,9 @@ struct TcpAcceptorOptions {
 class TcpAcceptor {
  public:
   // Takes a connection (the descriptor is its own from then on) and the
-  // descriptor of the listening socket it came through.
-  using HandOver = std::function<void(int fd, int listener_fd)>;
+  // descriptor of the listening socket it came through; false when it had
+  // to close the connection for want of descriptors (counted as shed).
+  using HandOver = std::function<bool(int fd, int listener_fd)>;
 
   // Binds and listens on every address options.address resolves to (see
   // above); nullptr with `error` naming the address and the reason when it
@@ -93,24 +95,35 @@ class TcpAcceptor {
   std::vector<std::string> bound_;
 };
 
-// A server's TCP listener: the acceptor and gRPC's end of the hand-over.
+// How a server's TCP connections reach it: the acceptor's address and
+// limits, the guard's budgets, and mutual TLS (ended by the guard) or none.
+struct TcpListenerOptions {
+  TcpAcceptorOptions acceptor;
+  Http2GuardLimits guard;
+  // Mutual TLS; none for plaintext (then acceptor.loopback_only should be set).
+  std::optional<TlsFiles> tls;
+  int handshake_timeout_ms = 10000;  // a client's TLS handshake and HTTP/2 preface
+};
+
+// A server's TCP listener: the acceptor, and the guard every connection is
+// relayed through (rpc::Http2Guard: frame budgets, and the TLS end).
 struct TcpListener {
-  // In this order: the acceptor's thread stops before gRPC's end goes.
-  std::unique_ptr<grpc::experimental::ExternalConnectionAcceptor> to_grpc;
+  // In this order: the acceptor's thread stops before the guard goes.
+  std::unique_ptr<Http2Guard> guard;
   std::unique_ptr<TcpAcceptor> acceptor;
 
-  // Starts handing accepted connections to the server (after BuildAndStart).
-  void Start();
+  // Starts accepting: each connection's gRPC end goes to `hand_over`, with
+  // the verified common name of its client certificate under TLS (on the
+  // guard's thread) or "" without (on the accept thread).
+  void Start(Http2Guard::HandOver hand_over);
   // Stops accepting; connections already handed over stay.
   void Stop();
 };
 
-// Binds options.address and registers it on `builder` with `credentials`
-// (mutual TLS, or plain for loopback); throws std::runtime_error naming the
-// address and the reason when it cannot bind.
-TcpListener ListenTcp(const TcpAcceptorOptions& options,
-                      std::shared_ptr<grpc::ServerCredentials> credentials,
-                      grpc::ServerBuilder& builder);
+// Binds options.acceptor.address and loads the TLS files; throws
+// TlsFileError naming the file and the reason, or std::runtime_error naming
+// the address and the reason when it cannot bind.
+TcpListener ListenTcp(const TcpListenerOptions& options);
 
 }  // namespace bsls::rpc
 

@@ -1,14 +1,13 @@
 // Mutual TLS for the services and their clients: PEM files read and checked,
-// server credentials that refuse any client without a certificate signed by
-// the given CA, and client credentials. Every remote (TCP) connection of
-// BSLS goes through here; Unix sockets and loopback test set-ups are plain.
+// and client credentials. The services end TLS themselves
+// (bsls/rpc/tls_session.h, from the same files); Unix sockets and loopback
+// test set-ups are plain.
 //
 // Thread-safety: pure functions (and the files).
 #ifndef BSLS_RPC_TLS_H_
 #define BSLS_RPC_TLS_H_
 
 #include <grpcpp/security/credentials.h>
-#include <grpcpp/security/server_credentials.h>
 
 #include <memory>
 #include <stdexcept>
@@ -40,10 +39,6 @@ struct TlsFiles {
 // The text of a PEM file; TlsFileError naming `setting` and `path` when it
 // cannot be read or holds no PEM block.
 std::string ReadPemFile(const std::string& path, const std::string& setting);
-
-// Server credentials that require and verify a client certificate signed by
-// files.ca. Throws TlsFileError.
-std::shared_ptr<grpc::ServerCredentials> MutualTlsServerCredentials(const TlsFiles& files);
 
 // Client credentials presenting files.certificate and trusting files.ca.
 // Throws TlsFileError.

@@ -48,6 +48,9 @@ struct UnixAcceptorOptions {
   // When set, each connection is relayed through rpc::Http2Guard with these
   // budgets (gRPC gets the guard's end; three descriptors per connection).
   std::optional<Http2GuardLimits> http2_guard;
+  // With the guard: a client that has not sent the HTTP/2 preface within
+  // this is closed.
+  int handshake_timeout_ms = 10000;
 };
 
 // Why a socket could not be made.

@@ -13,6 +13,9 @@
 // transport), so a peer name cannot be reused by a new connection while a
 // call of the old one can still look it up.
 //
+// Its TCP door (mutual TLS) records callers the same way, named by their
+// certificate's common name, once rpc::Http2Guard has verified them.
+//
 // Thread-safety: PeerRegistry is safe from any thread; UnixListener's
 // Start/Stop are called from one thread.
 #ifndef BSLS_SERVICE_UNIX_LISTENER_H_
@@ -27,6 +30,7 @@
 #include <string>
 
 #include "bsls/common/status.h"
+#include "bsls/rpc/tcp_acceptor.h"
 #include "bsls/rpc/unix_acceptor.h"
 #include "bsls/service/roles.h"
 
@@ -60,6 +64,7 @@ struct UnixListenerOptions {
   rpc::ConnectionLimits connections;
   // Each connection relayed through rpc::Http2Guard with these budgets.
   std::optional<rpc::Http2GuardLimits> http2_guard = rpc::Http2GuardLimits{};
+  int handshake_timeout_ms = 10000;  // a client's HTTP/2 preface (with the guard)
 };
 
 // bslsd's front door: rpc::UnixAcceptor (limits, descriptor exhaustion,
@@ -99,6 +104,13 @@ class UnixListener {
 
   std::unique_ptr<rpc::UnixAcceptor> acceptor_;
 };
+
+// Starts bslsd's TCP listener (mutual TLS ended by its guard): each verified
+// caller is recorded in `registry` under its connection's gRPC peer name,
+// named by its certificate's common name with its role from `policy`, and
+// only then given to `server`. All three must outlive tcp.Stop().
+void StartTcpListener(rpc::TcpListener& tcp, grpc::Server* server, PeerRegistry* registry,
+                      const RolePolicy* policy);
 
 }  // namespace bsls::service
 
