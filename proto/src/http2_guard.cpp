@@ -165,6 +165,11 @@ bool Http2Guard::Guard(int client, HandOver hand_over, std::string* error) {
   return true;
 }
 
+void Http2Guard::StopHandingOver() {
+  std::lock_guard lock(hand_over_mutex_);
+  handing_over_ = false;
+}
+
 std::size_t Http2Guard::relayed() const { return relayed_; }
 
 void Http2Guard::Relay() {
@@ -250,6 +255,8 @@ bool Http2Guard::Handshake(Link& link) {
   link.want_read = link.want_write = false;
   switch (link.tls->Handshake()) {
     case TlsSession::Step::kDone: {
+      std::lock_guard lock(hand_over_mutex_);
+      if (!handing_over_) return false;  // the server is going: closed, not counted
       const int fd = std::exchange(link.grpc_end, -1);
       link.hand_over(fd, link.tls->common_name());
       return true;

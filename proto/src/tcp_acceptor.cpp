@@ -239,6 +239,7 @@ void TcpListener::Start(Http2Guard::HandOver hand_over) {
 
 void TcpListener::Stop() {
   if (acceptor) acceptor->Stop();
+  if (guard) guard->StopHandingOver();
 }
 
 TcpListener ListenTcp(const TcpListenerOptions& options) {

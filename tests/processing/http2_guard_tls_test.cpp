@@ -225,6 +225,31 @@ TEST_F(GuardEndingTls, AClientThatNeverShakesHandsIsClosedAtTheTimeout) {
   ::close(silent);
 }
 
+// Once the server has stopped taking connections (StopHandingOver, as a
+// service drains), a client that finishes its handshake is closed, not
+// handed to a server that is going.
+TEST_F(GuardEndingTls, NothingIsHandedOverOnceHandingOverStopped) {
+  auto guard = MakeGuard({});
+  ASSERT_NE(guard, nullptr);
+  HandedOver handed;
+  Listener listener;
+  testing::TlsTunnels tunnels(station_, ca_);
+  guard->StopHandingOver();
+  std::thread accept([&] {
+    std::string error;
+    EXPECT_TRUE(guard->Guard(listener.Accept(), handed.Taker(), &error)) << error;
+  });
+  const int client = tunnels.Open(listener.port());
+  accept.join();
+  if (client >= 0) {
+    pollfd wait{client, POLLIN, 0};
+    EXPECT_EQ(::poll(&wait, 1, 2000), 1) << "the client was not closed";
+    ::close(client);
+  }
+  EXPECT_TRUE(WaitFor([&] { return guard->relayed() == 0; }));
+  EXPECT_EQ(handed.size(), 0u);
+}
+
 // A verified client that never sends the HTTP/2 preface is closed at the
 // timeout too, after its hand-over.
 TEST_F(GuardEndingTls, AVerifiedClientWithoutAPrefaceIsClosedAtTheTimeout) {

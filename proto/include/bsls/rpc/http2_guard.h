@@ -83,6 +83,10 @@ class Http2Guard {
   // with TLS (on the relay thread; never when it fails). False with `error`
   // naming the reason (and `client` closed) when no socket pair can be had.
   bool Guard(int client, HandOver hand_over, std::string* error);
+  // From its return on no TLS connection is handed over (those finishing
+  // their handshake later are closed), so that a server shutting down gets
+  // none; connections already handed over stay relayed.
+  void StopHandingOver();
 
   // Connections being relayed.
   std::size_t relayed() const;
@@ -120,6 +124,8 @@ class Http2Guard {
   int handshake_timeout_ms_;
   int wake_[2] = {-1, -1};  // written to by Guard (a new link) and the destructor
   std::atomic<bool> stopping_{false};
+  std::mutex hand_over_mutex_;                   // held while a TLS connection is handed over
+  bool handing_over_ = true;                     // guarded by hand_over_mutex_
   mutable std::mutex mutex_;                     // guards incoming_
   std::vector<std::unique_ptr<Link>> incoming_;  // links given by Guard, not yet polled
   std::vector<std::unique_ptr<Link>> links_;     // relay thread only

@@ -116,7 +116,8 @@ struct TcpListener {
   // the verified common name of its client certificate under TLS (on the
   // guard's thread) or "" without (on the accept thread).
   void Start(Http2Guard::HandOver hand_over);
-  // Stops accepting; connections already handed over stay.
+  // Stops accepting and handing over (a TLS handshake under way is not
+  // finished into a hand-over); connections already handed over stay.
   void Stop();
 };
 
