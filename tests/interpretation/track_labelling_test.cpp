@@ -192,6 +192,9 @@ TEST(TrackLabelling, InvalidParamsAreRejected) {
   bad = {};
   bad.reference_choice = -1;
   EXPECT_THROW(LabelTracks({}, pattern::Side::kLeft, {}, bad), std::invalid_argument);
+  bad = {};
+  bad.min_whole_links = -1;
+  EXPECT_THROW(LabelTracks({}, pattern::Side::kLeft, {}, bad), std::invalid_argument);
 }
 
 // A clean brick offers one chain of line-0 candidates: the first is line 0,

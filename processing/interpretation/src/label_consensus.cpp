@@ -339,32 +339,36 @@ struct Candidate {
 };
 
 // Per pair of components in the sorted `evidence`, the shift most of it
-// gives, where that has min_support votes and little dissent; the best
-// supported first.
+// gives, where that has min_support votes, min_whole_links of them whole
+// (not steps across a gap), and little dissent; the best supported first.
 std::vector<Candidate> AgreedJoins(const std::vector<Evidence>& evidence,
                                    const ConsensusParams& params) {
   std::vector<Candidate> candidates;
   for (size_t i = 0; i < evidence.size();) {
     size_t end = i;
-    int best = 0, total = 0;
+    int best = 0, total = 0, best_whole = 0;
     Label best_h{};
     while (end < evidence.size() && evidence[end].x == evidence[i].x &&
            evidence[end].y == evidence[i].y) {
       size_t run = end;
-      int count = 0;
+      int count = 0, whole = 0;
       while (run < evidence.size() && evidence[run].x == evidence[end].x &&
-             evidence[run].y == evidence[end].y && evidence[run].h == evidence[end].h)
+             evidence[run].y == evidence[end].y && evidence[run].h == evidence[end].h) {
+        whole += evidence[run].w == 2 ? 1 : 0;
         count += evidence[run++].w;
+      }
       total += count;
       // A shift that changes the parity of p + v is impossible: dissent.
       if (!OddSum(evidence[end].h) && count > best) {
         best = count;
         best_h = evidence[end].h;
+        best_whole = whole;
       }
       end = run;
     }
     const int dissent = total - best;
-    if (best >= 2 * params.min_support && dissent <= params.max_dissent * best)
+    if (best >= 2 * params.min_support && dissent <= params.max_dissent * best &&
+        best_whole >= params.min_whole_links)
       candidates.push_back({best, evidence[i].x, evidence[i].y, best_h});
     i = end;
   }

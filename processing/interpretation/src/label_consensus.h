@@ -59,6 +59,12 @@ struct ConsensusParams {
   // least this many half votes (a step across a gap is one, any other link
   // two), >= 1: the seeds confirm p, not v.
   int min_seeded_half_votes = 2;
+  // Of the links agreeing on a join of two components, at least this many
+  // are whole (not a step across a gap in a line), >= 0: where an occluding
+  // edge cuts the lines of the surface behind it, a line there and one of
+  // the surface in front meet end to end, and steps across that "gap" can
+  // agree on a join lines off.
+  int min_whole_links = 1;
 };
 // A lone junction (in no closed brick) at the pattern's edge joins the
 // labelled ones through two agreeing links, or through one smooth step

@@ -531,6 +531,7 @@ bool TrackLabellingParams::IsValid(std::string* error) const {
   if (min_island < 0) return fail("min_island must not be negative");
   if (reference_choice < 0) return fail("reference_choice must not be negative");
   if (min_seeded_half_votes < 1) return fail("min_seeded_half_votes must be at least 1");
+  if (min_whole_links < 0) return fail("min_whole_links must not be negative");
   return true;
 }
 
@@ -590,9 +591,10 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   // line 0 is labelled, every other junction left unlabelled.
   std::vector<char> odd_kind(n);
   for (int j = 0; j < n; ++j) odd_kind[j] = net.junctions[j].kind == JunctionKind::kCorresponding;
-  const Consensus consensus = LabelByConsensus(
-      odd_kind, links.links(), seeds, params.min_reference_junctions,
-      {params.min_support, params.max_dissent, params.min_island, params.min_seeded_half_votes});
+  const Consensus consensus =
+      LabelByConsensus(odd_kind, links.links(), seeds, params.min_reference_junctions,
+                       {params.min_support, params.max_dissent, params.min_island,
+                        params.min_seeded_half_votes, params.min_whole_links});
   cancel.ThrowIfRequested("the consensus of labels");
   if (consensus.p.empty() || std::none_of(consensus.p.begin(), consensus.p.end(),
                                           [](int p) { return p != kUnlabelled; })) {

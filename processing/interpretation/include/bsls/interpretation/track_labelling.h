@@ -78,6 +78,13 @@ struct TrackLabellingParams {
   // an occluding edge hides may be rows off. With one, the geometry checks
   // every junction's row, and one count is enough (the decoder sets 1).
   int min_seeded_half_votes = 2;
+  // Two groups of closed bricks join only where at least this many of the
+  // links agreeing on it are whole, not steps across a gap in a line (>= 0).
+  // Where an occluding edge cuts the lines of the surface behind it (the
+  // base plane below a cylinder), those lines end on the edge and lines of
+  // the surface in front go on from there: bridged as gaps, their steps
+  // agree on a join some lines off.
+  int min_whole_links = 1;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
