@@ -17,12 +17,14 @@
 #include <thread>
 
 #include "bsls/testing/http2_flood.h"
+#include "bsls/testing/raw_connections.h"
 
 namespace bsls::rpc {
 namespace {
 
 using std::chrono::milliseconds;
 namespace h2 = testing::http2;
+using testing::ReadFor;
 
 // A guarded connection: the client's socket and gRPC's end.
 struct Guarded {
@@ -46,38 +48,6 @@ void Connect(Http2Guard& guard, Guarded* out) {
   ASSERT_GE(out->server, 0);
 }
 
-// Writes all of `bytes` to `fd`.
-void Send(int fd, const std::string& bytes) {
-  std::size_t at = 0;
-  while (at < bytes.size()) {
-    const ssize_t n = ::send(fd, bytes.data() + at, bytes.size() - at, MSG_NOSIGNAL);
-    ASSERT_GT(n, 0) << std::strerror(errno);
-    at += static_cast<std::size_t>(n);
-  }
-}
-
-// What arrives on `fd` within `ms` (until its end, if sooner); *ended tells
-// whether the end came.
-std::string ReadFor(int fd, int ms, bool* ended = nullptr) {
-  std::string bytes;
-  const auto until = std::chrono::steady_clock::now() + milliseconds(ms);
-  if (ended != nullptr) *ended = false;
-  for (;;) {
-    const auto left =
-        std::chrono::duration_cast<milliseconds>(until - std::chrono::steady_clock::now()).count();
-    if (left <= 0) return bytes;
-    pollfd wait{fd, POLLIN, 0};
-    if (::poll(&wait, 1, static_cast<int>(left)) <= 0) continue;
-    char buffer[65536];
-    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
-    if (n <= 0) {
-      if (ended != nullptr) *ended = true;
-      return bytes;
-    }
-    bytes.append(buffer, static_cast<std::size_t>(n));
-  }
-}
-
 TEST(Http2Guard, BytesPassBothWaysUnchanged) {
   std::string error;
   auto guard = Http2Guard::Create({}, &error);
@@ -86,10 +56,10 @@ TEST(Http2Guard, BytesPassBothWaysUnchanged) {
   Guarded link;
   Connect(*guard, &link);
   const std::string up = h2::Preface() + h2::CallHeaders(1, "/a.B/C") + h2::Ping(7);
-  Send(link.client, up);
+  ASSERT_TRUE(testing::SendAll(link.client, up));
   EXPECT_EQ(ReadFor(link.server, 300), up);
   const std::string down = h2::Frame(h2::kSettings, 0, 0, "") + std::string(100000, 'x');
-  Send(link.server, down);
+  ASSERT_TRUE(testing::SendAll(link.server, down));
   EXPECT_EQ(ReadFor(link.client, 500), down);
   EXPECT_EQ(guard->relayed(), 1u);
   EXPECT_EQ(guard->throttled(), 0u);
@@ -111,7 +81,7 @@ TEST(Http2Guard, CostlyFramesPassAtTheBudgetsRateAndDataAsItComes) {
   const std::string ping = h2::Ping(1);
   std::string pings;
   for (int i = 0; i < 1000; ++i) pings += ping;
-  Send(link.client, h2::Preface() + pings);
+  ASSERT_TRUE(testing::SendAll(link.client, h2::Preface() + pings));
   const std::size_t passed =
       (ReadFor(link.server, 500).size() - h2::Preface().size()) / ping.size();
   EXPECT_GE(passed, 50u);
@@ -122,7 +92,7 @@ TEST(Http2Guard, CostlyFramesPassAtTheBudgetsRateAndDataAsItComes) {
   Connect(*guard, &data_link);
   std::string data = h2::Preface();
   for (int i = 0; i < 1000; ++i) data += h2::Frame(0x0 /*DATA*/, 0, 1, "0123456789");
-  Send(data_link.client, data);
+  ASSERT_TRUE(testing::SendAll(data_link.client, data));
   EXPECT_EQ(ReadFor(data_link.server, 500), data) << "DATA frames were held back";
 }
 
@@ -140,8 +110,8 @@ TEST(Http2Guard, TheTotalBudgetHoldsAcrossConnections) {
   Connect(*guard, &b);
   std::string pings = h2::Preface();
   for (int i = 0; i < 100; ++i) pings += h2::Ping(2);
-  Send(a.client, pings);
-  Send(b.client, pings);
+  ASSERT_TRUE(testing::SendAll(a.client, pings));
+  ASSERT_TRUE(testing::SendAll(b.client, pings));
   std::thread read_a([&] { pings = ReadFor(a.server, 500); });
   const std::string from_b = ReadFor(b.server, 500);
   read_a.join();
@@ -187,7 +157,7 @@ TEST(Http2Guard, AClientWithoutAPrefaceIsClosedAtTheHandshakeTimeout) {
   Guarded silent, speaking;
   Connect(*guard, &silent);
   Connect(*guard, &speaking);
-  Send(speaking.client, h2::Preface());
+  ASSERT_TRUE(testing::SendAll(speaking.client, h2::Preface()));
   const auto start = std::chrono::steady_clock::now();
   bool ended = false;
   ReadFor(silent.client, 3000, &ended);

@@ -26,6 +26,7 @@
 #include "bsls/rpc/tls_session.h"
 #include "bsls/testing/certificates.h"
 #include "bsls/testing/http2_flood.h"
+#include "bsls/testing/raw_connections.h"
 #include "bsls/testing/tls_tunnel.h"
 
 namespace bsls::rpc {
@@ -34,6 +35,7 @@ namespace {
 using std::chrono::milliseconds;
 namespace fs = std::filesystem;
 namespace h2 = testing::http2;
+using testing::ReadFor;
 
 // A loopback listening socket whose connections the test hands to a guard.
 class Listener {
@@ -109,6 +111,20 @@ class GuardEndingTls : public ::testing::Test {
     return guard;
   }
 
+  // A client of `tunnels` connected through `listener` and given to
+  // `guard`, whose hand-over `handed` takes: the client's plaintext end, or
+  // -1 when its handshake failed.
+  static int Open(Http2Guard& guard, HandedOver& handed, const Listener& listener,
+                  testing::TlsTunnels& tunnels) {
+    std::thread accept([&] {
+      std::string error;
+      EXPECT_TRUE(guard.Guard(listener.Accept(), handed.Taker(), &error)) << error;
+    });
+    const int client = tunnels.Open(listener.port());
+    accept.join();
+    return client;
+  }
+
   // Waits up to a second for `done`.
   template <typename Done>
   static bool WaitFor(Done done) {
@@ -122,33 +138,6 @@ class GuardEndingTls : public ::testing::Test {
   fs::path ca_;
 };
 
-// Writes all of `bytes` to `fd`.
-void Send(int fd, const std::string& bytes) {
-  std::size_t at = 0;
-  while (at < bytes.size()) {
-    const ssize_t n = ::send(fd, bytes.data() + at, bytes.size() - at, MSG_NOSIGNAL);
-    ASSERT_GT(n, 0) << std::strerror(errno);
-    at += static_cast<std::size_t>(n);
-  }
-}
-
-// What arrives on `fd` within `ms`.
-std::string ReadFor(int fd, int ms) {
-  std::string bytes;
-  const auto until = std::chrono::steady_clock::now() + milliseconds(ms);
-  for (;;) {
-    const auto left =
-        std::chrono::duration_cast<milliseconds>(until - std::chrono::steady_clock::now()).count();
-    if (left <= 0) return bytes;
-    pollfd wait{fd, POLLIN, 0};
-    if (::poll(&wait, 1, static_cast<int>(left)) <= 0) continue;
-    char buffer[65536];
-    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
-    if (n <= 0) return bytes;
-    bytes.append(buffer, static_cast<std::size_t>(n));
-  }
-}
-
 TEST_F(GuardEndingTls, AVerifiedClientIsHandedOverWithItsNameAndItsBytesPassBothWays) {
   auto guard = MakeGuard({});
   ASSERT_NE(guard, nullptr);
@@ -156,21 +145,16 @@ TEST_F(GuardEndingTls, AVerifiedClientIsHandedOverWithItsNameAndItsBytesPassBoth
   Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
   ASSERT_TRUE(tunnels.ok());
-  std::thread accept([&] {
-    std::string error;
-    EXPECT_TRUE(guard->Guard(listener.Accept(), handed.Taker(), &error)) << error;
-  });
-  const int client = tunnels.Open(listener.port());
-  accept.join();
+  const int client = Open(*guard, handed, listener, tunnels);
   ASSERT_GE(client, 0) << "the handshake failed";
   ASSERT_TRUE(WaitFor([&] { return handed.size() == 1; }));
   const auto [server, name] = handed.connections[0];
   EXPECT_EQ(name, "station");
   const std::string up = h2::Preface() + h2::CallHeaders(1, "/a.B/C") + h2::Ping(7);
-  Send(client, up);
+  ASSERT_TRUE(testing::SendAll(client, up));
   EXPECT_EQ(ReadFor(server, 500), up);
   const std::string down = h2::Frame(h2::kSettings, 0, 0, "") + std::string(200000, 'x');
-  Send(server, down);
+  ASSERT_TRUE(testing::SendAll(server, down));
   EXPECT_EQ(ReadFor(client, 1000), down);
   EXPECT_EQ(guard->refused(), 0u);
   ::close(client);
@@ -184,12 +168,7 @@ TEST_F(GuardEndingTls, ClientsWithoutACertificateOfTheCaNeverReachGrpc) {
   testing::TlsTunnels anonymous(testing::PemFiles{}, ca_);
   testing::TlsTunnels stranger(stranger_, ca_);
   for (testing::TlsTunnels* tunnels : {&anonymous, &stranger}) {
-    std::thread accept([&] {
-      std::string error;
-      EXPECT_TRUE(guard->Guard(listener.Accept(), handed.Taker(), &error)) << error;
-    });
-    const int client = tunnels->Open(listener.port());
-    accept.join();
+    const int client = Open(*guard, handed, listener, *tunnels);
     EXPECT_LT(client, 0) << "a client the CA did not sign got a connection";
     if (client >= 0) ::close(client);
   }
@@ -235,12 +214,7 @@ TEST_F(GuardEndingTls, NothingIsHandedOverOnceHandingOverStopped) {
   Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
   guard->StopHandingOver();
-  std::thread accept([&] {
-    std::string error;
-    EXPECT_TRUE(guard->Guard(listener.Accept(), handed.Taker(), &error)) << error;
-  });
-  const int client = tunnels.Open(listener.port());
-  accept.join();
+  const int client = Open(*guard, handed, listener, tunnels);
   if (client >= 0) {
     pollfd wait{client, POLLIN, 0};
     EXPECT_EQ(::poll(&wait, 1, 2000), 1) << "the client was not closed";
@@ -258,12 +232,7 @@ TEST_F(GuardEndingTls, AVerifiedClientWithoutAPrefaceIsClosedAtTheTimeout) {
   HandedOver handed;
   Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
-  std::thread accept([&] {
-    std::string error;
-    EXPECT_TRUE(guard->Guard(listener.Accept(), handed.Taker(), &error)) << error;
-  });
-  const int client = tunnels.Open(listener.port());
-  accept.join();
+  const int client = Open(*guard, handed, listener, tunnels);
   ASSERT_GE(client, 0);
   EXPECT_TRUE(WaitFor([&] { return handed.size() == 1; }));
   pollfd wait{client, POLLIN, 0};
@@ -285,18 +254,13 @@ TEST_F(GuardEndingTls, CostlyFramesInsideTlsPassAtTheBudgetsRate) {
   HandedOver handed;
   Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
-  std::thread accept([&] {
-    std::string error;
-    EXPECT_TRUE(guard->Guard(listener.Accept(), handed.Taker(), &error)) << error;
-  });
-  const int client = tunnels.Open(listener.port());
-  accept.join();
+  const int client = Open(*guard, handed, listener, tunnels);
   ASSERT_GE(client, 0);
   ASSERT_TRUE(WaitFor([&] { return handed.size() == 1; }));
   const std::string ping = h2::Ping(1);
   std::string pings = h2::Preface();
   for (int i = 0; i < 1000; ++i) pings += ping;
-  Send(client, pings);
+  ASSERT_TRUE(testing::SendAll(client, pings));
   const std::size_t passed =
       (ReadFor(handed.connections[0].first, 500).size() - h2::Preface().size()) / ping.size();
   EXPECT_GE(passed, 50u);

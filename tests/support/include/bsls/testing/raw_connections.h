@@ -1,7 +1,8 @@
 // Raw connections for the connection-limit tests: to a service's Unix
 // socket made as another effective uid (SO_PEERCRED gives the server the
 // euid of the connecting process), to its TCP port from one of the loopback
-// addresses, and whether the server closes one at once (header only).
+// addresses, whether the server closes one at once, and bytes written to
+// and read from one (header only).
 #ifndef BSLS_TESTING_RAW_CONNECTIONS_H_
 #define BSLS_TESTING_RAW_CONNECTIONS_H_
 
@@ -81,6 +82,40 @@ inline bool ClosedWithin(int fd, int ms) {
     char buffer[256];
     const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
     if (n == 0 || (n < 0 && errno == ECONNRESET)) return true;
+  }
+}
+
+// Writes all of `bytes` to `fd`; false when the connection fails first.
+inline bool SendAll(int fd, const std::string& bytes) {
+  std::size_t at = 0;
+  while (at < bytes.size()) {
+    const ssize_t n = ::send(fd, bytes.data() + at, bytes.size() - at, MSG_NOSIGNAL);
+    if (n <= 0) return false;
+    at += static_cast<std::size_t>(n);
+  }
+  return true;
+}
+
+// What arrives on `fd` within `ms` (until its end, if sooner); *ended tells
+// whether the end came.
+inline std::string ReadFor(int fd, int ms, bool* ended = nullptr) {
+  std::string bytes;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+  if (ended != nullptr) *ended = false;
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+                          until - std::chrono::steady_clock::now())
+                          .count();
+    if (left <= 0) return bytes;
+    pollfd wait{fd, POLLIN, 0};
+    if (::poll(&wait, 1, static_cast<int>(left)) <= 0) continue;
+    char buffer[65536];
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_DONTWAIT);
+    if (n <= 0) {
+      if (ended != nullptr) *ended = true;
+      return bytes;
+    }
+    bytes.append(buffer, static_cast<std::size_t>(n));
   }
 }
 
