@@ -111,16 +111,15 @@ class GuardEndingTls : public ::testing::Test {
     return guard;
   }
 
-  // A client of `tunnels` connected through `listener` and given to
-  // `guard`, whose hand-over `handed` takes: the client's plaintext end, or
-  // -1 when its handshake failed.
-  static int Open(Http2Guard& guard, HandedOver& handed, const Listener& listener,
-                  testing::TlsTunnels& tunnels) {
+  // A client of `tunnels` connected through listener_ and given to `guard`,
+  // whose hand-over handed_ takes: the client's plaintext end, or -1 when
+  // its handshake failed.
+  int Open(Http2Guard& guard, testing::TlsTunnels& tunnels) {
     std::thread accept([&] {
       std::string error;
-      EXPECT_TRUE(guard.Guard(listener.Accept(), handed.Taker(), &error)) << error;
+      EXPECT_TRUE(guard.Guard(listener_.Accept(), handed_.Taker(), &error)) << error;
     });
-    const int client = tunnels.Open(listener.port());
+    const int client = tunnels.Open(listener_.port());
     accept.join();
     return client;
   }
@@ -136,19 +135,19 @@ class GuardEndingTls : public ::testing::Test {
 
   testing::PemFiles server_, station_, stranger_;
   fs::path ca_;
+  HandedOver handed_;  // what the guards of the test handed over
+  Listener listener_;  // where the test's clients connect
 };
 
 TEST_F(GuardEndingTls, AVerifiedClientIsHandedOverWithItsNameAndItsBytesPassBothWays) {
   auto guard = MakeGuard({});
   ASSERT_NE(guard, nullptr);
-  HandedOver handed;
-  Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
   ASSERT_TRUE(tunnels.ok());
-  const int client = Open(*guard, handed, listener, tunnels);
+  const int client = Open(*guard, tunnels);
   ASSERT_GE(client, 0) << "the handshake failed";
-  ASSERT_TRUE(WaitFor([&] { return handed.size() == 1; }));
-  const auto [server, name] = handed.connections[0];
+  ASSERT_TRUE(WaitFor([&] { return handed_.size() == 1; }));
+  const auto [server, name] = handed_.connections[0];
   EXPECT_EQ(name, "station");
   const std::string up = h2::Preface() + h2::CallHeaders(1, "/a.B/C") + h2::Ping(7);
   ASSERT_TRUE(testing::SendAll(client, up));
@@ -163,34 +162,30 @@ TEST_F(GuardEndingTls, AVerifiedClientIsHandedOverWithItsNameAndItsBytesPassBoth
 TEST_F(GuardEndingTls, ClientsWithoutACertificateOfTheCaNeverReachGrpc) {
   auto guard = MakeGuard({});
   ASSERT_NE(guard, nullptr);
-  HandedOver handed;
-  Listener listener;
   testing::TlsTunnels anonymous(testing::PemFiles{}, ca_);
   testing::TlsTunnels stranger(stranger_, ca_);
   for (testing::TlsTunnels* tunnels : {&anonymous, &stranger}) {
-    const int client = Open(*guard, handed, listener, *tunnels);
+    const int client = Open(*guard, *tunnels);
     EXPECT_LT(client, 0) << "a client the CA did not sign got a connection";
     if (client >= 0) ::close(client);
   }
   EXPECT_TRUE(WaitFor([&] { return guard->refused() == 2; })) << guard->refused();
-  EXPECT_EQ(handed.size(), 0u);
+  EXPECT_EQ(handed_.size(), 0u);
   EXPECT_TRUE(WaitFor([&] { return guard->relayed() == 0; }));
 }
 
 TEST_F(GuardEndingTls, AClientThatNeverShakesHandsIsClosedAtTheTimeout) {
   auto guard = MakeGuard({}, /*handshake_ms=*/300);
   ASSERT_NE(guard, nullptr);
-  HandedOver handed;
-  Listener listener;
   const int silent = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   sockaddr_in address{};
   address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<std::uint16_t>(listener.port()));
+  address.sin_port = htons(static_cast<std::uint16_t>(listener_.port()));
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   ASSERT_EQ(::connect(silent, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
   std::string error;
   const auto start = std::chrono::steady_clock::now();
-  ASSERT_TRUE(guard->Guard(listener.Accept(), handed.Taker(), &error)) << error;
+  ASSERT_TRUE(guard->Guard(listener_.Accept(), handed_.Taker(), &error)) << error;
   pollfd wait{silent, POLLIN, 0};
   ASSERT_EQ(::poll(&wait, 1, 3000), 1) << "still open 3 s after a 300 ms handshake timeout";
   char byte;
@@ -200,7 +195,7 @@ TEST_F(GuardEndingTls, AClientThatNeverShakesHandsIsClosedAtTheTimeout) {
   EXPECT_GE(waited, 250);
   EXPECT_LE(waited, 1500);
   EXPECT_EQ(guard->refused(), 1u);
-  EXPECT_EQ(handed.size(), 0u);
+  EXPECT_EQ(handed_.size(), 0u);
   ::close(silent);
 }
 
@@ -210,18 +205,16 @@ TEST_F(GuardEndingTls, AClientThatNeverShakesHandsIsClosedAtTheTimeout) {
 TEST_F(GuardEndingTls, NothingIsHandedOverOnceHandingOverStopped) {
   auto guard = MakeGuard({});
   ASSERT_NE(guard, nullptr);
-  HandedOver handed;
-  Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
   guard->StopHandingOver();
-  const int client = Open(*guard, handed, listener, tunnels);
+  const int client = Open(*guard, tunnels);
   if (client >= 0) {
     pollfd wait{client, POLLIN, 0};
     EXPECT_EQ(::poll(&wait, 1, 2000), 1) << "the client was not closed";
     ::close(client);
   }
   EXPECT_TRUE(WaitFor([&] { return guard->relayed() == 0; }));
-  EXPECT_EQ(handed.size(), 0u);
+  EXPECT_EQ(handed_.size(), 0u);
 }
 
 // A verified client that never sends the HTTP/2 preface is closed at the
@@ -229,12 +222,10 @@ TEST_F(GuardEndingTls, NothingIsHandedOverOnceHandingOverStopped) {
 TEST_F(GuardEndingTls, AVerifiedClientWithoutAPrefaceIsClosedAtTheTimeout) {
   auto guard = MakeGuard({}, /*handshake_ms=*/500);
   ASSERT_NE(guard, nullptr);
-  HandedOver handed;
-  Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
-  const int client = Open(*guard, handed, listener, tunnels);
+  const int client = Open(*guard, tunnels);
   ASSERT_GE(client, 0);
-  EXPECT_TRUE(WaitFor([&] { return handed.size() == 1; }));
+  EXPECT_TRUE(WaitFor([&] { return handed_.size() == 1; }));
   pollfd wait{client, POLLIN, 0};
   ASSERT_EQ(::poll(&wait, 1, 3000), 1) << "still open 3 s after a 500 ms timeout";
   char byte;
@@ -251,18 +242,16 @@ TEST_F(GuardEndingTls, CostlyFramesInsideTlsPassAtTheBudgetsRate) {
   limits.burst = 50;
   auto guard = MakeGuard(limits);
   ASSERT_NE(guard, nullptr);
-  HandedOver handed;
-  Listener listener;
   testing::TlsTunnels tunnels(station_, ca_);
-  const int client = Open(*guard, handed, listener, tunnels);
+  const int client = Open(*guard, tunnels);
   ASSERT_GE(client, 0);
-  ASSERT_TRUE(WaitFor([&] { return handed.size() == 1; }));
+  ASSERT_TRUE(WaitFor([&] { return handed_.size() == 1; }));
   const std::string ping = h2::Ping(1);
   std::string pings = h2::Preface();
   for (int i = 0; i < 1000; ++i) pings += ping;
   ASSERT_TRUE(testing::SendAll(client, pings));
   const std::size_t passed =
-      (ReadFor(handed.connections[0].first, 500).size() - h2::Preface().size()) / ping.size();
+      (ReadFor(handed_.connections[0].first, 500).size() - h2::Preface().size()) / ping.size();
   EXPECT_GE(passed, 50u);
   EXPECT_LE(passed, 50u + 50u / 2 + 10u) << "the budget did not hold back the flood inside TLS";
   EXPECT_GE(guard->throttled(), 1u);
