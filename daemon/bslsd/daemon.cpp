@@ -137,9 +137,8 @@ Status ConfigureServer(const Config& config, grpc::Service* service, rpc::TcpLis
     options.acceptor.address = config.listen.tcp;
     options.acceptor.connections = config.listen.connections;
     options.guard = config.listen.guard;
-    options.tls = rpc::TlsFiles{config.listen.tls_client_ca, config.listen.tls_certificate,
-                                config.listen.tls_key,       "listen.tls_client_ca",
-                                "listen.tls_certificate",    "listen.tls_key"};
+    options.tls = rpc::ListenTlsFiles(config.listen.tls_client_ca, config.listen.tls_certificate,
+                                      config.listen.tls_key);
     options.handshake_timeout_ms = config.listen.http2.handshake_timeout_ms;
     try {
       *tcp = rpc::ListenTcp(options);

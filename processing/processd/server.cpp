@@ -60,9 +60,8 @@ std::unique_ptr<Server> Server::Start(const Config& config, const std::string& s
     tcp.acceptor.loopback_only = config.listen.plaintext_loopback;
     tcp.guard = config.listen.guard;  // new streams, resets, pings at a bounded rate
     if (!config.listen.plaintext_loopback)
-      tcp.tls = rpc::TlsFiles{config.listen.tls_client_ca, config.listen.tls_certificate,
-                              config.listen.tls_key,       "listen.tls_client_ca",
-                              "listen.tls_certificate",    "listen.tls_key"};
+      tcp.tls = rpc::ListenTlsFiles(config.listen.tls_client_ca, config.listen.tls_certificate,
+                                    config.listen.tls_key);
     tcp.handshake_timeout_ms = config.listen.http2.handshake_timeout_ms;
     s->tcp_ = rpc::ListenTcp(tcp);
     s->tcp_port_ = s->tcp_.acceptor->port();

@@ -253,14 +253,25 @@ void Http2Guard::Relay() {
 
 bool Http2Guard::Handshake(Link& link) {
   link.want_read = link.want_write = false;
-  switch (link.tls->Handshake()) {
-    case TlsSession::Step::kDone: {
-      std::lock_guard lock(hand_over_mutex_);
-      if (!handing_over_) return false;  // the server is going: closed, not counted
-      const int fd = std::exchange(link.grpc_end, -1);
-      link.hand_over(fd, link.tls->common_name());
+  const TlsSession::Step step = link.tls->Handshake();
+  if (step == TlsSession::Step::kDone) {
+    std::lock_guard lock(hand_over_mutex_);
+    if (!handing_over_) return false;  // the server is going: closed (and counted refused)
+    const int fd = std::exchange(link.grpc_end, -1);
+    link.hand_over(fd, link.tls->common_name());
+    return true;
+  }
+  if (Goes(link, step)) return true;  // the handshake waits for the client
+  LogRefusal(step == TlsSession::Step::kClosed
+                 ? "the client closed the connection during the TLS handshake"
+                 : link.tls->error());
+  return false;
+}
+
+bool Http2Guard::Goes(Link& link, TlsSession::Step step) {
+  switch (step) {
+    case TlsSession::Step::kDone:
       return true;
-    }
     case TlsSession::Step::kWantRead:
       link.want_read = true;
       return true;
@@ -268,12 +279,9 @@ bool Http2Guard::Handshake(Link& link) {
       link.want_write = true;
       return true;
     case TlsSession::Step::kClosed:
-      LogRefusal("the client closed the connection during the TLS handshake");
-      return false;
     case TlsSession::Step::kFailed:
       break;
   }
-  LogRefusal(link.tls->error());
   return false;
 }
 
@@ -281,38 +289,17 @@ bool Http2Guard::ReadClient(Link& link) {
   if (link.up.size() >= kBufferBytes) return true;
   if (!link.tls) return ReadSome(link.client, &link.up);
   link.want_read = false;
-  switch (link.tls->Read(&link.up, kBufferBytes - link.up.size())) {
-    case TlsSession::Step::kDone:
-    case TlsSession::Step::kWantRead:
-      return true;
-    case TlsSession::Step::kWantWrite:
-      link.want_write = true;
-      return true;
-    case TlsSession::Step::kClosed:
-    case TlsSession::Step::kFailed:
-      break;
-  }
-  return false;
+  const TlsSession::Step step = link.tls->Read(&link.up, kBufferBytes - link.up.size());
+  // Waiting to read is what the link polls for whenever `up` has room:
+  // nothing to record (a mark would outlive the room and spin the poll).
+  return Goes(link, step == TlsSession::Step::kWantRead ? TlsSession::Step::kDone : step);
 }
 
 bool Http2Guard::WriteClient(Link& link) {
   if (link.down.empty()) return true;
   if (!link.tls) return WriteSome(link.client, &link.down, link.down.size());
   link.want_write = false;
-  switch (link.tls->Write(&link.down, link.down.size())) {
-    case TlsSession::Step::kDone:
-      return true;
-    case TlsSession::Step::kWantWrite:
-      link.want_write = true;
-      return true;
-    case TlsSession::Step::kWantRead:
-      link.want_read = true;
-      return true;
-    case TlsSession::Step::kClosed:
-    case TlsSession::Step::kFailed:
-      break;
-  }
-  return false;
+  return Goes(link, link.tls->Write(&link.down, link.down.size()));
 }
 
 void Http2Guard::LogRefusal(const std::string& why) {

@@ -4,9 +4,15 @@
 
 #include <fstream>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 namespace bsls::rpc {
+
+TlsFiles ListenTlsFiles(std::string client_ca, std::string certificate, std::string key) {
+  return {std::move(client_ca),   std::move(certificate),   std::move(key),
+          "listen.tls_client_ca", "listen.tls_certificate", "listen.tls_key"};
+}
 
 std::string ReadPemFile(const std::string& path, const std::string& setting) {
   std::ifstream in(path, std::ios::binary);

@@ -41,9 +41,9 @@
 #include <thread>
 #include <vector>
 
-namespace bsls::rpc {
+#include "bsls/rpc/tls_session.h"
 
-class TlsServerContext;
+namespace bsls::rpc {
 
 // Frames that make the server work (HEADERS, PRIORITY, RST_STREAM,
 // SETTINGS, PING) let through per second, and in one burst after a quiet
@@ -107,6 +107,9 @@ class Http2Guard {
   // Moves `link`'s TLS handshake on and hands its gRPC end over once the
   // client is verified; false when the handshake failed.
   bool Handshake(Link& link);
+  // Records on `link` what a TLS step waits for (the client readable or
+  // writable); false when the step ended the connection.
+  static bool Goes(Link& link, TlsSession::Step step);
   // Reads what the client sent into link.up; false at its end or on an error.
   bool ReadClient(Link& link);
   // Writes link.down to the client; false when the client is gone.

@@ -36,6 +36,10 @@ struct TlsFiles {
   bool complete() const { return !ca.empty() && !certificate.empty() && !key.empty(); }
 };
 
+// A service's own TLS files, named by its `listen.tls_client_ca`,
+// `listen.tls_certificate` and `listen.tls_key` keys for errors.
+TlsFiles ListenTlsFiles(std::string client_ca, std::string certificate, std::string key);
+
 // The text of a PEM file; TlsFileError naming `setting` and `path` when it
 // cannot be read or holds no PEM block.
 std::string ReadPemFile(const std::string& path, const std::string& setting);
