@@ -38,7 +38,6 @@ const cv::Mat& FaceFrame(int size) {
   auto it = frames.find(size);
   if (it != frames.end()) return it->second;
   bsls::simulator::ThesisSceneOptions options;
-  options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
   options.rig.width = size;
   options.rig.height = size;
   bsls::simulator::RenderParams params;

@@ -29,7 +29,6 @@ const bsls::simulator::Frame& Frame(SurfaceKind kind) {
   auto it = frames.find(kind);
   if (it != frames.end()) return it->second;
   bsls::simulator::ThesisSceneOptions options;
-  options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
   bsls::simulator::RenderParams params;
   params.noise_sigma = 3.0;
   return frames[kind] = bsls::simulator::Render(

@@ -133,7 +133,6 @@ std::string Reason(const bsls::simulator::TruthJunction& t, const cv::Point2d& a
 
 void Report(SurfaceKind kind, Side side, std::uint32_t seed, const Options& o, Totals* totals) {
   bsls::simulator::ThesisSceneOptions options;
-  options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
   options.rig.width = o.size;
   options.rig.height = o.size;
   bsls::simulator::RenderParams params;

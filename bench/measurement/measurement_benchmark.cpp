@@ -63,7 +63,6 @@ struct Side3d {
 const Side3d& Face(bool with_lump) {
   static const auto make = [](bool lump) {
     bsls::simulator::ThesisSceneOptions options;
-    options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
     if (lump) options.face_lesions.push_back(kLump);
     const bsls::simulator::Scene scene =
         bsls::simulator::ThesisScene(Side::kLeft, bsls::simulator::SurfaceKind::kFace, options);

@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "bsls/testing/build_paths.h"
 #include "processd_process.h"
 #include "service_fixture.h"
 
@@ -75,9 +76,9 @@ void BM_ReconstructSessionReplicas(benchmark::State& state) {
   const fs::path folder = MakeTempFolder("bsls_replicas_bench_");
   std::vector<std::unique_ptr<ProcessdProcess>> replicas;
   for (int i = 0; i < n; ++i) {
-    replicas.push_back(
-        std::make_unique<ProcessdProcess>(BSLS_PROCESSD_PATH, folder, "r" + std::to_string(i), 1,
-                                          std::vector<std::string>{"--set", "log_level=warn"}));
+    replicas.push_back(std::make_unique<ProcessdProcess>(
+        bsls::testing::ProcessdPath(), folder, "r" + std::to_string(i), 1,
+        std::vector<std::string>{"--set", "log_level=warn"}));
     if (!replicas.back()->ready()) {
       state.SkipWithError(("replica did not start: " + replicas.back()->Log()).c_str());
       return;

@@ -50,7 +50,6 @@ using Clock = std::chrono::steady_clock;
 const bsls::simulator::Scene& FaceScene(bsls::pattern::Side side = bsls::pattern::Side::kLeft) {
   static const auto make = [](bsls::pattern::Side s) {
     bsls::simulator::ThesisSceneOptions options;
-    options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
     return bsls::simulator::ThesisScene(s, bsls::simulator::SurfaceKind::kFace, options);
   };
   static const bsls::simulator::Scene left = make(bsls::pattern::Side::kLeft);

@@ -12,8 +12,6 @@ namespace {
 
 Scene BenchScene(SurfaceKind kind, int size) {
   ThesisSceneOptions options;
-  options.face.obj_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "canonical_face_model.obj";
-  options.bunny.json_path = std::filesystem::path(BSLS_BENCH_DATA_DIR) / "stanford_bunny.json";
   options.rig.width = size;
   options.rig.height = size;
   return ThesisScene(pattern::Side::kLeft, kind, options);

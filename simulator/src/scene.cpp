@@ -1,10 +1,8 @@
 #include "bsls/simulator/scene.h"
 
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <stdexcept>
-#include <system_error>
 
 namespace bsls::simulator {
 namespace {
@@ -115,15 +113,6 @@ std::optional<SurfaceKind> ParseSurfaceKind(std::string_view text) {
                                  SurfaceKind::kFace, SurfaceKind::kBunny})
     if (text == ToString(kind)) return kind;
   return std::nullopt;
-}
-
-std::filesystem::path DefaultDataDir() {
-  if (const char* env = std::getenv("BSLS_DATA_DIR"); env != nullptr && *env != '\0')
-    return std::filesystem::path(env);
-  const std::filesystem::path installed(BSLS_DATA_DIR);
-  std::error_code ec;
-  if (std::filesystem::exists(installed / kFaceFileName, ec)) return installed;
-  return std::filesystem::path(BSLS_SOURCE_DATA_DIR);
 }
 
 bool RigParams::IsValid(std::string* error) const {

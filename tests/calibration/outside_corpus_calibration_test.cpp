@@ -18,6 +18,7 @@
 #include "bsls/calibration/manifest.h"
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/geometry/pinhole_model.h"
+#include "bsls/testing/build_paths.h"
 
 namespace bsls::calibration {
 namespace {
@@ -34,7 +35,7 @@ constexpr double kCameraCentreMm = 3.0;  // camera centre
 // acceptance's bound over the face volume.
 constexpr double kTargetVolumeMaxPx = 0.2;
 
-fs::path CorpusFolder() { return fs::path(BSLS_SHARED_DIR) / "data" / "outside-corpus"; }
+fs::path CorpusFolder() { return bsls::testing::SharedDir() / "data" / "outside-corpus"; }
 
 // The true camera of a session's truth.json (world frame of contracts
 // section 3, pixels with the origin at the top-left pixel's centre).

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "bsls/common/sha256.h"
+#include "bsls/testing/build_paths.h"
 #include "bsls/testing/certificates.h"
 #include "bsls/testing/raw_connections.h"
 #include "daemon_process.h"
@@ -514,6 +515,7 @@ TEST_F(Bslsd, EveryRoleOnEveryCallHasNoUnauthorizedSuccess) {
       {"Grab", 2},          {"SetSlide", 2},      {"SetFocus", 2},     {"SetLamp", 2},
       {"DeleteCapture", 3}};
   int unauthorized_successes = 0;
+  const std::string probe = bsls::testing::RoleProbePath();
   for (const auto& [uid, role] :
        std::vector<std::pair<uid_t, int>>{{60001, 1}, {60002, 2}, {60003, 3}, {60004, 0}}) {
     int pipe_fds[2];
@@ -526,7 +528,7 @@ TEST_F(Bslsd, EveryRoleOnEveryCallHasNoUnauthorizedSuccess) {
       const gid_t socket_group = kTestSocketGroup;
       if (::setgroups(1, &socket_group) != 0 || ::setgid(uid) != 0 || ::setuid(uid) != 0)
         ::_exit(3);
-      ::execl(ROLE_PROBE_PATH, ROLE_PROBE_PATH, daemon_->socket().c_str(), nullptr);
+      ::execl(probe.c_str(), probe.c_str(), daemon_->socket().c_str(), nullptr);
       ::_exit(127);
     }
     ::close(pipe_fds[1]);
@@ -695,7 +697,7 @@ TEST_F(Bslsd, AConnectionWithoutCallsIsClosedAfterTheIdleLimit) {
 TEST(BslsdConfig, CheckConfigNamesTheBadKeyAndExitsWithConfigError) {
   const fs::path dir = MakeDaemonDir("check");
   const fs::path config = WriteDaemonConfig(dir);
-  const std::string command = std::string(BSLSD_PATH) + " --check-config --config " +
+  const std::string command = bsls::testing::BslsdPath() + " --check-config --config " +
                               config.string() + " --set framestore.backend=firewire 2>&1";
   FILE* pipe = ::popen(command.c_str(), "r");
   ASSERT_NE(pipe, nullptr);
@@ -708,7 +710,7 @@ TEST(BslsdConfig, CheckConfigNamesTheBadKeyAndExitsWithConfigError) {
   EXPECT_NE(output.find("firewire"), std::string::npos) << output;
 
   const std::string ok_command =
-      std::string(BSLSD_PATH) + " --check-config --config " + config.string() + " 2>&1";
+      bsls::testing::BslsdPath() + " --check-config --config " + config.string() + " 2>&1";
   pipe = ::popen(ok_command.c_str(), "r");
   output.clear();
   while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
@@ -734,13 +736,13 @@ TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
   const fs::path config = WriteDaemonConfig(dir);
   for (const char* mode : {"0666", "0602", "0777", "2"}) {
     const auto [code, output] =
-        RunCommand(std::string(BSLSD_PATH) + " --check-config --config " + config.string() +
+        RunCommand(bsls::testing::BslsdPath() + " --check-config --config " + config.string() +
                    " --set 'listen.socket_mode=\"" + mode + "\"'");
     EXPECT_EQ(code, 78) << mode << ": " << output;
     EXPECT_NE(output.find("listen.socket_mode"), std::string::npos) << output;
     EXPECT_NE(output.find("world-writable"), std::string::npos) << output;
   }
-  const auto [code, output] = RunCommand(std::string(BSLSD_PATH) + " --check-config --config " +
+  const auto [code, output] = RunCommand(bsls::testing::BslsdPath() + " --check-config --config " +
                                          config.string() + " --set 'listen.socket_mode=\"0660\"'");
   EXPECT_EQ(code, 0) << output;
 }
@@ -750,7 +752,8 @@ TEST(BslsdConfig, AWorldWritableSocketModeIsRefused) {
 TEST(BslsdConfig, GuardBudgetsAreBoundedKeys) {
   const fs::path dir = MakeDaemonDir("guard_keys");
   const fs::path config = WriteDaemonConfig(dir);
-  const std::string check = std::string(BSLSD_PATH) + " --check-config --config " + config.string();
+  const std::string check =
+      bsls::testing::BslsdPath() + " --check-config --config " + config.string();
   {
     const auto [code, output] = RunCommand(check + " --set listen.guard_frames_per_second=0");
     EXPECT_EQ(code, 78) << output;
@@ -782,7 +785,7 @@ TEST(BslsdConfig, ACalibrationOfTheOtherSideOrFormatIsRefusedAtStart) {
        {std::pair{right, std::string("is a calibration of the other side")},
         std::pair{other, std::string("format is 'other'")}}) {
     const auto [code, output] =
-        RunCommand("timeout 60 " + std::string(BSLSD_PATH) + " --config " + config.string() +
+        RunCommand("timeout 60 " + bsls::testing::BslsdPath() + " --config " + config.string() +
                    " --set processing.calibration_left=" + file.string());
     EXPECT_EQ(code, 78) << output;
     EXPECT_NE(output.find("processing.calibration_left"), std::string::npos) << output;
@@ -796,8 +799,8 @@ TEST(BslsdConfig, StartedAsRootWithAnUnknownUserItRefusesToStart) {
   if (::geteuid() != 0) GTEST_SKIP() << "needs root: the user matters only when started as root";
   const fs::path dir = MakeDaemonDir("nouser");
   const fs::path config = WriteDaemonConfig(dir);
-  const auto [code, output] = RunCommand(std::string(BSLSD_PATH) + " --config " + config.string() +
-                                         " --set user=no-such-bsls-user");
+  const auto [code, output] = RunCommand(bsls::testing::BslsdPath() + " --config " +
+                                         config.string() + " --set user=no-such-bsls-user");
   EXPECT_EQ(code, 78) << output;
   EXPECT_NE(output.find("'no-such-bsls-user' does not exist"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(dir / "bslsd.sock")) << "it opened its socket before refusing";

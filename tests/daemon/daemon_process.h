@@ -23,6 +23,7 @@
 #include <thread>
 #include <vector>
 
+#include "bsls/testing/build_paths.h"
 #include "bsls/testing/spawn.h"
 #include "bsls/v1/capture.grpc.pb.h"
 
@@ -76,7 +77,7 @@ class DaemonProcess : public ChildProcess {
   DaemonProcess(const fs::path& dir, const fs::path& config, std::vector<std::string> args = {},
                 std::chrono::seconds timeout = std::chrono::seconds(120))
       : dir_(dir), socket_(dir / "bslsd.sock") {
-    std::vector<std::string> argv = {BSLSD_PATH, "--config", config.string()};
+    std::vector<std::string> argv = {bsls::testing::BslsdPath(), "--config", config.string()};
     argv.insert(argv.end(), args.begin(), args.end());
     Spawn(std::move(argv), (dir / "bslsd.log").string());
     const auto until = std::chrono::steady_clock::now() + timeout;

@@ -11,6 +11,7 @@
 #include "bsls/calibration/calibration_file.h"
 #include "bsls/common/sha256.h"
 #include "bsls/io/surface_file.h"
+#include "bsls/testing/build_paths.h"
 #include "bsls/testing/calibration_sessions.h"
 #include "bsls/v1/processing.grpc.pb.h"
 #include "daemon_process.h"
@@ -28,7 +29,7 @@ using processing::test::ProcessdProcess;
 std::unique_ptr<ProcessdProcess> StartReplica(const fs::path& dir, const std::string& name,
                                               const std::string& tcp = "127.0.0.1:0") {
   return std::make_unique<ProcessdProcess>(
-      BSLS_PROCESSD_PATH, dir, name, 1,
+      bsls::testing::ProcessdPath(), dir, name, 1,
       std::vector<std::string>{"--set", "scratch_dir=" + dir.string()}, std::chrono::seconds(120),
       tcp);
 }

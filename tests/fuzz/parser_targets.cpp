@@ -23,6 +23,7 @@
 #include "bsls/io/frame_file.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/simulator/mesh.h"
+#include "bsls/testing/build_paths.h"
 #include "daemon/bslsd/config.h"
 #include "fuzz_input.h"
 #include "grammars.h"
@@ -495,6 +496,6 @@ const ParserTarget* FindParserTarget(std::string_view name) {
   return nullptr;
 }
 
-std::string SeedsDir() { return BSLS_FUZZ_SEEDS_DIR; }
+std::string SeedsDir() { return bsls::testing::FuzzSeedsDir().string(); }
 
 }  // namespace bsls::fuzz

@@ -11,6 +11,7 @@
 #include "bsls/geometry/surface_mesh.h"
 #include "bsls/simulator/mesh.h"
 #include "bsls/simulator/scene.h"
+#include "bsls/testing/build_paths.h"
 #include "bsls/testing/surface_sampling.h"
 
 namespace bsls::joining::test {
@@ -19,7 +20,7 @@ namespace bsls::joining::test {
 inline const simulator::Surface& Face() {
   static const std::shared_ptr<const simulator::Surface> face = [] {
     simulator::FaceModelParams params;
-    params.obj_path = std::filesystem::path(BSLS_TEST_DATA_DIR) / "canonical_face_model.obj";
+    params.obj_path = bsls::testing::TestDataDir() / "canonical_face_model.obj";
     return std::make_shared<simulator::MeshSurface>(simulator::LoadFaceMesh(params), "face");
   }();
   return *face;

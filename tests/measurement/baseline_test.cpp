@@ -11,12 +11,13 @@
 #include "bsls/measurement/lesion_measure.h"
 #include "bsls/simulator/lesion.h"
 #include "bsls/simulator/scene.h"
+#include "bsls/testing/build_paths.h"
 #include "bsls/testing/surface_sampling.h"
 
 namespace bsls::measurement {
 namespace {
 
-const std::filesystem::path kDataDir = BSLS_TEST_DATA_DIR;
+const std::filesystem::path kDataDir = bsls::testing::TestDataDir();
 constexpr double kNoiseMm = 0.05;
 
 std::shared_ptr<const simulator::Surface> Face() {

@@ -15,12 +15,13 @@
 #include "bsls/measurement/report.h"
 #include "bsls/simulator/lesion.h"
 #include "bsls/simulator/scene.h"
+#include "bsls/testing/build_paths.h"
 #include "bsls/testing/surface_sampling.h"
 
 namespace bsls::measurement {
 namespace {
 
-const std::filesystem::path kDataDir = BSLS_TEST_DATA_DIR;
+const std::filesystem::path kDataDir = bsls::testing::TestDataDir();
 // Acceptance of the issue: height/depth within 0.5 mm, area within 3 %.
 constexpr double kPeakTolerance = 0.5;           // mm
 constexpr double kAreaRelativeTolerance = 0.03;  // of the true area

@@ -47,6 +47,7 @@
 #include <thread>
 
 #include "bsls/rpc/frame_message.h"
+#include "bsls/testing/build_paths.h"
 #include "bsls/testing/hostile_frame.h"
 #include "bsls/testing/raw_connections.h"
 #include "bsls/v1/capture.grpc.pb.h"
@@ -303,8 +304,8 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
   pb::SetLogHandler(&QuietProtobuf);
   const fs::path folder = MakeTempFolder("bsls_attack_processd_");
   const fs::path socket = folder / "processd.sock";
-  ProcessdProcess processd(BSLS_PROCESSD_PATH, folder, "attack", 2, {}, seconds(120), "127.0.0.1:0",
-                           socket.string());
+  ProcessdProcess processd(bsls::testing::ProcessdPath(), folder, "attack", 2, {}, seconds(120),
+                           "127.0.0.1:0", socket.string());
   ASSERT_TRUE(processd.ready()) << processd.Log();
   const std::string target = processd.address();
   auto info_stub = v1::Processing::NewStub(OwnChannel(target));

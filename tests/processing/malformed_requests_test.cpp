@@ -43,6 +43,7 @@
 #include <thread>
 
 #include "bsls/processing/calibration_cache.h"
+#include "bsls/testing/build_paths.h"
 #include "bsls/v1/capture.grpc.pb.h"
 #include "bsls/v1/processing.grpc.pb.h"
 #include "daemon_process.h"
@@ -1048,7 +1049,7 @@ TEST(MalformedRequests, ProcessdSurvivesTenThousand) {
   const fs::path folder = MakeTempFolder("bsls_malformed_processd_");
   const fs::path scratch = folder / "scratch";
   fs::create_directories(scratch);
-  ProcessdProcess replica(BSLS_PROCESSD_PATH, folder, "robust", 2,
+  ProcessdProcess replica(bsls::testing::ProcessdPath(), folder, "robust", 2,
                           {"--set", "scratch_dir=" + scratch.string(), "--set",
                            "max_upload_bytes=2097152", "--set", "log_level=warn"});
   ASSERT_TRUE(replica.ready()) << replica.Log();

@@ -14,6 +14,7 @@
 #include <set>
 #include <thread>
 
+#include "bsls/testing/build_paths.h"
 #include "processd_process.h"
 #include "replica_inputs.h"
 
@@ -56,7 +57,8 @@ TEST(ProcessdFailover, HundredSessionsCompleteWhenAReplicaIsKilled) {
   const fs::path folder = MakeTempFolder("bsls_failover_");
   std::vector<std::unique_ptr<ProcessdProcess>> replicas;
   for (const char* name : {"r0", "r1", "r2"}) {
-    replicas.push_back(std::make_unique<ProcessdProcess>(BSLS_PROCESSD_PATH, folder, name, 1));
+    replicas.push_back(
+        std::make_unique<ProcessdProcess>(bsls::testing::ProcessdPath(), folder, name, 1));
     ASSERT_TRUE(replicas.back()->ready()) << name << ": " << replicas.back()->Log();
   }
   ClientOptions options;

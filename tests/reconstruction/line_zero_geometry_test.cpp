@@ -16,6 +16,7 @@
 #include "bsls/simulator/evaluation.h"
 #include "bsls/simulator/random_scene.h"
 #include "bsls/simulator/renderer.h"
+#include "bsls/testing/build_paths.h"
 
 namespace bsls::reconstruction {
 namespace {
@@ -30,7 +31,7 @@ struct Drawn {
 
 const Drawn& TurnedFace() {
   static const Drawn drawn = [] {
-    const std::filesystem::path data = BSLS_TEST_DATA_DIR;
+    const std::filesystem::path data = bsls::testing::TestDataDir();
     Drawn d;
     d.random = simulator::MakeRandomScene(
         kTurnedFace, {data / "canonical_face_model.obj", data / "stanford_bunny.json"});

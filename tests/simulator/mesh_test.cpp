@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "bsls/simulator/scene.h"
+#include "bsls/testing/build_paths.h"
 
 namespace bsls::simulator {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 constexpr double kDistanceTolerance = 1e-9;  // mm, BVH vs brute force
 constexpr double kNormalTolerance = 1e-9;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-const std::filesystem::path kDataDir = BSLS_TEST_DATA_DIR;
+const std::filesystem::path kDataDir = bsls::testing::TestDataDir();
 
 // Writes `content` to a fresh file in the test temp directory.
 std::filesystem::path WriteTemp(const std::string& name, const std::string& content) {

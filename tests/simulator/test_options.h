@@ -5,10 +5,11 @@
 #include <filesystem>
 
 #include "bsls/simulator/scene.h"
+#include "bsls/testing/build_paths.h"
 
 namespace bsls::simulator {
 
-inline const std::filesystem::path kDataDir = BSLS_TEST_DATA_DIR;
+inline const std::filesystem::path kDataDir = bsls::testing::TestDataDir();
 
 // Thesis scene options reading the face and bunny from the source tree.
 inline ThesisSceneOptions TestOptions() {

@@ -27,6 +27,7 @@
 #include "bsls/calibration/manifest.h"
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/simulator/calibration_session.h"
+#include "bsls/testing/build_paths.h"
 
 namespace bsls::calibration::testing {
 
@@ -61,8 +62,8 @@ inline simulator::CalibrationSessionParams SessionParams(SessionKind kind) {
 // Which build renders the sessions: `tree` names the build tree (a release
 // and a sanitizer build keep their own sessions), `build` the simulator
 // libraries' modification times and sizes (a rebuilt simulator renders
-// afresh). Without the libraries' paths (BSLS_SIMULATOR_LIBRARIES, set by
-// the bsls::test_sessions target): this test binary and its build.
+// afresh). Without the libraries' paths (bsls/testing/build_paths.h): this
+// test binary and its build.
 struct SessionBuild {
   std::string tree;
   std::string build;
@@ -71,10 +72,8 @@ struct SessionBuild {
 inline SessionBuild SimulatorBuild() {
   namespace fs = std::filesystem;
   std::vector<std::string> files;
-#ifdef BSLS_SIMULATOR_LIBRARIES
-  std::stringstream paths(BSLS_SIMULATOR_LIBRARIES);
+  std::stringstream paths(bsls::testing::SimulatorLibraries());
   for (std::string path; std::getline(paths, path, '|');) files.push_back(path);
-#endif
   SessionBuild out;
   std::string joined;
   for (const std::string& file : files) {
