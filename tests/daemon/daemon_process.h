@@ -7,6 +7,7 @@
 #include <arpa/inet.h>
 #include <fcntl.h>
 #include <grpcpp/grpcpp.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <sys/socket.h>
@@ -20,6 +21,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -31,14 +33,45 @@ namespace bsls::testing {
 
 namespace fs = std::filesystem;
 
+// Removes the daemon directories made during a test once the test has
+// passed (stores, logs, keys); a failed test's are kept for its log.
+class DaemonDirCleaner : public ::testing::EmptyTestEventListener {
+ public:
+  // The one cleaner of this test process, appended to GoogleTest's listeners.
+  static DaemonDirCleaner& Instance() {
+    static DaemonDirCleaner* cleaner = [] {
+      auto* made = new DaemonDirCleaner;  // owned by GoogleTest's listener list
+      ::testing::UnitTest::GetInstance()->listeners().Append(made);
+      return made;
+    }();
+    return *cleaner;
+  }
+
+  // `dir` goes when the test running now ends well.
+  void Add(const fs::path& dir) { dirs_.push_back(dir); }
+
+  void OnTestEnd(const ::testing::TestInfo& info) override {
+    if (info.result() != nullptr && info.result()->Passed()) {
+      std::error_code ec;
+      for (const fs::path& dir : dirs_) fs::remove_all(dir, ec);
+    }
+    dirs_.clear();
+  }
+
+ private:
+  std::vector<fs::path> dirs_;
+};
+
 // A fresh directory under the test temp dir, world-searchable so that
-// callers of other uids reach the socket inside.
+// callers of other uids reach the socket inside; removed after the test
+// when it passes.
 inline fs::path MakeDaemonDir(const std::string& name) {
   const fs::path dir =
       fs::path(::testing::TempDir()) / ("bslsd_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   ::chmod(dir.c_str(), 0755);
+  DaemonDirCleaner::Instance().Add(dir);
   return dir;
 }
 

@@ -154,5 +154,40 @@ TEST(HeldOutSample, LinesEndingOnAnOccludingEdgeJoinNothingThroughTheirGaps) {
       << "the case this test holds is gone from the frame";
 }
 
+// Held-out seed 101366 (a ball, right side, pitch 8.9 px; looked at to
+// build the rule, so no longer held out): on the ball's limb, seen nearly
+// edge-on, its lines crowd, and bricks closed over lines that were not
+// neighbours joined the whole ball to the base plane 4 lines off (180
+// wrong p). A brick whose top or bottom segment is abrupt no longer closes
+// (TrackLabellingParams::close_abrupt_bricks).
+TEST(HeldOutSample, BricksClosedOverACrowdedLimbAreNotTrusted) {
+  const LabelScore all = DecodeSeed(101366);
+  EXPECT_LE(all.wrong_p, 10) << all.Summary();   // 6 left, joined through other links
+  EXPECT_GE(all.Right(), 550) << all.Summary();  // the base plane's, as before
+
+  decoder::DecodeParams before;
+  before.track_chain.labelling.close_abrupt_bricks = true;
+  EXPECT_GT(DecodeSeed(101366, before).wrong_p, 100)
+      << "the case this test holds is gone from the frame";
+}
+
+// Held-out seed 100771 (a face turned 18.5 degrees, left side; looked at to
+// build the rule, so no longer held out): line 0 hides behind the nose's
+// profile over part of its length, where the reference line runs on line
+// 1. Its seeds there joined the face's patch while those on line 0 itself
+// were left out (their bricks abrupt), and every label came out one line
+// low. Those seeds' links place them beyond line 0: the frame is refused.
+TEST(HeldOutSample, ALineZeroRunningOnLineOneWhereItHidesIsRefused) {
+  RandomScene random;
+  const Frame frame = RenderSeed(100771, &random);
+  const decoder::DecodeResult r = decoder::Decode(frame.image, random.scene.side, {});
+  EXPECT_FALSE(r.ok) << "labelled although its line 0 runs on line 1 in places";
+  if (r.ok) {
+    const LabelScore all =
+        ScoreLabels(VisibleJunctions(frame.truth), DecodedLabels(r), kMatchReach);
+    EXPECT_EQ(all.wrong_p, 0) << all.Summary();
+  }
+}
+
 }  // namespace
 }  // namespace bsls::simulator

@@ -724,11 +724,11 @@ void PlaceByGeometry(const interpretation::TrackNetwork& net, const pattern::Pat
   std::set<std::pair<int, int>> taken;
   for (const FramedJunction& j : labelled) taken.emplace(j.p, j.q);
   for (const interpretation::TrackLabels::Island& island : labels->islands) {
-    std::vector<FramedJunction> own;
+    std::vector<FramedJunction> members;
     for (size_t k = 0; k < island.junctions.size(); ++k)
-      own.push_back(
+      members.push_back(
           {scale.ToFull(net.junctions[island.junctions[k]].position), island.p[k], island.v[k]});
-    const std::optional<LabelShift> shift = geometry.PlaceIsland(labelled, own, &why);
+    const std::optional<LabelShift> shift = geometry.PlaceIsland(labelled, members, &why);
     if (!shift || !lines_on_slide(island.line_p, shift->dp)) continue;
     std::vector<char> keep(island.junctions.size(), 0);
     bool fits = true;

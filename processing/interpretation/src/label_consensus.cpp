@@ -459,6 +459,24 @@ void KeepIslands(const std::vector<char>& labelled, LabelOf label_of, int min_is
 
 }  // namespace
 
+// Whether a whole link (neither abrupt nor across a gap) from a labelled
+// junction places a seed left unlabelled beyond line 0 (p < 0): a junction
+// the reference line claims as line 0 and the labels as the line before
+// it. Where line 0 hides behind an occluding edge over part of its length
+// (a profile turned away), the outermost lit line there is line 1 and the
+// reference line runs on it; the labels then count from line 1.
+bool SeedPlacedBeyondLineZero(const std::vector<ConsensusLink>& links,
+                              const std::vector<int>& seeds, const std::vector<char>& labelled,
+                              const std::vector<Label>& label) {
+  std::vector<char> is_seed(labelled.size(), 0);
+  for (int s : seeds) is_seed[s] = 1;
+  return std::any_of(links.begin(), links.end(), [&](const ConsensusLink& l) {
+    if (l.abrupt || l.gap) return false;
+    return (is_seed[l.a] && !labelled[l.a] && labelled[l.b] && label[l.b].p - l.dp < 0) ||
+           (is_seed[l.b] && !labelled[l.b] && labelled[l.a] && label[l.a].p + l.dp < 0);
+  });
+}
+
 Consensus LabelByConsensus(const std::vector<char>& odd_kind,
                            const std::vector<ConsensusLink>& links, const std::vector<int>& seeds,
                            int min_seeds, const ConsensusParams& params) {
@@ -507,6 +525,7 @@ Consensus LabelByConsensus(const std::vector<char>& odd_kind,
   std::vector<int> patch_size(patches.count, 0);
   for (int j = 0; j < n; ++j) ++patch_size[patches.of[j]];
   AttachLoneJunctions(odd_kind, links, patches.of, patch_size, params, &labelled, &label);
+  if (SeedPlacedBeyondLineZero(links, seeds, labelled, label)) return out;
   for (int j = 0; j < n; ++j)
     if (labelled[j]) {
       out.p[j] = label[j].p;

@@ -260,8 +260,13 @@ struct TrustedLinks {
 // Thesis 5.1.4.1: a complete loop. The brick below segment A-B (A direct
 // on line p, B corresponding on p + 1) closes when both lines run down
 // exactly two rows, through their median junctions, to the ends of one
-// segment; its six links are trusted.
-TrustedLinks TrustClosedBricks(const std::vector<Step>& down, const std::vector<int>& across) {
+// segment; its six links are trusted. A brick whose top or bottom segment
+// is abrupt (the line pitch jumps across it) is not, unless
+// TrackLabellingParams::close_abrupt_bricks: its loop may close over lines
+// crowded on a surface seen edge-on, where the line beyond is not the next.
+template <typename Abrupt>
+TrustedLinks TrustClosedBricks(const std::vector<Step>& down, const std::vector<int>& across,
+                               const Abrupt& abrupt) {
   const int n = static_cast<int>(down.size());
   auto two_rows_down = [&](int j, std::vector<int>* path) {
     int rows = 0;
@@ -283,6 +288,7 @@ TrustedLinks TrustClosedBricks(const std::vector<Step>& down, const std::vector<
     right_path.clear();
     const int a2 = two_rows_down(a, &left_path), b2 = two_rows_down(b, &right_path);
     if (a2 < 0 || b2 < 0 || across[a2] != b2) continue;
+    if (abrupt(a, b) || abrupt(a2, b2)) continue;
     trusted.across[a] = trusted.across[a2] = 1;
     for (const auto* path : {&left_path, &right_path})
       for (int j : *path) trusted.down[j] = 1;
@@ -358,7 +364,6 @@ class TrackLinks {
   const std::vector<std::vector<Link>>& adj() const { return adj_; }
   const std::vector<ConsensusLink>& links() const { return links_; }
 
- private:
   // A link is abrupt where the line pitch at its two ends differs beyond
   // what a smooth surface gives and one end's lines crowd (a grazing
   // surface, an occluding edge beside it).
@@ -367,6 +372,8 @@ class TrackLinks {
       return false;
     return std::min(pitch_[a], pitch_[b]) < kCrowded * frame_pitch_;
   }
+
+ private:
   void Add(int a, int b, int dp, int dv, bool trusted, bool smooth = false, bool gap = false) {
     adj_[a].push_back({b, dp, dv});
     adj_[b].push_back({a, -dp, -dv});
@@ -567,7 +574,9 @@ TrackLabels LabelTracks(const TrackNetwork& net, pattern::Side side,
   const std::vector<int> across = SegmentPartners(net);
   cancel.ThrowIfRequested("the steps along lines");
   TrackLinks links(net, spacing, params);
-  const TrustedLinks trusted = TrustClosedBricks(down, across);
+  const TrustedLinks trusted = TrustClosedBricks(down, across, [&](int a, int b) {
+    return !params.close_abrupt_bricks && links.Abrupt(a, b);
+  });
   cancel.ThrowIfRequested("the closed bricks");
   links.AddStepsAndSegments(down, across, trusted);
   links.AddLineGaps();

@@ -85,6 +85,12 @@ struct TrackLabellingParams {
   // the surface in front go on from there: bridged as gaps, their steps
   // agree on a join some lines off.
   int min_whole_links = 1;
+  // Whether a brick whose top or bottom segment is abrupt (the line pitch
+  // at its two ends jumps, one end's lines crowded) still closes and its
+  // links are trusted. Off: on a surface seen edge-on (a ball's limb),
+  // lines crowd until the loop of a brick closes over lines that are not
+  // neighbours, and a whole patch takes a shift of several lines.
+  bool close_abrupt_bricks = false;
 
   // True when the values are usable; otherwise says why.
   bool IsValid(std::string* error) const;
