@@ -1,6 +1,7 @@
 #include "bsls/interpretation/track_labelling.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -296,11 +297,13 @@ TrustedLinks TrustClosedBricks(const std::vector<Step>& down, const std::vector<
   return trusted;
 }
 
-// Per junction: px to the nearest other line in its row, or 0.
+// Per junction: px to the nearest other line, the median over its row and
+// the rows above and below it (one stray ridge point in a row, a stroke
+// cut by the frame's edge, does not decide), or 0 where none is measured.
 std::vector<double> PitchAtJunctions(const TrackNetwork& net) {
-  auto pitch_at = [&](int j) {
-    const cv::Point2d at = net.junctions[j].position;
-    const auto row = net.rows.Row(static_cast<int>(std::lround(at.y)));
+  const int n_rows = static_cast<int>(net.rows.row_start.size()) - 1;
+  auto pitch_in_row = [&](const cv::Point2d& at, int y) {
+    const auto row = net.rows.Row(y);
     // The row runs left to right: the nearest beyond kOwnLine on each side.
     const auto right = std::partition_point(row.begin(), row.end(),
                                             [&](const auto& r) { return r.x <= at.x + kOwnLine; });
@@ -311,6 +314,16 @@ std::vector<double> PitchAtJunctions(const TrackNetwork& net) {
     if (left != row.begin() && (nearest == 0 || at.x - std::prev(left)->x < nearest))
       nearest = at.x - std::prev(left)->x;
     return nearest;
+  };
+  auto pitch_at = [&](int j) {
+    const cv::Point2d at = net.junctions[j].position;
+    const int centre = static_cast<int>(std::lround(at.y));
+    std::array<double, 3> seen{};
+    int count = 0;
+    for (int y = std::max(centre - 1, 0); y <= std::min(centre + 1, n_rows - 1); ++y)
+      if (const double v = pitch_in_row(at, y); v > 0) seen[count++] = v;
+    if (count < 3) return count == 0 ? 0.0 : std::max(seen[0], seen[count - 1]);
+    return std::max(std::min(seen[0], seen[1]), std::min(std::max(seen[0], seen[1]), seen[2]));
   };
   std::vector<double> pitch(net.junctions.size());
   for (int j = 0; j < static_cast<int>(pitch.size()); ++j) pitch[j] = pitch_at(j);
