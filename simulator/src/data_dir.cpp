@@ -13,7 +13,7 @@ std::filesystem::path DefaultDataDir() {
     return std::filesystem::path(env);
   const std::filesystem::path installed(BSLS_DATA_DIR);
   std::error_code ec;
-  if (std::filesystem::exists(installed / "canonical_face_model.obj", ec)) return installed;
+  if (std::filesystem::exists(installed / kFaceFileName, ec)) return installed;
   return std::filesystem::path(BSLS_SOURCE_DATA_DIR);
 }
 

@@ -7,7 +7,6 @@
 namespace bsls::simulator {
 namespace {
 
-constexpr const char* kFaceFileName = "canonical_face_model.obj";
 constexpr const char* kBunnyFileName = "stanford_bunny.json";
 // Image sizes the rig accepts, pixels.
 constexpr int kMinImageSize = 8;

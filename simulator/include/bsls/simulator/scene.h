@@ -84,8 +84,11 @@ std::string_view ToString(SurfaceKind kind);
 // Parses the names of ToString; nullopt for anything else.
 std::optional<SurfaceKind> ParseSurfaceKind(std::string_view text);
 
+// The face model's file in a data directory (DefaultDataDir()).
+inline constexpr const char* kFaceFileName = "canonical_face_model.obj";
+
 // Where the bundled meshes are: $BSLS_DATA_DIR when set and non-empty, else
-// the installed data directory when it holds canonical_face_model.obj, else the
+// the installed data directory when it holds kFaceFileName, else the
 // source tree's simulator/data.
 std::filesystem::path DefaultDataDir();
 
