@@ -457,8 +457,6 @@ void KeepIslands(const std::vector<char>& labelled, LabelOf label_of, int min_is
   }
 }
 
-}  // namespace
-
 // Whether a whole link (neither abrupt nor across a gap) from a labelled
 // junction places a seed left unlabelled beyond line 0 (p < 0): a junction
 // the reference line claims as line 0 and the labels as the line before
@@ -476,6 +474,8 @@ bool SeedPlacedBeyondLineZero(const std::vector<ConsensusLink>& links,
            (is_seed[l.b] && !labelled[l.b] && labelled[l.a] && label[l.a].p + l.dp < 0);
   });
 }
+
+}  // namespace
 
 Consensus LabelByConsensus(const std::vector<char>& odd_kind,
                            const std::vector<ConsensusLink>& links, const std::vector<int>& seeds,
