@@ -15,6 +15,11 @@ std::string ProcessdPath() { return BSLS_BUILD_PROCESSD; }
 
 std::string RoleProbePath() { return BSLS_BUILD_ROLE_PROBE; }
 
-std::string SimulatorLibraries() { return BSLS_BUILD_SIMULATOR_LIBRARIES; }
+std::vector<std::string> SimulatorLibraries() {
+  std::vector<std::string> out;
+  for (const char* file : {BSLS_BUILD_SIMULATOR, BSLS_BUILD_SIMULATOR_SCENE})
+    if (*file != '\0') out.emplace_back(file);
+  return out;
+}
 
 }  // namespace bsls::testing

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace bsls::testing {
 
@@ -29,8 +30,8 @@ std::string ProcessdPath();
 // The role probe of the daemon's tests; empty when the tree builds none.
 std::string RoleProbePath();
 
-// The simulator's libraries, joined by '|'; empty without a simulator.
-std::string SimulatorLibraries();
+// The simulator's libraries as this tree builds them; none without a simulator.
+std::vector<std::string> SimulatorLibraries();
 
 }  // namespace bsls::testing
 

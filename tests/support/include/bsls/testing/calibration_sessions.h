@@ -71,9 +71,7 @@ struct SessionBuild {
 
 inline SessionBuild SimulatorBuild() {
   namespace fs = std::filesystem;
-  std::vector<std::string> files;
-  std::stringstream paths(bsls::testing::SimulatorLibraries());
-  for (std::string path; std::getline(paths, path, '|');) files.push_back(path);
+  std::vector<std::string> files = bsls::testing::SimulatorLibraries();
   SessionBuild out;
   std::string joined;
   for (const std::string& file : files) {
