@@ -3,9 +3,11 @@
 # rule fails the configure (CMake generates nothing), each breach named with
 # the chain that brought it in, e.g. "bslsd -> bslsd_core -> bsls_calibration".
 #
-#  - The contracts' libraries (bsls_proto, bsls_rpc) link bsls::common alone
-#    of this project (targets of common/ and proto/, not bsls::config): no
-#    OpenCV, no yaml-cpp, no processing or daemon library.
+#  - The contracts' libraries (every target of proto/: bsls_proto, bsls_rpc)
+#    link bsls::common alone of this project (targets of common/ and proto/,
+#    not bsls::config): no OpenCV, no yaml-cpp, no processing or daemon
+#    library. The messages' conversions to each side's own types live with
+#    that side (processing/contract, daemon/service's contract_messages).
 #  - bslsd links no processing library (targets of processing/), except
 #      bsls_pattern, bsls_geometry      the simulated backend renders the
 #                                       slides through a pinhole camera

@@ -13,9 +13,9 @@
 #include <opencv2/highgui.hpp>
 
 #include "bsls/common/atomic_file.h"
+#include "bsls/contract/frame_message.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/rpc/artifacts.h"
-#include "bsls/rpc/frame_message.h"
 #include "bsls/v1/capture.grpc.pb.h"
 #include "command.h"
 #include "daemon_connection.h"
@@ -57,8 +57,8 @@ void MakeFolder(const std::string& dir) {
 // `what` when the message does not hold the frame its size says.
 cv::Mat FrameImage(const v1::Frame& frame, const std::string& what) {
   try {
-    return rpc::FrameView(frame, what);
-  } catch (const rpc::FrameMessageError& e) {
+    return contract::FrameView(frame, what);
+  } catch (const contract::MessageError& e) {
     throw CommandError(kExitServiceFailed, std::string(e.what()) + " (damaged in transit?)");
   }
 }

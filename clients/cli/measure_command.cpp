@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "bsls/common/atomic_file.h"
+#include "bsls/contract/processing_messages.h"
 #include "bsls/measurement/plan.h"
 #include "bsls/measurement/report.h"
 #include "command.h"
@@ -77,15 +78,6 @@ measurement::ReferenceKind ParseReference(const std::string& name) {
   throw CommandError(kExitUsage, "--reference " + name + ": must be plane, quadric or cubic");
 }
 
-void AddPoint(const Eigen::Vector2d& p, v1::PointXY* out) {
-  out->set_x(p.x());
-  out->set_y(p.y());
-}
-
-void AddPolygon(const measurement::Polygon2d& polygon, v1::Polygon* out) {
-  for (const Eigen::Vector2d& p : polygon) AddPoint(p, out->add_points());
-}
-
 // The figures of `plan`, measured by the processing service (here or the
 // one --server names): the surface (and baseline) go up, measurements.json
 // comes back; a table on stdout and the JSON report.
@@ -94,17 +86,7 @@ void MeasureOnService(const MeasureOptions& o, const measurement::MeasurementPla
   request.set_surface_ply(ReadInputFile(o.surface, "surface"));
   if (!o.baseline.empty()) request.set_baseline_ply(ReadInputFile(o.baseline, "--baseline"));
   request.set_baseline_shares_frame(!o.register_baseline);
-  v1::MeasurementPlan* m = request.mutable_measurements();
-  for (const Eigen::Vector2d& h : plan.heights) AddPoint(h, m->add_heights());
-  for (const auto& d : plan.distances) AddPolygon({d[0], d[1]}, m->add_distances());
-  for (const auto& a : plan.areas) AddPolygon(a, m->add_areas());
-  for (const auto& l : plan.lesions) AddPolygon(l, m->add_lesions());
-  m->set_reference(plan.lesion.reference == measurement::ReferenceKind::kPlane
-                       ? v1::MeasurementPlan::REFERENCE_PLANE
-                   : plan.lesion.reference == measurement::ReferenceKind::kQuadric
-                       ? v1::MeasurementPlan::REFERENCE_QUADRIC
-                       : v1::MeasurementPlan::REFERENCE_CUBIC);
-  m->set_ring_mm(plan.lesion.ring_width_mm);
+  *request.mutable_measurements() = contract::ToProto(plan);
   request.set_request_tag(o.surface.substr(0, 256));
   ProcessingRoute route(o.server);
   const processing::WorkOutcome out = route.client().Measure(request, route.Progress(o.quiet));

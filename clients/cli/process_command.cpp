@@ -9,9 +9,9 @@
 
 #include "bsls/calibration/calibration_file.h"
 #include "bsls/common/atomic_file.h"
+#include "bsls/contract/frame_message.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/pattern/brick_pattern.h"
-#include "bsls/rpc/frame_message.h"
 #include "command.h"
 #include "daemon_connection.h"
 #include "processing_route.h"
@@ -67,7 +67,7 @@ v1::ProcessFrameRequest ProcessRequest(const ProcessOptions& o, pattern::Side si
   if (conversion.converted())
     std::cerr << "bsls: note: " << o.image << ": " << conversion.Describe() << "\n";
   v1::ProcessFrameRequest request;
-  rpc::ToFrameMessage(frame, request.mutable_frame());
+  contract::ToFrameMessage(frame, request.mutable_frame());
   request.set_side(side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
   if (!o.calibration.empty())
     *request.mutable_calibration() =

@@ -12,8 +12,8 @@
 #include <string>
 
 #include "bsls/common/atomic_file.h"
+#include "bsls/contract/frame_message.h"
 #include "bsls/io/frame_file.h"
-#include "bsls/rpc/frame_message.h"
 #include "command.h"
 #include "daemon_connection.h"
 #include "processing_route.h"
@@ -76,8 +76,8 @@ void PrintSessionSummary(const nlohmann::json& report, const std::string& output
 
 void RunReconstruct(const ReconstructOptions& o) {
   v1::ReconstructSessionRequest request;
-  rpc::ToFrameMessage(LoadFrame(o.left_image), request.mutable_left());
-  rpc::ToFrameMessage(LoadFrame(o.right_image), request.mutable_right());
+  contract::ToFrameMessage(LoadFrame(o.left_image), request.mutable_left());
+  contract::ToFrameMessage(LoadFrame(o.right_image), request.mutable_right());
   *request.mutable_left_calibration() = processing::ProcessingClient::Inline(
       ReadCalibrationFile(o.left_calibration, "--calibration-left"));
   *request.mutable_right_calibration() = processing::ProcessingClient::Inline(

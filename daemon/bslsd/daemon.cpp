@@ -10,6 +10,7 @@
 #include "bsls/rpc/malformed_requests.h"
 #include "bsls/rpc/server_limits.h"
 #include "bsls/rpc/tls.h"
+#include "bsls/service/contract_messages.h"
 
 #ifndef BSLS_VERSION
 #define BSLS_VERSION "unknown"
@@ -18,10 +19,6 @@
 namespace bsls::bslsd {
 
 namespace {
-
-v1::Camera ToProto(framestore::Camera camera) {
-  return static_cast<v1::Camera>(static_cast<int>(camera) + 1);
-}
 
 // The capture store of `config`, opened; its recovery report logged.
 // Recovery reports damaged acknowledged captures, never drops them.
@@ -57,7 +54,7 @@ service::DeviceCallbacks DeviceEvents(service::EventHub* events, std::function<v
   };
   callbacks.camera_changed = [events](framestore::Camera camera, int gain) {
     v1::Event event;
-    event.mutable_camera_changed()->set_camera(ToProto(camera));
+    event.mutable_camera_changed()->set_camera(service::ToProto(camera));
     event.mutable_camera_changed()->set_gain(gain);
     events->Publish(std::move(event));
   };

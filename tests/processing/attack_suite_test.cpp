@@ -46,7 +46,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <thread>
 
-#include "bsls/rpc/frame_message.h"
+#include "bsls/contract/frame_message.h"
 #include "bsls/testing/build_paths.h"
 #include "bsls/testing/hostile_frame.h"
 #include "bsls/testing/raw_connections.h"
@@ -287,7 +287,7 @@ std::string PlyTriangle(const std::string& header_extra) {
 // A ProcessFrame request of `grey` (8-bit) as a left frame, nothing else asked.
 v1::ProcessFrameRequest FrameRequest(const cv::Mat& grey) {
   v1::ProcessFrameRequest request;
-  rpc::ToFrameMessage(grey, request.mutable_frame());
+  contract::ToFrameMessage(grey, request.mutable_frame());
   request.set_side(v1::SIDE_LEFT);
   return request;
 }
@@ -444,8 +444,8 @@ TEST(AttackSuite, ProcessdWithTwoWorkersStaysAliveFreeAndClean) {
     plane.mutable_surface()->set_plane_model(static_cast<v1::SurfaceOptions::PlaneModel>(-3));
     plane.mutable_surface()->set_strips(static_cast<v1::SurfaceOptions::StripMethod>(9));
     v1::ReconstructSessionRequest join;
-    rpc::ToFrameMessage(noise, join.mutable_left());
-    rpc::ToFrameMessage(noise, join.mutable_right());
+    contract::ToFrameMessage(noise, join.mutable_left());
+    contract::ToFrameMessage(noise, join.mutable_right());
     join.set_join(static_cast<v1::ReconstructSessionRequest::Join>(42));
     v1::GetCalibrationRequest id;
     id.set_id(std::string(60 << 10, 'i'));

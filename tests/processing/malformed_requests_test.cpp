@@ -465,10 +465,10 @@ Corpus ProcessdCorpus(const SessionInputs& inputs, const std::string& binary_ply
   cv::Mat noise(64, 64, CV_8UC1);
   cv::randu(noise, 0, 256);
   v1::ProcessFrameRequest small;
-  rpc::ToFrameMessage(noise, small.mutable_frame());
+  contract::ToFrameMessage(noise, small.mutable_frame());
   small.set_side(v1::SIDE_LEFT);
   v1::ProcessFrameRequest face;
-  rpc::ToFrameMessage(inputs.left_face, face.mutable_frame());
+  contract::ToFrameMessage(inputs.left_face, face.mutable_frame());
   face.set_side(v1::SIDE_LEFT);
   *face.mutable_calibration() = ProcessingClient::Inline(left_yaml);
   face.set_want_surface(true);

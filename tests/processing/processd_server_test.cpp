@@ -15,8 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "bsls/contract/frame_message.h"
 #include "bsls/processing/processing_client.h"
-#include "bsls/rpc/frame_message.h"
 #include "bsls/testing/certificates.h"
 #include "bsls/testing/hostile_frame.h"
 #include "bsls/testing/raw_connections.h"
@@ -106,7 +106,7 @@ TEST_F(ProcessdServer, DrainStopsWorkInsideItsStages) {
   options.target = "unix:" + config.listen.unix_socket;
   options.timeout = std::chrono::minutes(5);
   v1::ProcessFrameRequest request;
-  rpc::ToFrameMessage(testing::HostileFrame(), request.mutable_frame());
+  contract::ToFrameMessage(testing::HostileFrame(), request.mutable_frame());
   request.set_side(v1::SIDE_LEFT);
   auto start = std::chrono::steady_clock::now();
   {

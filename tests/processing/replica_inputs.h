@@ -18,8 +18,8 @@
 #include "bsls/calibration/calibration_file.h"
 #include "bsls/calibration/manifest.h"
 #include "bsls/calibration/side_calibration.h"
+#include "bsls/contract/frame_message.h"
 #include "bsls/processing/processing_client.h"
-#include "bsls/rpc/frame_message.h"
 #include "bsls/simulator/calibration_session.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
@@ -83,8 +83,8 @@ inline const SessionInputs& LightSessionInputs() {
 // (as the C++ client always sends them).
 inline v1::ReconstructSessionRequest SessionRequestOf(const SessionInputs& inputs) {
   v1::ReconstructSessionRequest request;
-  rpc::ToFrameMessage(inputs.left_face, request.mutable_left());
-  rpc::ToFrameMessage(inputs.right_face, request.mutable_right());
+  contract::ToFrameMessage(inputs.left_face, request.mutable_left());
+  contract::ToFrameMessage(inputs.right_face, request.mutable_right());
   *request.mutable_left_calibration() = ProcessingClient::Inline(inputs.left_calibration);
   *request.mutable_right_calibration() = ProcessingClient::Inline(inputs.right_calibration);
   return request;

@@ -11,9 +11,9 @@
 #include <string>
 
 #include "bsls/calibration/calibration_file.h"
+#include "bsls/contract/frame_message.h"
 #include "bsls/processing/processing_client.h"
 #include "bsls/processing/processing_service.h"
-#include "bsls/rpc/frame_message.h"
 #include "bsls/simulator/renderer.h"
 #include "bsls/simulator/scene.h"
 #include "bsls/testing/calibration_sessions.h"
@@ -48,7 +48,7 @@ inline const cv::Mat& FaceFrame(pattern::Side side) {
 
 inline v1::Frame FrameMessage(const cv::Mat& grey) {
   v1::Frame frame;
-  rpc::ToFrameMessage(grey, &frame);
+  contract::ToFrameMessage(grey, &frame);
   return frame;
 }
 

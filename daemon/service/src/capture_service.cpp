@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "bsls/rpc/artifacts.h"
-#include "contract_messages.h"
+#include "bsls/service/contract_messages.h"
 #include "push_stream.h"
 
 namespace bsls::service {

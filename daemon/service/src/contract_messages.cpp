@@ -1,4 +1,4 @@
-#include "contract_messages.h"
+#include "bsls/service/contract_messages.h"
 
 #include <google/protobuf/util/time_util.h>
 

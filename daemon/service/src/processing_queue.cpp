@@ -7,7 +7,7 @@
 #include <set>
 
 #include "bsls/common/sha256.h"
-#include "contract_messages.h"
+#include "bsls/service/contract_messages.h"
 
 namespace bsls::service {
 namespace {

@@ -21,11 +21,12 @@
 #include "bsls/common/errors.h"
 #include "bsls/common/sha256.h"
 #include "bsls/config/bounded_yaml.h"
+#include "bsls/contract/frame_message.h"
+#include "bsls/contract/processing_messages.h"
 #include "bsls/decoder/decode_output.h"
 #include "bsls/io/surface_file.h"
 #include "bsls/measurement/measurement_error.h"
 #include "bsls/rpc/artifacts.h"
-#include "bsls/rpc/frame_message.h"
 #include "bsls/rpc/server_limits.h"
 #include "bsls/session/session.h"
 #include "work_stream.h"
@@ -50,39 +51,16 @@ struct Refusal {
   throw Refusal{Status(code, message)};
 }
 
-// Refuses a number in an enum field that its .proto does not define (proto3
-// keeps unknown numbers rather than rejecting them).
-void RequireDefined(int value, bool (*is_valid)(int), const std::string& field) {
-  if (!is_valid(value))
-    Refuse(StatusCode::INVALID_ARGUMENT,
-           field + ": " + std::to_string(value) + " is not one of the field's values");
-}
-
-pattern::Side SideOf(v1::Side side, const std::string& field) {
-  if (side == v1::SIDE_LEFT) return pattern::Side::kLeft;
-  if (side == v1::SIDE_RIGHT) return pattern::Side::kRight;
-  Refuse(StatusCode::INVALID_ARGUMENT, field + ": must be SIDE_LEFT or SIDE_RIGHT");
-}
-
-v1::Side ToProto(pattern::Side side) {
-  return side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT;
-}
-
 void CheckTag(const std::string& tag) {
   if (tag.size() > kMaxTagBytes)
     Refuse(StatusCode::INVALID_ARGUMENT,
            "request_tag: " + std::to_string(tag.size()) + " bytes, at most 256");
 }
 
-// The frame `name` of a request, refused (INVALID_ARGUMENT) when malformed
-// or above `max_pixels`.
+// The frame `name` of a request; contract::MessageError when malformed,
+// refused (INVALID_ARGUMENT) above `max_pixels`.
 cv::Mat FrameOf(const v1::Frame& frame, const std::string& name, std::int64_t max_pixels) {
-  cv::Mat grey;
-  try {
-    grey = rpc::FrameView(frame, name);
-  } catch (const rpc::FrameMessageError& e) {
-    Refuse(StatusCode::INVALID_ARGUMENT, e.what());
-  }
+  const cv::Mat grey = contract::FrameView(frame, name);
   if (static_cast<std::int64_t>(grey.total()) > max_pixels)
     Refuse(StatusCode::INVALID_ARGUMENT,
            name + ": " + std::to_string(grey.cols) + " x " + std::to_string(grey.rows) + " = " +
@@ -93,81 +71,11 @@ cv::Mat FrameOf(const v1::Frame& frame, const std::string& name, std::int64_t ma
 
 void FillInfo(const CachedCalibration& c, v1::CalibrationInfo* info) {
   info->set_id(c.id);
-  info->set_side(ToProto(c.calibration.side));
+  info->set_side(contract::ToProto(c.calibration.side));
   info->set_width(static_cast<std::uint32_t>(c.calibration.width));
   info->set_height(static_cast<std::uint32_t>(c.calibration.height));
   info->set_software_version(c.software_version);
   info->set_has_projector_matrix(c.calibration.projector_matrix.has_value());
-}
-
-reconstruction::SidePipelineParams SideParams(const v1::DecodeOptions& decode,
-                                              const v1::SurfaceOptions& surface) {
-  RequireDefined(decode.method(), v1::DecodeOptions::Method_IsValid, "decode.method");
-  RequireDefined(decode.chain(), v1::DecodeOptions::Chain_IsValid, "decode.chain");
-  RequireDefined(surface.plane_model(), v1::SurfaceOptions::PlaneModel_IsValid,
-                 "surface.plane_model");
-  RequireDefined(surface.strips(), v1::SurfaceOptions::StripMethod_IsValid, "surface.strips");
-  reconstruction::SidePipelineParams params;
-  params.decode.extraction.method = decode.method() == v1::DecodeOptions::METHOD_THESIS
-                                        ? extraction::ExtractionMethod::kThesis
-                                        : extraction::ExtractionMethod::kModern;
-  params.decode.interpretation.enable_repair = !decode.no_repair();
-  std::optional<decoder::DecodeChain> named;
-  if (decode.chain() == v1::DecodeOptions::CHAIN_TRACKS) named = decoder::DecodeChain::kTracks;
-  if (decode.chain() == v1::DecodeOptions::CHAIN_SKELETON) named = decoder::DecodeChain::kSkeleton;
-  std::string why;
-  if (!decoder::ChainFor(named, params.decode, &why))
-    Refuse(StatusCode::INVALID_ARGUMENT, "decode.chain: " + why);
-  params.chain = named;
-  params.planes = surface.plane_model() == v1::SurfaceOptions::PLANE_MODEL_PARALLEL
-                      ? reconstruction::PlaneModelKind::kParallel
-                      : reconstruction::PlaneModelKind::kPerspective;
-  params.reconstruction.smooth_lines = surface.smooth_lines();
-  params.reconstruction.mesh.strips = surface.strips() == v1::SurfaceOptions::STRIP_METHOD_ROW_PAIRS
-                                          ? reconstruction::StripMethod::kRowPairs
-                                          : reconstruction::StripMethod::kStitched;
-  return params;
-}
-
-Eigen::Vector2d PointOf(const v1::PointXY& p) { return {p.x(), p.y()}; }
-
-measurement::Polygon2d PolygonOf(const v1::Polygon& polygon) {
-  measurement::Polygon2d out;
-  for (const v1::PointXY& p : polygon.points()) out.push_back(PointOf(p));
-  return out;
-}
-
-measurement::MeasurementPlan PlanOf(const v1::MeasurementPlan& m, int max_figures) {
-  const int figures = m.heights_size() + m.distances_size() + m.areas_size() + m.lesions_size();
-  if (figures > max_figures)
-    Refuse(StatusCode::INVALID_ARGUMENT, "measurements: " + std::to_string(figures) +
-                                             " figures, at most " + std::to_string(max_figures));
-  RequireDefined(m.reference(), v1::MeasurementPlan::Reference_IsValid, "measurements.reference");
-  measurement::MeasurementPlan plan;
-  for (const v1::PointXY& h : m.heights()) plan.heights.push_back(PointOf(h));
-  for (int i = 0; i < m.distances_size(); ++i) {
-    if (m.distances(i).points_size() != 2)
-      Refuse(StatusCode::INVALID_ARGUMENT,
-             "measurements.distances[" + std::to_string(i) + "]: give exactly two points");
-    plan.distances.push_back(
-        {PointOf(m.distances(i).points(0)), PointOf(m.distances(i).points(1))});
-  }
-  for (const v1::Polygon& a : m.areas()) plan.areas.push_back(PolygonOf(a));
-  for (const v1::Polygon& l : m.lesions()) plan.lesions.push_back(PolygonOf(l));
-  switch (m.reference()) {
-    case v1::MeasurementPlan::REFERENCE_PLANE:
-      plan.lesion.reference = measurement::ReferenceKind::kPlane;
-      break;
-    case v1::MeasurementPlan::REFERENCE_QUADRIC:
-      plan.lesion.reference = measurement::ReferenceKind::kQuadric;
-      break;
-    default:
-      plan.lesion.reference = measurement::ReferenceKind::kCubic;
-  }
-  if (m.ring_mm() != 0.0) plan.lesion.ring_width_mm = m.ring_mm();
-  std::string why;
-  if (!plan.IsValid(&why)) Refuse(StatusCode::INVALID_ARGUMENT, "measurements: " + why);
-  return plan;
 }
 
 StatusCode CodeOf(calibration::CalibrationErrorReason reason) {
@@ -224,30 +132,6 @@ fs::path UploadPath(const std::string& path) {
   if (p == "manifest.yaml")
     Refuse(StatusCode::INVALID_ARGUMENT, "file.path \"manifest.yaml\": is the manifest's own name");
   return p;
-}
-
-void FillSide(const reconstruction::SideOutcome& o, pattern::Side side, v1::SideSummary* out) {
-  const decoder::DecodeResult& d = o.decode;
-  out->set_side(ToProto(side));
-  out->set_junctions(static_cast<std::uint32_t>(d.junctions.size()));
-  std::uint32_t interpolated = 0;
-  for (const auto& j : d.junctions) interpolated += j.interpolated;
-  out->set_interpolated_junctions(interpolated);
-  out->set_unlabelled_junctions(static_cast<std::uint32_t>(d.unlabelled.size()));
-  out->set_lines(static_cast<std::uint32_t>(d.lines.size()));
-  out->set_q_absolute(d.q_absolute);
-  out->set_rows_note(o.rows_note);
-  out->set_repairs(static_cast<std::uint32_t>(d.repairs));
-  out->set_vertices(static_cast<std::uint32_t>(o.report.vertices));
-  out->set_triangles(static_cast<std::uint32_t>(o.report.triangles));
-  out->set_bridged_samples(static_cast<std::uint32_t>(o.report.bridged_samples));
-  out->set_label_conflicts(static_cast<std::uint32_t>(d.label_conflicts));
-  out->set_islands(static_cast<std::uint32_t>(d.islands));
-  out->set_islands_placed(static_cast<std::uint32_t>(d.islands_placed));
-  out->set_ruled_out(static_cast<std::uint32_t>(d.ruled_out));
-  out->set_dropped_samples(static_cast<std::uint32_t>(o.report.dropped_samples));
-  out->set_surface_junctions(static_cast<std::uint32_t>(o.report.junctions));
-  out->set_junctions_by_projector(static_cast<std::uint32_t>(o.report.junctions_by_projector));
 }
 
 // SHA-256 of the frame's packed pixels (width * height bytes, as the
@@ -706,7 +590,7 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ProcessFrame(
   return StartWork(context, "ProcessFrame", [this, request](Work& w) {
     // Every field is checked before any work.
     const cv::Mat grey = FrameOf(request->frame(), "frame", options_.max_frame_pixels);
-    const pattern::Side side = SideOf(request->side(), "side");
+    const pattern::Side side = contract::SideOf(request->side(), "side");
     CheckTag(request->request_tag());
     std::shared_ptr<const CachedCalibration> cal;
     if (request->calibration().source_case() != v1::CalibrationSource::SOURCE_NOT_SET)
@@ -717,7 +601,8 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ProcessFrame(
       Refuse(StatusCode::INVALID_ARGUMENT,
              "want_surface: needs a calibration (or geometric_setup, the thesis's uncalibrated "
              "height formula)");
-    reconstruction::SidePipelineParams params = SideParams(request->decode(), request->surface());
+    reconstruction::SidePipelineParams params =
+        contract::SideParams(request->decode(), request->surface());
     params.reconstruct = request->want_surface();
 
     w.observer.CheckCancelled("the decode");
@@ -740,7 +625,7 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ProcessFrame(
                  io::EncodePly(*outcome.surface, request->surface().ascii_ply()
                                                      ? io::PlyEncoding::kAscii
                                                      : io::PlyEncoding::kBinaryLittleEndian));
-    FillSide(outcome, side, w.result.add_sides());
+    contract::FillSide(outcome, side, w.result.add_sides());
     if (cal) w.result.add_calibration_ids(cal->id);
     w.result.set_request_tag(request->request_tag());
     w.result.set_frame_sha256(PackedSha256(grey));
@@ -761,19 +646,9 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ReconstructSession(
     const auto left_cal = ResolveCalibration(request->left_calibration(), "left_calibration");
     const auto right_cal = ResolveCalibration(request->right_calibration(), "right_calibration");
     session::SessionParams params;
-    params.side = SideParams({}, request->surface());
-    RequireDefined(request->join(), v1::ReconstructSessionRequest::Join_IsValid, "join");
-    switch (request->join()) {
-      case v1::ReconstructSessionRequest::JOIN_SHARED:
-        params.join = session::JoinMode::kShared;
-        break;
-      case v1::ReconstructSessionRequest::JOIN_FEATURES:
-        params.join = session::JoinMode::kFeatures;
-        break;
-      default:
-        params.join = session::JoinMode::kAuto;
-    }
-    params.measurements = PlanOf(request->measurements(), options_.max_measurements);
+    params.side = contract::SideParams({}, request->surface());
+    params.join = contract::JoinModeOf(request->join());
+    params.measurements = contract::PlanOf(request->measurements(), options_.max_measurements);
 
     const session::SessionOutcome s = session::ReconstructSession(
         left, left_cal->calibration, right, right_cal->calibration, params, w.observer);
@@ -804,8 +679,8 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ReconstructSession(
     }
     w.Artifact("surface.ply", "application/x-ply", io::EncodePly(s.joined.mesh, encoding));
 
-    FillSide(s.left, pattern::Side::kLeft, w.result.add_sides());
-    FillSide(s.right, pattern::Side::kRight, w.result.add_sides());
+    contract::FillSide(s.left, pattern::Side::kLeft, w.result.add_sides());
+    contract::FillSide(s.right, pattern::Side::kRight, w.result.add_sides());
     w.result.add_calibration_ids(left_cal->id);
     w.result.add_calibration_ids(right_cal->id);
     w.result.set_request_tag(request->request_tag());
@@ -826,7 +701,8 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::Measure(
     grpc::CallbackServerContext* context, const v1::MeasureRequest* request) {
   return StartWork(context, "Measure", [this, request](Work& w) {
     CheckTag(request->request_tag());
-    measurement::MeasurementPlan plan = PlanOf(request->measurements(), options_.max_measurements);
+    measurement::MeasurementPlan plan =
+        contract::PlanOf(request->measurements(), options_.max_measurements);
     if (plan.empty())
       Refuse(StatusCode::INVALID_ARGUMENT, "measurements: give at least one figure");
     geometry::SurfaceMesh surface;

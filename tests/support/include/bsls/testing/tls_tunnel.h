@@ -5,7 +5,8 @@
 // (bsls/testing/http2_flood.h) work on a TLS listener as on a Unix socket.
 // A tunnel ends when either side closes; the destructor ends them all.
 //
-// Thread-safety: Open from one thread at a time.
+// Thread-safety: Open may be called from several threads at once (the
+// floods open their connections from one thread each).
 #ifndef BSLS_TESTING_TLS_TUNNEL_H_
 #define BSLS_TESTING_TLS_TUNNEL_H_
 
@@ -49,6 +50,7 @@ class TlsTunnels {
   }
   ~TlsTunnels() {
     stopping_ = true;
+    const std::lock_guard<std::mutex> lock(threads_mutex_);
     for (std::thread& thread : threads_) thread.join();
   }
   TlsTunnels(const TlsTunnels&) = delete;
@@ -89,6 +91,7 @@ class TlsTunnels {
     const timeval slice{0, 20000};
     ::setsockopt(tcp, SOL_SOCKET, SO_RCVTIMEO, &slice, sizeof slice);
     ::setsockopt(tcp, SOL_SOCKET, SO_SNDTIMEO, &slice, sizeof slice);
+    const std::lock_guard<std::mutex> lock(threads_mutex_);
     threads_.emplace_back([this, ssl, tcp, inner = plain[0]] { Relay(ssl, tcp, inner); });
     return plain[1];
   }
@@ -147,6 +150,7 @@ class TlsTunnels {
   std::unique_ptr<SSL_CTX, decltype(&SSL_CTX_free)> context_;
   bool ok_ = false;
   std::atomic<bool> stopping_{false};
+  std::mutex threads_mutex_;  // guards threads_
   std::vector<std::thread> threads_;
 };
 

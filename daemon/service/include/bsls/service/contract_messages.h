@@ -1,9 +1,9 @@
-// Private to bsls::service: the daemon's one conversion between its own
-// types (cameras, frames, stored captures, times) and the contract's
-// messages (bsls/v1/capture.proto). The capture service and the processing
-// queue both build their frames here.
-#ifndef BSLS_SERVICE_SRC_CONTRACT_MESSAGES_H_
-#define BSLS_SERVICE_SRC_CONTRACT_MESSAGES_H_
+// The daemon's one conversion between its own types (cameras, frames,
+// stored captures, times) and the contract's messages
+// (bsls/v1/capture.proto). The capture service, the processing queue and
+// bslsd's device events all convert here.
+#ifndef BSLS_SERVICE_CONTRACT_MESSAGES_H_
+#define BSLS_SERVICE_CONTRACT_MESSAGES_H_
 
 #include <google/protobuf/timestamp.pb.h>
 
@@ -41,4 +41,4 @@ void FillInfo(const store::CaptureInfo& info, v1::CaptureInfo* out);
 
 }  // namespace bsls::service
 
-#endif  // BSLS_SERVICE_SRC_CONTRACT_MESSAGES_H_
+#endif  // BSLS_SERVICE_CONTRACT_MESSAGES_H_
