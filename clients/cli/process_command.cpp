@@ -10,6 +10,7 @@
 #include "bsls/calibration/calibration_file.h"
 #include "bsls/common/atomic_file.h"
 #include "bsls/contract/frame_message.h"
+#include "bsls/contract/processing_messages.h"
 #include "bsls/io/frame_file.h"
 #include "bsls/pattern/brick_pattern.h"
 #include "command.h"
@@ -68,7 +69,7 @@ v1::ProcessFrameRequest ProcessRequest(const ProcessOptions& o, pattern::Side si
     std::cerr << "bsls: note: " << o.image << ": " << conversion.Describe() << "\n";
   v1::ProcessFrameRequest request;
   contract::ToFrameMessage(frame, request.mutable_frame());
-  request.set_side(side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
+  request.set_side(contract::ToProto(side));
   if (!o.calibration.empty())
     *request.mutable_calibration() =
         processing::ProcessingClient::Inline(ReadCalibrationFile(o.calibration, "--calibration"));

@@ -12,6 +12,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <thread>
 
+#include "bsls/contract/processing_messages.h"
 #include "bsls/decoder/decode_output.h"
 #include "bsls/decoder/decoder.h"
 #include "bsls/io/surface_file.h"
@@ -29,7 +30,7 @@ using grpc::StatusCode;
 v1::ProcessFrameRequest FaceRequest(pattern::Side side, bool with_calibration) {
   v1::ProcessFrameRequest request;
   *request.mutable_frame() = FrameMessage(FaceFrame(side));
-  request.set_side(side == pattern::Side::kLeft ? v1::SIDE_LEFT : v1::SIDE_RIGHT);
+  request.set_side(contract::ToProto(side));
   if (with_calibration) {
     *request.mutable_calibration() = ProcessingClient::Inline(CalibrationYaml(side));
     request.set_want_surface(true);
