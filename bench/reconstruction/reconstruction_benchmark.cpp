@@ -152,7 +152,7 @@ void BM_FullBothSides(benchmark::State& state) {
   // session uses for a surface, side by side (as it runs them) and one after
   // the other, in this run.
   bsls::decoder::DecodeParams decode = params.side.decode;
-  decode.chain = bsls::decoder::DecodeChain::kSkeleton;  // the session's for a surface
+  decode.chain = bsls::decoder::DecodeChain::kTracks;  // the session's, as ProcessSide sets it
   decode.chain = *bsls::decoder::ChainFor(params.side.chain, decode, nullptr);
   decode.measure_ahead = false;  // each side has a core of its own
   std::vector<double> decode_ms, serial_decode_ms;

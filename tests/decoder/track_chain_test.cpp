@@ -36,6 +36,37 @@ TEST(TrackChain, TheResultDoesNotDependOnTheThreadCount) {
   for (size_t i = 0; i < one.lines.size(); ++i) EXPECT_EQ(one.lines[i].points, two.lines[i].points);
 }
 
+// A line broken at a junction whose label cannot be proven, where it goes
+// on as the same line across the break (line 0 at the lips' fold on the
+// thesis face), keeps its rows beside that junction: the surface and the
+// join's mouth profile need them.
+TEST(TrackChain, ALineKeepsItsRowsAcrossAnUnprovenJunctionBetweenTwoOfItsStretches) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 4);
+  const DecodeResult r = Decode(frame.image, Side::kLeft, TrackChain());
+  ASSERT_TRUE(r.ok) << r.error;
+  const auto zero =
+      std::find_if(r.lines.begin(), r.lines.end(), [](const DecodedLine& l) { return l.p == 0; });
+  ASSERT_NE(zero, r.lines.end());
+  // Line 0's x by row, and the unlabelled junctions lying on it with
+  // centres of it a whole row spacing above and below.
+  std::vector<double> x_of_row(frame.image.rows, -1.0);
+  for (const cv::Point2d& c : zero->points) x_of_row[static_cast<int>(std::lround(c.y))] = c.x;
+  const double spacing = 0.5 * frame.image.rows / 20.0;  // rows, about a brick row here
+  int between = 0;
+  for (const UnlabelledJunction& u : r.unlabelled) {
+    const int y = static_cast<int>(std::lround(u.position.y));
+    const int above = y - static_cast<int>(spacing), below = y + static_cast<int>(spacing);
+    if (above < 0 || below >= frame.image.rows || x_of_row[above] < 0 || x_of_row[below] < 0)
+      continue;
+    if (std::abs(u.position.x - 0.5 * (x_of_row[above] + x_of_row[below])) > 12.0) continue;
+    ++between;
+    for (int row = y - 2; row <= y + 2; ++row)
+      EXPECT_GE(x_of_row[row], 0.0) << "line 0 has no centre in row " << row
+                                    << " beside the unproven junction at " << u.position;
+  }
+  EXPECT_GE(between, 1) << "the frame no longer shows the case";
+}
+
 TEST(TrackChain, FrameWithoutReferenceLineIsReportedNotGuessed) {
   simulator::ThesisSceneOptions options;
   options.reference_cross = true;

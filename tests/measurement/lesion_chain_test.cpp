@@ -51,13 +51,14 @@ struct Lesion {
   // Share of the region the measured surface covers today, less a margin
   // of about a point for other machines' floating point (OpenCV's SIMD
   // paths differ in the last bits): a floor that keeps what the decoder
-  // reaches; the whole region is lit and seen. The lump: 73.1 % since
-  // surfaces take only labels the track chain proves (2026-11-29,
-  // decoder::KeepProvenLabels: the last rows of lines 9-13 on its steep
-  // lower skirt are seen by the skeleton chain alone, or left unlabelled by
-  // the track chain, and are no longer reported); 88.4 % before, when the
-  // skeleton chain's labels went unproven (the same chain put wrong labels
-  // on the outside corpus's ramps and cavity, docs/decoding.md).
+  // reaches; the whole region is lit and seen. The lump: 69.6 % since
+  // surfaces are decoded by the track chain alone (2026-11-30, issue 25
+  // part 1: one chain); 73.1 % while the skeleton chain's junctions and
+  // lines were kept under the labels the track chain proved, 88.4 % before
+  // that, when the skeleton chain's labels went unproven (the same chain put
+  // wrong labels on the outside corpus's ramps and cavity,
+  // docs/decoding.md). What is left out: the last rows of lines 9-13 on its
+  // steep lower skirt, whose junctions the track chain sees but cannot prove.
   double min_coverage;
   // The region is covered enough for its measure without filling holes to
   // meet the acceptance both ways; else (the lump) only filling does, and
@@ -71,7 +72,7 @@ struct Lesion {
 const Lesion kLesions[] = {
     {"cheek lump",
      {.centre_xy_mm = {-42.0, -32.0}, .height_mm = 15.0, .radius_mm = 30.0, .top_radius_mm = 12.0},
-     0.72,
+     0.68,
      false},
     {"forehead cavity",
      {.centre_xy_mm = {-28.0, 50.0}, .height_mm = -15.0, .radius_mm = 28.0, .top_radius_mm = 11.0},
@@ -290,10 +291,10 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
   }
   // The lump through a perfect decode of the same frames: what any decoder
   // could give the rest of the chain (its baseline scan decoded perfectly
-  // too). Its surface covers 93.6 % of the region; the decoder's (73.1 %)
+  // too). Its surface covers 93.6 % of the region; the decoder's (69.6 %)
   // loses the last rows of lines 9-13 on the lower outer skirt, which lean
   // 60-75 degrees there (docs/measurement.md) and whose labels the track
-  // chain does not prove (Lesion::min_coverage), and is held within 22
+  // chain does not prove (Lesion::min_coverage), and is held within 25
   // points of it.
   double default_coverage[2] = {0.0, 0.0};  // the lump's: decoder, perfect decode
   {
@@ -307,7 +308,7 @@ TEST_F(LesionChain, ThesisLesionsMeasuredThroughTheWholeChain) {
     EXPECT_LT(std::abs(e.area_relative), kAreaRelativeTolerance);
     EXPECT_LT(std::abs(e.volume_relative), kVolumeRelativeTolerance);
     EXPECT_LE(lump->surface_coverage, best.surface_coverage + 0.01);
-    EXPECT_GE(lump->surface_coverage, best.surface_coverage - 0.22);
+    EXPECT_GE(lump->surface_coverage, best.surface_coverage - 0.25);
     default_coverage[0] = lump->surface_coverage;
     default_coverage[1] = best.surface_coverage;
   }

@@ -131,13 +131,26 @@ TrackCentres MeasureTrack(const cv::Mat& grey, const interpretation::TrackNetwor
 // edge into another line or into a region whose labels could not be
 // proven, and its centres from half a row spacing past its last junction
 // of p (or that junction, if nearer) on are dropped. A junction not
-// labelled p between two of p is a stray segment end and cuts nothing, and
+// labelled p between two of p is a stray segment end and cuts nothing, so
+// is one beyond the track's last junction of p where the track across the
+// gap below holds junctions of p (and the same above: the lips' fold on
+// line 0, where the line breaks at an unproven junction and goes on), and
 // a track that runs on with no junction keeps its centres. The measured
 // centres stay: they still place the line's junctions.
 void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
                        const interpretation::TrackLabels& labels, int t, TrackCentres* c) {
   const int p = labels.line_p[t];
   const double reach = labels.row_spacing > 0 ? 0.5 * labels.row_spacing : 0.0;
+  auto holds_p = [&](int track) {
+    if (track < 0 || labels.line_p[track] != p) return false;
+    const std::vector<int>& on = net.junctions_on_line[track];
+    return std::any_of(on.begin(), on.end(), [&](int j) { return labels.p[j] == p; });
+  };
+  // The line goes on as p across its gap below (above): a junction not
+  // labelled p between there and the track's own junctions of p lies
+  // between two of p.
+  const bool p_below = holds_p(net.line_below[t]);
+  const bool p_above = holds_p(net.line_above[t]);
   double first = INFINITY, last = -INFINITY;  // rows of its junctions of p
   const std::vector<int>& on = net.junctions_on_line[t];
   for (int j : on)
@@ -149,8 +162,8 @@ void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
   for (int j : on) {
     if (labels.p[j] == p) continue;
     const double y = net.junctions[j].position.y;
-    if (y > last) to = std::min(to, std::min(y, last + reach));
-    if (y < first) from = std::max(from, std::max(y, first - reach));
+    if (y > last && !p_below) to = std::min(to, std::min(y, last + reach));
+    if (y < first && !p_above) from = std::max(from, std::max(y, first - reach));
   }
   for (size_t k = 0; k < c->output.size(); ++k) {
     const double y = c->first_row + static_cast<double>(k);

@@ -15,8 +15,8 @@ bool SidePipelineParams::IsValid(std::string* error) const {
     if (error) *error = "SidePipelineParams.chain: " + why;
     return false;
   }
-  return decode.IsValid(error) && proof.IsValid(error) && reconstruction.IsValid(error) &&
-         rows.IsValid(error) && islands.IsValid(error);
+  return decode.IsValid(error) && reconstruction.IsValid(error) && rows.IsValid(error) &&
+         islands.IsValid(error);
 }
 
 SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeometry& geometry,
@@ -36,26 +36,14 @@ SideOutcome ProcessSide(const cv::Mat& grey, pattern::Side side, const SideGeome
                                   std::to_string(grey.cols) + "x" + std::to_string(grey.rows));
   }
 
-  // The chain: the one named, else for a surface the skeleton chain's
-  // geometry under the labels the track chain proves, and the track chain
-  // for labels alone.
-  const bool surface = params.reconstruct && !std::holds_alternative<std::monostate>(geometry);
+  // The chain: the one named, else the track chain (the skeleton chain
+  // where `decode` asks for its own options).
   decoder::DecodeParams decode = params.decode;
   if (calibration) decode.geometry = LabelGeometryOfCalibration(**calibration, params.islands);
   decode.chain = decoder::DecodeChain::kTracks;
-  // The thesis's extraction or no repair: the skeleton chain's own options.
-  const bool skeleton_options =
-      decoder::ChainFor(std::nullopt, decode, nullptr) == decoder::DecodeChain::kSkeleton;
-  decode.chain = surface ? decoder::DecodeChain::kSkeleton : decoder::DecodeChain::kTracks;
   decode.chain = *decoder::ChainFor(params.chain, decode, nullptr);  // checked by IsValid
   SideOutcome outcome;
   outcome.decode = decoder::Decode(grey, side, decode, cancel);
-  if (surface && !params.chain && !skeleton_options) {
-    decoder::DecodeParams proof = decode;
-    proof.chain = decoder::DecodeChain::kTracks;
-    outcome.decode = decoder::KeepProvenLabels(
-        outcome.decode, decoder::Decode(grey, side, proof, cancel), params.proof, &outcome.proof);
-  }
   if (!outcome.decode.ok) return outcome;
   if (calibration) {
     if (const auto offset =

@@ -16,7 +16,6 @@
 
 #include "bsls/calibration/side_calibration.h"
 #include "bsls/decoder/decoder.h"
-#include "bsls/decoder/label_proof.h"
 #include "bsls/geometry/surface_mesh.h"
 #include "bsls/reconstruction/calibrated_model.h"
 #include "bsls/reconstruction/island_placement.h"
@@ -28,17 +27,13 @@ struct SidePipelineParams {
   // q_offset must stay unset: the calibration fixes it. Its `chain` is
   // replaced by the one below.
   decoder::DecodeParams decode;
-  // The chain that decodes (decoder::ChainFor). nullopt: where a surface is
-  // reconstructed, the skeleton chain's junctions and lines under the
-  // labels the track chain proves (decoder::KeepProvenLabels, with `proof`);
-  // where only the labels are wanted, the track chain. The skeleton chain
-  // keeps more of the steep lines on a lump's skirts and places junctions
-  // closer; the track chain never reports a label it cannot prove
-  // (docs/decoding.md, "Which chain"). A chain named here, or the skeleton
-  // chain's own options in `decode` (the thesis's extraction, no repair),
-  // decode alone.
+  // The chain that decodes (decoder::ChainFor). nullopt: the track chain,
+  // for labels and surfaces alike (it reports no label it cannot prove;
+  // docs/decoding.md, "Which chain"), or the skeleton chain where `decode`
+  // asks for its own options (the thesis's extraction, no repair). The
+  // skeleton chain is the thesis's reference, named here or by those
+  // options.
   std::optional<decoder::DecodeChain> chain;
-  decoder::LabelProofParams proof;
   ReconstructionParams reconstruction;
   PlaneModelKind planes = PlaneModelKind::kPerspective;
   SlideRowParams rows;
@@ -61,9 +56,6 @@ struct SideOutcome {
   // Why the rows stayed relative although a calibration was given (empty
   // when they are absolute or no calibration was given).
   std::string rows_note;
-  // Where the skeleton chain's labels were proven by the track chain's:
-  // what was kept (SidePipelineParams::chain).
-  decoder::LabelProofReport proof;
   std::optional<geometry::SurfaceMesh> surface;  // when reconstructed
   ReconstructionReport report;
 };
