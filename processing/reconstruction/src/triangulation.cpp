@@ -42,6 +42,40 @@ void DeviceRows(const geometry::PinholeModel& device, const Eigen::Vector2d& nor
   }
 }
 
+// Thesis eq. 2.18 on ideal normalised coordinates of both devices (their
+// undistortion done once by the caller): IntersectCameraAndProjectorRays.
+// Each pass solves the 3 x 3 normal equations of the four rows (the rays
+// are checked to cross at an angle first, so they are well conditioned).
+std::optional<Eigen::Vector3d> IntersectNormalised(const geometry::PinholeModel& camera,
+                                                   const Eigen::Vector2d& camera_n,
+                                                   const geometry::PinholeModel& projector,
+                                                   const Eigen::Vector2d& projector_n) {
+  auto direction = [](const geometry::PinholeModel& device, const Eigen::Vector2d& n) {
+    return (device.pose().rotation.transpose() * Eigen::Vector3d(n.x(), n.y(), 1.0)).normalized();
+  };
+  if (direction(camera, camera_n).cross(direction(projector, projector_n)).norm() < kMinRaySine)
+    return std::nullopt;
+  // A row's residual is the normalised error times the point's depth in
+  // that device; dividing by the depth (from the previous solve, 1 at
+  // first) makes it a distance in mm, so that both rays weigh alike. Two
+  // reweighted solves settle the depths to far below a micron.
+  double camera_depth = 1.0, projector_depth = 1.0;
+  Eigen::Vector3d x = Eigen::Vector3d::Zero();
+  for (int pass = 0; pass < 3; ++pass) {
+    Eigen::Matrix<double, 4, 3> a;
+    Eigen::Vector4d b;
+    DeviceRows(camera, camera_n, pass == 0 ? 1.0 : 1.0 / camera_depth, &a, &b, 0);
+    DeviceRows(projector, projector_n, pass == 0 ? 1.0 : 1.0 / projector_depth, &a, &b, 2);
+    const Eigen::Matrix3d normal = a.transpose() * a;
+    x = normal.ldlt().solve(a.transpose() * b);
+    camera_depth = (camera.pose().rotation * x + camera.pose().translation).z();
+    projector_depth = (projector.pose().rotation * x + projector.pose().translation).z();
+    if (!(camera_depth > 0.0) || !(projector_depth > 0.0)) return std::nullopt;
+  }
+  if (!x.allFinite()) return std::nullopt;
+  return x;
+}
+
 }  // namespace
 
 LightPlaneFunction LightPlanesOfProjector(const geometry::PinholeModel& projector,
@@ -172,29 +206,8 @@ std::optional<Eigen::Vector3d> GeometricHeightPoint(const GeometricSetupParams& 
 std::optional<Eigen::Vector3d> IntersectCameraAndProjectorRays(
     const geometry::PinholeModel& camera, const Eigen::Vector2d& image_px,
     const geometry::PinholeModel& projector, const Eigen::Vector2d& slide_st) {
-  const geometry::Ray camera_ray = camera.BackProject(image_px);
-  const geometry::Ray projector_ray = projector.BackProject(slide_st);
-  if (camera_ray.direction.cross(projector_ray.direction).norm() < kMinRaySine) return std::nullopt;
-  const Eigen::Vector2d camera_n = camera.Undistort(image_px);
-  const Eigen::Vector2d projector_n = projector.Undistort(slide_st);
-  // Thesis eq. 2.18. A row's residual is the normalised error times the
-  // point's depth in that device; dividing by the depth (from the previous
-  // solve, 1 at first) makes it a distance in mm, so that both rays weigh
-  // alike. Two reweighted solves settle the depths to far below a micron.
-  double camera_depth = 1.0, projector_depth = 1.0;
-  Eigen::Vector3d x = Eigen::Vector3d::Zero();
-  for (int pass = 0; pass < 3; ++pass) {
-    Eigen::Matrix<double, 4, 3> a;
-    Eigen::Vector4d b;
-    DeviceRows(camera, camera_n, pass == 0 ? 1.0 : 1.0 / camera_depth, &a, &b, 0);
-    DeviceRows(projector, projector_n, pass == 0 ? 1.0 : 1.0 / projector_depth, &a, &b, 2);
-    x = a.colPivHouseholderQr().solve(b);
-    camera_depth = (camera.pose().rotation * x + camera.pose().translation).z();
-    projector_depth = (projector.pose().rotation * x + projector.pose().translation).z();
-    if (!(camera_depth > 0.0) || !(projector_depth > 0.0)) return std::nullopt;
-  }
-  if (!x.allFinite()) return std::nullopt;
-  return x;
+  return IntersectNormalised(camera, camera.Undistort(image_px), projector,
+                             projector.Undistort(slide_st));
 }
 
 Triangulator::Triangulator(TriangulationModel model) : model_(std::move(model)) {
@@ -292,8 +305,12 @@ std::optional<TriangulatedPoint> Triangulator::Junction(int p, int q,
   const geometry::PinholeModel& projector =
       *std::get<CalibratedGeometry>(model_.geometry).projector;
   const Eigen::Vector2d slide = calibration::SlideOfJunction(model_.side, p, q);
+  // Each device's point undistorted once; the steps below move one of them.
+  const Eigen::Vector2d camera_n = camera_.Undistort(image_px);
+  const Eigen::Vector2d projector_n = projector.Undistort(slide);
   const auto solve = [&](const Eigen::Vector2d& image, const Eigen::Vector2d& st) {
-    return IntersectCameraAndProjectorRays(camera_, image, projector, st);
+    return IntersectNormalised(camera_, image == image_px ? camera_n : camera_.Undistort(image),
+                               projector, st == slide ? projector_n : projector.Undistort(st));
   };
   const std::optional<Eigen::Vector3d> point = solve(image_px, slide);
   if (!point) return std::nullopt;
