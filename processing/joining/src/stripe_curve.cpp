@@ -40,7 +40,22 @@ StripeCurve StripeCurve::FromMesh(const geometry::SurfaceMesh& mesh, int p, doub
   for (std::size_t i = 0; i + 1 < curve.points_.size(); ++i) {
     curve.joined_.push_back((curve.points_[i + 1] - curve.points_[i]).norm() <= max_gap_mm);
   }
+  curve.ComputeBounds();
   return curve;
+}
+
+void StripeCurve::ComputeBounds() {
+  bounds_.clear();
+  for (std::size_t first = 0; first + 1 < points_.size(); first += kChunk) {
+    const std::size_t last = std::min(first + kChunk, points_.size() - 1);
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (std::size_t i = first; i <= last; ++i) centre += points_[i];
+    centre /= static_cast<double>(last - first + 1);
+    double radius = 0.0;
+    for (std::size_t i = first; i <= last; ++i)
+      radius = std::max(radius, (points_[i] - centre).norm());
+    bounds_.push_back({centre, radius});
+  }
 }
 
 std::optional<CurvePoint> StripeCurve::Closest(const Eigen::Vector3d& query,
@@ -48,17 +63,24 @@ std::optional<CurvePoint> StripeCurve::Closest(const Eigen::Vector3d& query,
   double best = std::numeric_limits<double>::infinity();
   std::size_t best_segment = 0;
   double best_s = 0.0;
-  for (std::size_t i = 0; i + 1 < points_.size(); ++i) {
-    if (!joined_[i]) continue;
-    const Eigen::Vector3d d = points_[i + 1] - points_[i];
-    const double length2 = d.squaredNorm();
-    const double s =
-        length2 > 0.0 ? std::clamp((query - points_[i]).dot(d) / length2, 0.0, 1.0) : 0.0;
-    const double distance = (points_[i] + s * d - query).squaredNorm();
-    if (distance < best) {
-      best = distance;
-      best_segment = i;
-      best_s = s;
+  for (std::size_t c = 0; c < bounds_.size(); ++c) {
+    // No point of the chunk's segments lies nearer than this: skipping it
+    // changes nothing (a tie keeps the earlier segment either way).
+    const double lower = (query - bounds_[c].centre).norm() - bounds_[c].radius;
+    if (lower > max_distance_mm || (lower > 0.0 && lower * lower >= best)) continue;
+    const std::size_t end = std::min((c + 1) * kChunk, points_.size() - 1);
+    for (std::size_t i = c * kChunk; i < end; ++i) {
+      if (!joined_[i]) continue;
+      const Eigen::Vector3d d = points_[i + 1] - points_[i];
+      const double length2 = d.squaredNorm();
+      const double s =
+          length2 > 0.0 ? std::clamp((query - points_[i]).dot(d) / length2, 0.0, 1.0) : 0.0;
+      const double distance = (points_[i] + s * d - query).squaredNorm();
+      if (distance < best) {
+        best = distance;
+        best_segment = i;
+        best_s = s;
+      }
     }
   }
   if (!std::isfinite(best) || std::sqrt(best) > max_distance_mm) return std::nullopt;
@@ -82,6 +104,7 @@ StripeCurve StripeCurve::Transformed(const Eigen::Isometry3d& transform) const {
   StripeCurve moved = *this;
   for (Eigen::Vector3d& p : moved.points_) p = transform * p;
   for (Eigen::Vector3d& n : moved.normals_) n = transform.linear() * n;
+  moved.ComputeBounds();
   return moved;
 }
 

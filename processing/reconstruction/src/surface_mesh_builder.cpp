@@ -73,6 +73,7 @@ struct StripInput {
   const MeshParams& params;
 
   double Length(int a, int b) const { return (pos[a] - pos[b]).norm(); }
+  double SquaredLength(int a, int b) const { return (pos[a] - pos[b]).squaredNorm(); }
 };
 
 // Thesis 5.2.1: the quads of samples on the same rows, split along the
@@ -149,14 +150,16 @@ std::vector<double> NearestAcross(const StripInput& in, int first, int count, in
   int k = 0;
   for (int i = 0; i < count; ++i) {
     const int v = first + i;
-    while (k + 1 < to_count && in.Length(v, to_first + k + 1) <= in.Length(v, to_first + k)) ++k;
-    while (k > 0 && in.Length(v, to_first + k - 1) < in.Length(v, to_first + k)) --k;
-    double best = in.Length(v, to_first + k);
+    // Compared squared: the nearest is the same, one root taken.
+    auto d2 = [&](int w) { return in.SquaredLength(v, to_first + w); };
+    while (k + 1 < to_count && d2(k + 1) <= d2(k)) ++k;
+    while (k > 0 && d2(k - 1) < d2(k)) --k;
+    double best = d2(k);
     int best_k = k;
     for (int w = std::max(0, k - kWindow); w <= std::min(to_count - 1, k + kWindow); ++w)
-      if (const double d = in.Length(v, to_first + w); d < best) best = d, best_k = w;
+      if (const double d = d2(w); d < best) best = d, best_k = w;
     k = best_k;
-    nearest[static_cast<std::size_t>(i)] = best;
+    nearest[static_cast<std::size_t>(i)] = std::sqrt(best);
   }
   return nearest;
 }

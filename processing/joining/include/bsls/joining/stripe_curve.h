@@ -58,6 +58,16 @@ class StripeCurve {
   std::vector<Eigen::Vector3d> normals_;  // empty: unknown
   std::vector<int> vertices_;
   std::vector<char> joined_;  // size() - 1 entries (0 when empty)
+  // Spheres around runs of kChunk segments (chunk c: points c * kChunk ..
+  // (c + 1) * kChunk), so that Closest skips the runs that cannot hold a
+  // nearer point.
+  static constexpr std::size_t kChunk = 16;
+  struct Bound {
+    Eigen::Vector3d centre;
+    double radius;
+  };
+  std::vector<Bound> bounds_;
+  void ComputeBounds();
 };
 
 // Unit vertex normals of `mesh`: its own when present, else area-weighted from
