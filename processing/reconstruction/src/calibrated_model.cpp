@@ -96,9 +96,14 @@ bool SlideRowParams::IsValid(std::string* error) const {
 // (thesis eq. 2.16) says which slide row each seen junction came from.
 std::optional<SlidePoint> JunctionOnSlide(const calibration::SideCalibration& calibration,
                                           const cv::Point2d& image, int p) {
+  return JunctionOnSlide(calibration, calibration.camera.model.BackProject({image.x, image.y}), p);
+}
+
+std::optional<SlidePoint> JunctionOnSlide(const calibration::SideCalibration& calibration,
+                                          const geometry::Ray& ray, int p) {
   if (!calibration.projector_matrix) return std::nullopt;
   const calibration::LightPlane plane = calibration.perspective.model.PlaneOfLine(p);
-  const auto world = plane.Intersect(calibration.camera.model.BackProject({image.x, image.y}));
+  const auto world = plane.Intersect(ray);
   if (!world) return std::nullopt;
   const auto slide = calibration.projector_matrix->model.Project(*world);
   if (!slide) return std::nullopt;

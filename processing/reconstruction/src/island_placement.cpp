@@ -49,19 +49,22 @@ class EpipolarGeometry final : public decoder::LabelGeometry {
   std::vector<char> RuleOut(const std::vector<decoder::FramedJunction>& labelled) const override;
 
  private:
-  // The slide row of the junction at `image` on the light plane of line p,
-  // and whether that point lies in the measuring volume; nullopt where the
+  // The slide row of the junction on camera ray `ray` on the light plane of
+  // line p, and whether that point lies in the measuring volume; nullopt where the
   // ray misses the plane or the projector.
-  std::optional<std::pair<double, bool>> SlideRow(const cv::Point2d& image, int p) const;
-  // Whether the junction at `image`, labelled (p, q), misses its slide row
+  std::optional<std::pair<double, bool>> SlideRow(const geometry::Ray& ray, int p) const;
+  // The camera rays through the junctions of `island`, in its order.
+  std::vector<geometry::Ray> Rays(const std::vector<decoder::FramedJunction>& island) const;
+  // Whether the junction on camera ray `ray`, labelled (p, q), misses its slide row
   // under `offset` (slide row = q + offset) by more than max_junction_rows,
   // or cannot be placed on the slide.
-  bool OffItsRow(const cv::Point2d& image, int p, int q, int offset) const;
+  bool OffItsRow(const geometry::Ray& ray, int p, int q, int offset) const;
   // The rows of line 0's component: the even offset from its q to slide rows.
   std::optional<int> RowOffset(const std::vector<decoder::FramedJunction>& labelled,
-                               std::string* why) const;
-  // The fit of `island` shifted by dp.
-  Fit FitShift(const std::vector<decoder::FramedJunction>& island, int dp) const;
+                               const std::vector<geometry::Ray>& rays, std::string* why) const;
+  // The fit of `island` (with its camera rays) shifted by dp.
+  Fit FitShift(const std::vector<decoder::FramedJunction>& island,
+               const std::vector<geometry::Ray>& rays, int dp) const;
 
   calibration::SideCalibration calibration_;
   int lines_;
@@ -69,24 +72,35 @@ class EpipolarGeometry final : public decoder::LabelGeometry {
   double z_min_ = 0.0, z_max_ = 0.0;
 };
 
-std::optional<std::pair<double, bool>> EpipolarGeometry::SlideRow(const cv::Point2d& image,
+std::optional<std::pair<double, bool>> EpipolarGeometry::SlideRow(const geometry::Ray& ray,
                                                                   int p) const {
-  const auto on = JunctionOnSlide(calibration_, image, p);
+  const auto on = JunctionOnSlide(calibration_, ray, p);
   if (!on) return std::nullopt;
   return std::make_pair(on->slide.y(), on->world.z() >= z_min_ && on->world.z() <= z_max_);
 }
 
-bool EpipolarGeometry::OffItsRow(const cv::Point2d& image, int p, int q, int offset) const {
-  const auto row = SlideRow(image, p);
+std::vector<geometry::Ray> EpipolarGeometry::Rays(
+    const std::vector<decoder::FramedJunction>& island) const {
+  std::vector<geometry::Ray> rays;
+  rays.reserve(island.size());
+  for (const decoder::FramedJunction& j : island)
+    rays.push_back(calibration_.camera.model.BackProject({j.position.x, j.position.y}));
+  return rays;
+}
+
+bool EpipolarGeometry::OffItsRow(const geometry::Ray& ray, int p, int q, int offset) const {
+  const auto row = SlideRow(ray, p);
   return !row || std::abs(row->first - q - offset) > params_.max_junction_rows;
 }
 
 // As SlideRowOffset (calibrated_model.h), on the junctions the decoder has.
 std::optional<int> EpipolarGeometry::RowOffset(const std::vector<decoder::FramedJunction>& labelled,
+                                               const std::vector<geometry::Ray>& rays,
                                                std::string* why) const {
   std::vector<double> residue;
-  for (const decoder::FramedJunction& j : labelled)
-    if (const auto row = SlideRow(j.position, j.p)) residue.push_back(row->first - j.q);
+  for (size_t k = 0; k < labelled.size(); ++k)
+    if (const auto row = SlideRow(rays[k], labelled[k].p))
+      residue.push_back(row->first - labelled[k].q);
   if (static_cast<int>(residue.size()) < params_.min_junctions) {
     if (why)
       *why = "line 0's part has " + std::to_string(residue.size()) + " junctions on the slide";
@@ -95,13 +109,15 @@ std::optional<int> EpipolarGeometry::RowOffset(const std::vector<decoder::Framed
   return EvenRowOffset(&residue);
 }
 
-Fit EpipolarGeometry::FitShift(const std::vector<decoder::FramedJunction>& island, int dp) const {
+Fit EpipolarGeometry::FitShift(const std::vector<decoder::FramedJunction>& island,
+                               const std::vector<geometry::Ray>& rays, int dp) const {
   Fit fit;
   std::vector<double> rows;
   rows.reserve(island.size());
   int inside = 0;
-  for (const decoder::FramedJunction& j : island) {
-    const auto row = SlideRow(j.position, j.p + dp);
+  for (size_t k = 0; k < island.size(); ++k) {
+    const decoder::FramedJunction& j = island[k];
+    const auto row = SlideRow(rays[k], j.p + dp);
     if (!row) continue;
     rows.push_back(row->first - j.q);
     inside += row->second;
@@ -132,7 +148,7 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
   };
   if (static_cast<int>(island.size()) < params_.min_junctions)
     return fail("the island has " + std::to_string(island.size()) + " junctions");
-  const auto offset = RowOffset(labelled, why);
+  const auto offset = RowOffset(labelled, Rays(labelled), why);
   if (!offset) return std::nullopt;
   int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
   for (const decoder::FramedJunction& j : island) lo = std::min(lo, j.p), hi = std::max(hi, j.p);
@@ -140,8 +156,9 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
   std::optional<int> best;
   Fit best_fit;
   double rival = std::numeric_limits<double>::infinity();
+  const std::vector<geometry::Ray> rays = Rays(island);
   for (int dp = -lo; hi + dp < lines_; ++dp) {
-    const Fit fit = FitShift(island, dp);
+    const Fit fit = FitShift(island, rays, dp);
     if (std::isnan(fit.rms)) continue;
     if (!best || fit.rms < best_fit.rms) {
       if (best) rival = std::min(rival, best_fit.rms);
@@ -160,18 +177,19 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
                 std::to_string(rival) + " rows RMS)");
   decoder::LabelShift shift{*best, best_fit.dv - *offset, {}};
   shift.ruled_out.reserve(island.size());
-  for (const decoder::FramedJunction& j : island)
-    shift.ruled_out.push_back(OffItsRow(j.position, j.p + *best, j.q, best_fit.dv));
+  for (size_t k = 0; k < island.size(); ++k)
+    shift.ruled_out.push_back(OffItsRow(rays[k], island[k].p + *best, island[k].q, best_fit.dv));
   return shift;
 }
 
 std::vector<char> EpipolarGeometry::RuleOut(
     const std::vector<decoder::FramedJunction>& labelled) const {
   std::vector<char> out(labelled.size(), 0);
-  const auto offset = RowOffset(labelled, nullptr);
+  const std::vector<geometry::Ray> rays = Rays(labelled);
+  const auto offset = RowOffset(labelled, rays, nullptr);
   if (!offset) return out;
   for (size_t k = 0; k < labelled.size(); ++k)
-    out[k] = OffItsRow(labelled[k].position, labelled[k].p, labelled[k].q, *offset);
+    out[k] = OffItsRow(rays[k], labelled[k].p, labelled[k].q, *offset);
   return out;
 }
 

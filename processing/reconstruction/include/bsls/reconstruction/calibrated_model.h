@@ -78,6 +78,10 @@ struct SlidePoint {
 };
 std::optional<SlidePoint> JunctionOnSlide(const calibration::SideCalibration& calibration,
                                           const cv::Point2d& image, int p);
+// The same for the camera ray through the junction (its BackProject), when
+// one junction is tried on several lines.
+std::optional<SlidePoint> JunctionOnSlide(const calibration::SideCalibration& calibration,
+                                          const geometry::Ray& ray, int p);
 
 // The even offset nearest the median of `residues` (slide row t - q, one per
 // junction; reordered); `residues` must not be empty.
