@@ -1,6 +1,10 @@
 #include "junction_placement.h"
 
+#include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <span>
 
 #include "bsls/geometry/curve_fit.h"
 
@@ -23,10 +27,14 @@ bool DropWorstColumn(std::vector<std::pair<double, double>>& columns, double max
   const auto worst =
       std::max_element(columns.begin(), columns.end(),
                        [&](const auto& l, const auto& r) { return residual(l) < residual(r); });
-  std::vector<std::pair<double, double>> others(columns.begin(), worst);
-  others.insert(others.end(), worst + 1, columns.end());
-  if (!FitLine(others, &c, &e) || residual(*worst) <= max_residual) return false;
-  columns = std::move(others);
+  // The others in their order, then the worst: fitted without a copy.
+  std::rotate(worst, worst + 1, columns.end());
+  const std::span<const std::pair<double, double>> others(columns.data(), columns.size() - 1);
+  if (!FitLine(others, &c, &e) || residual(columns.back()) <= max_residual) {
+    std::rotate(worst, columns.end() - 1, columns.end());  // back in its place
+    return false;
+  }
+  columns.pop_back();
   return true;
 }
 
@@ -41,18 +49,29 @@ void DropOutlyingColumns(std::vector<std::pair<double, double>>& columns, double
 }  // namespace
 
 ColumnCentres ColumnCentres::Wanted(const std::vector<JunctionPlan>& plans) {
-  ColumnCentres out;
+  // Sorted as one integer each (x, then y: the pairs' order, as the
+  // columns lie in the frame, x and y >= 0).
+  std::vector<std::uint64_t> packed;
   for (const JunctionPlan& plan : plans)
-    for (const cv::Point& c : plan.columns) out.keys.emplace_back(c.x, c.y);
-  std::sort(out.keys.begin(), out.keys.end());
-  out.keys.erase(std::unique(out.keys.begin(), out.keys.end()), out.keys.end());
+    for (const cv::Point& c : plan.columns) {
+      assert(c.x >= 0 && c.y >= 0);
+      packed.push_back(static_cast<std::uint64_t>(c.x) << 32 | static_cast<std::uint32_t>(c.y));
+    }
+  std::sort(packed.begin(), packed.end());
+  packed.erase(std::unique(packed.begin(), packed.end()), packed.end());
+  ColumnCentres out;
+  out.keys.reserve(packed.size());
+  for (std::uint64_t k : packed)
+    out.keys.emplace_back(static_cast<int>(k >> 32), static_cast<int>(k & 0xffffffffu));
   out.centres.resize(out.keys.size());
   return out;
 }
 
 bool FitMeasuredSegment(const JunctionPlan& plan, const ColumnCentres& columns,
                         const DecodeParams& params, double* c, double* e) {
-  std::vector<std::pair<double, double>> measured;  // (x - a, y)
+  // (x - a, y); one buffer per thread, as this runs once or twice per junction.
+  thread_local std::vector<std::pair<double, double>> measured;
+  measured.clear();
   for (const cv::Point& s : plan.columns)
     if (const std::optional<double>& cy = columns.At(s)) measured.push_back({s.x - plan.a, *cy});
   // A column far off the line through the others is dropped: where a line
