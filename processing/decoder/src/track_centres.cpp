@@ -10,7 +10,6 @@ namespace bsls::decoder::internal {
 using geometry::FitAtZero;
 using geometry::FitLine;
 using geometry::FitParabola;
-using geometry::Sample;
 using geometry::Samples;
 
 // The (t = row - y, centre) samples of the measured centres within `reach`

@@ -11,7 +11,6 @@ namespace bsls::decoder::internal {
 
 using geometry::FitAtZero;
 using geometry::FitLine;
-using geometry::FitParabola;
 using geometry::Sample;
 using geometry::Samples;
 
