@@ -148,7 +148,11 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
   };
   if (static_cast<int>(island.size()) < params_.min_junctions)
     return fail("the island has " + std::to_string(island.size()) + " junctions");
-  const auto offset = RowOffset(labelled, Rays(labelled), why);
+  // Judging line 0's component (island == labelled), its rays serve both.
+  const std::vector<geometry::Ray> rays = Rays(island);
+  const bool same = &labelled == &island;
+  const std::vector<geometry::Ray> others = same ? std::vector<geometry::Ray>() : Rays(labelled);
+  const auto offset = RowOffset(labelled, same ? rays : others, why);
   if (!offset) return std::nullopt;
   int lo = std::numeric_limits<int>::max(), hi = std::numeric_limits<int>::min();
   for (const decoder::FramedJunction& j : island) lo = std::min(lo, j.p), hi = std::max(hi, j.p);
@@ -156,7 +160,6 @@ std::optional<decoder::LabelShift> EpipolarGeometry::PlaceIsland(
   std::optional<int> best;
   Fit best_fit;
   double rival = std::numeric_limits<double>::infinity();
-  const std::vector<geometry::Ray> rays = Rays(island);
   for (int dp = -lo; hi + dp < lines_; ++dp) {
     const Fit fit = FitShift(island, rays, dp);
     if (std::isnan(fit.rms)) continue;

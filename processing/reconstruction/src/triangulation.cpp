@@ -305,14 +305,17 @@ std::optional<TriangulatedPoint> Triangulator::Junction(int p, int q,
   const geometry::PinholeModel& projector =
       *std::get<CalibratedGeometry>(model_.geometry).projector;
   const Eigen::Vector2d slide = calibration::SlideOfJunction(model_.side, p, q);
-  // Each device's point undistorted once; the steps below move one of them.
+  // Each device's point undistorted once; each step below moves one of them.
   const Eigen::Vector2d camera_n = camera_.Undistort(image_px);
   const Eigen::Vector2d projector_n = projector.Undistort(slide);
-  const auto solve = [&](const Eigen::Vector2d& image, const Eigen::Vector2d& st) {
-    return IntersectNormalised(camera_, image == image_px ? camera_n : camera_.Undistort(image),
-                               projector, st == slide ? projector_n : projector.Undistort(st));
+  const auto moving_camera = [&](const Eigen::Vector2d& image) {
+    return IntersectNormalised(camera_, camera_.Undistort(image), projector, projector_n);
   };
-  const std::optional<Eigen::Vector3d> point = solve(image_px, slide);
+  const auto moving_projector = [&](const Eigen::Vector2d& st) {
+    return IntersectNormalised(camera_, camera_n, projector, projector.Undistort(st));
+  };
+  const std::optional<Eigen::Vector3d> point =
+      IntersectNormalised(camera_, camera_n, projector, projector_n);
   if (!point) return std::nullopt;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   const double image_sigma2 = u.junction_sigma_px * u.junction_sigma_px +
@@ -320,11 +323,11 @@ std::optional<TriangulatedPoint> Triangulator::Junction(int p, int q,
   for (int axis = 0; axis < 2; ++axis) {
     Eigen::Vector2d step = Eigen::Vector2d::Zero();
     step[axis] = kImageStepPx;
-    const auto a = solve(image_px + step, slide), b = solve(image_px - step, slide);
+    const auto a = moving_camera(image_px + step), b = moving_camera(image_px - step);
     if (a && b) AddSource((*a - *b) / (2.0 * kImageStepPx), std::sqrt(image_sigma2), &covariance);
     Eigen::Vector2d slide_step = Eigen::Vector2d::Zero();
     slide_step[axis] = kSlideStepD;
-    const auto c = solve(image_px, slide + slide_step), d = solve(image_px, slide - slide_step);
+    const auto c = moving_projector(slide + slide_step), d = moving_projector(slide - slide_step);
     if (c && d)
       AddSource((*c - *d) / (2.0 * kSlideStepD), u.projector_residual_sigma_d, &covariance);
   }
