@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "bsls/extraction/stripe_pitch.h"
+#include "missing_junctions.h"
 #include "track_centres.h"
 #include "track_geometry.h"
 #include "track_junctions.h"
@@ -17,6 +18,10 @@ namespace bsls::decoder::internal {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Working px: an unlabelled junction this near one placed from its line's
+// junctions (PlaceMissingJunctions) is that junction.
+constexpr double kSameJunction = 2.0;
 
 double MsSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -154,8 +159,13 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   result->junctions =
       PlaceTrackJunctions(working, net, labels, centres, params, scale, &result->label_conflicts);
   result->unlabelled = UnlabelledJunctions(net, labels, scale);
-  if (params.geometry) RuleOutPlaced(*params.geometry, result);
   result->lines = DecodedLines(working, net, labelled, labels, centres, working.rows, scale);
+  const interpretation::LabellingParams& missing = params.interpretation.labelling;
+  if (missing.interpolate_missing)
+    PlaceMissingJunctions(result->lines, params.spec, params.q_offset.value_or(0),
+                          missing.max_interpolated_run, kSameJunction * scale.x, &result->junctions,
+                          &result->unlabelled);
+  if (params.geometry) RuleOutPlaced(*params.geometry, result);
   result->times.subpixel_ms = MsSince(t);
   result->ok = true;
 }

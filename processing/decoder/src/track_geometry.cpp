@@ -189,6 +189,7 @@ void RuleOutPlaced(const LabelGeometry& geometry, DecodeResult* result) {
   for (size_t k = 0; k < result->junctions.size(); ++k) {
     const DecodedJunction& j = result->junctions[k];
     if (RuledOut(out, k)) {
+      if (j.interpolated) continue;  // never seen: nothing to list
       result->unlabelled.push_back({j.position, j.kind});
       ++result->ruled_out;
     } else {

@@ -270,8 +270,9 @@ void MergeLine(int p, const std::vector<LineVertex>& vertices,
                      out.vertices.end());
 }
 
-// Appends a vertex for every decoded junction that triangulates, its normal
-// from the line vertex on its row (else towards the camera); counted in r.
+// Appends a vertex for every decoded junction seen (not interpolated) that
+// triangulates, its normal from the line vertex on its row (else towards
+// the camera); counted in r.
 void AddJunctions(const decoder::DecodeResult& decode, const Triangulator& triangulator,
                   const std::vector<TriangulatedLine>& lines, geometry::SurfaceMesh& mesh,
                   ReconstructionReport& r) {
@@ -281,6 +282,9 @@ void AddJunctions(const decoder::DecodeResult& decode, const Triangulator& trian
   for (const TriangulatedLine& line : lines)
     for (const LineVertex& v : line.vertices) vertex_of[{line.p, v.row}] = index++;
   for (const decoder::DecodedJunction& j : decode.junctions) {
+    // Placed from its line's junctions (thesis 5.1.4.6), not seen: its row
+    // is no measurement, and its line's centres carry the surface there.
+    if (j.interpolated) continue;
     const Eigen::Vector2d image(j.position.x, j.position.y);
     if (!image.allFinite()) {
       ++r.dropped_junctions;
