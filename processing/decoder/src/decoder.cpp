@@ -594,7 +594,8 @@ void PlaceJunctions(const cv::Mat& grey,
       d.kind = j.kind;
       d.interpolated = j.interpolated;
       d.position = j.position;
-      if (auto refined = internal::RefineJunction(plans[i], columns, j.position.y, subpixel, n))
+      columns.Fill(&plans[i]);
+      if (auto refined = internal::RefineJunction(plans[i], j.position.y, subpixel, n))
         d.position = *refined;
     }
   });

@@ -67,13 +67,21 @@ ColumnCentres ColumnCentres::Wanted(const std::vector<JunctionPlan>& plans) {
   return out;
 }
 
-bool FitMeasuredSegment(const JunctionPlan& plan, const ColumnCentres& columns,
-                        const DecodeParams& params, double* c, double* e) {
+void ColumnCentres::Fill(JunctionPlan* plan) const {
+  plan->centres.clear();
+  plan->centres.reserve(plan->columns.size());
+  for (const cv::Point& s : plan->columns) plan->centres.push_back(At(s));
+}
+
+bool FitMeasuredSegment(const JunctionPlan& plan, const DecodeParams& params, double* c,
+                        double* e) {
+  assert(plan.centres.size() == plan.columns.size());
   // (x - a, y); one buffer per thread, as this runs once or twice per junction.
   thread_local std::vector<std::pair<double, double>> measured;
   measured.clear();
-  for (const cv::Point& s : plan.columns)
-    if (const std::optional<double>& cy = columns.At(s)) measured.push_back({s.x - plan.a, *cy});
+  for (size_t k = 0; k < plan.columns.size(); ++k)
+    if (const std::optional<double>& cy = plan.centres[k])
+      measured.push_back({plan.columns[k].x - plan.a, *cy});
   // A column far off the line through the others is dropped: where a line
   // leans towards the segment's side below or above the junction, its
   // light reaches into the column profiles nearest to it (one in a short
@@ -90,8 +98,8 @@ bool FitMeasuredSegment(const JunctionPlan& plan, const ColumnCentres& columns,
 // and fitted as y(x). An interpolated junction, or one whose segment cannot be
 // measured, is placed on the line's fit at its row. nullopt when the line has
 // too few centres near it.
-std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const ColumnCentres& columns,
-                                          double y0, const DecodeParams& params, int n) {
+std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, double y0,
+                                          const DecodeParams& params, int n) {
   if (!plan.ok) return std::nullopt;
   // How far from the skeleton's junction row the meeting point may lie.
   const double reach = params.junction_clearance + 1.0 * n;
@@ -102,7 +110,7 @@ std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const Column
     // The segment as y(x): centres column by column along its skeleton, or the
     // skeleton itself.
     double c, e;
-    bool fitted = FitMeasuredSegment(plan, columns, params, &c, &e);
+    bool fitted = FitMeasuredSegment(plan, params, &c, &e);
     if (!fitted) {
       std::vector<std::pair<double, double>> skeleton;  // (x - a, y)
       for (const cv::Point& s : plan.columns) skeleton.push_back({s.x - a, 1.0 * s.y});

@@ -30,6 +30,9 @@ struct JunctionPlan {
   // over these.
   std::vector<std::pair<double, double>> wide;
   std::vector<cv::Point> columns;  // (column, approximate row) of each centre to measure
+  // The centre measured in each of `columns` (ColumnCentres::Fill, or the
+  // track chain measuring them itself), in their order; nullopt where none.
+  std::vector<std::optional<double>> centres;
 };
 
 // Sub-pixel centres of segment columns, measured once each (a segment is
@@ -46,22 +49,23 @@ struct ColumnCentres {
     const auto it = std::lower_bound(keys.begin(), keys.end(), std::make_pair(p.x, p.y));
     return centres[static_cast<size_t>(it - keys.begin())];
   }
+  // Gives `plan` the centres measured in its columns.
+  void Fill(JunctionPlan* plan) const;
 };
 
 // The segment of `plan` as y = *c + *e (x - plan.a), fitted through its
-// columns' measured centres (those far off the others' line dropped);
-// false when fewer than two are left.
-bool FitMeasuredSegment(const JunctionPlan& plan, const ColumnCentres& columns,
-                        const DecodeParams& params, double* c, double* e);
+// columns' measured centres (plan.centres; those far off the others' line
+// dropped); false when fewer than two are left.
+bool FitMeasuredSegment(const JunctionPlan& plan, const DecodeParams& params, double* c, double* e);
 
 // The junction where the line's centre curve meets the segment's: the line's
 // measured centres near the junction fitted as x(y), the segment's centres
-// measured column by column along its skeleton (plan.columns, from `columns`)
+// measured column by column along its skeleton (plan.columns, plan.centres)
 // and fitted as y(x). An interpolated junction, or one whose segment cannot be
 // measured, is placed on the line's fit at its row. nullopt when the line has
 // too few centres near it.
-std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, const ColumnCentres& columns,
-                                          double y0, const DecodeParams& params, int n);
+std::optional<cv::Point2d> RefineJunction(const JunctionPlan& plan, double y0,
+                                          const DecodeParams& params, int n);
 
 }  // namespace bsls::decoder::internal
 

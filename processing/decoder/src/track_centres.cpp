@@ -145,6 +145,7 @@ void KeepRowsOfItsLine(const interpretation::TrackNetwork& net,
 // (row - y0, x) pairs.
 std::vector<std::pair<double, double>> CentresNear(const TrackCentres& line, double y0, int reach) {
   std::vector<std::pair<double, double>> out;
+  out.reserve(2 * static_cast<size_t>(reach) + 1);
   for (int r = static_cast<int>(std::ceil(y0 - reach)); r <= y0 + reach; ++r)
     if (const double x = line.Measured(r); !std::isnan(x)) out.emplace_back(r - y0, x);
   return out;

@@ -48,6 +48,7 @@ JunctionPlan PlanTrackJunction(const interpretation::TrackNetwork& net, int j,
     if (plan.vertical.size() < 3 || !FitLine(plan.vertical, &plan.a, &plan.b)) return plan;
   }
   plan.ok = true;
+  plan.columns.reserve(static_cast<size_t>(params.track_chain.segment_columns));
   const auto& seg = net.segments[junction.segment].points;
   const auto& cp = net.columns.points;  // x: image row, y: image column
   const int n = static_cast<int>(seg.size());
@@ -86,7 +87,7 @@ bool StraightThrough(const JunctionPlan& plan, const DecodeParams& params) {
 // straight line y(x) and met with the line's centres fitted as x(y).
 cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwork& net, int j,
                           const TrackCentres& line, const JunctionPlan& plan,
-                          const ColumnCentres& measured, const DecodeParams& params) {
+                          const DecodeParams& params) {
   const interpretation::TrackJunction& junction = net.junctions[j];
   cv::Point2d at = junction.position;
   const int fit_rows = params.junction_fit_rows;
@@ -124,7 +125,7 @@ cv::Point2d PlaceJunction(const cv::Mat& grey, const interpretation::TrackNetwor
   };
   double a, b;  // the segment: y = a + b (x - x_ref)
   const double x_ref = at.x;
-  if (double c, e; plan.ok && FitMeasuredSegment(plan, measured, params, &c, &e)) {
+  if (double c, e; plan.ok && FitMeasuredSegment(plan, params, &c, &e)) {
     a = c + e * (x_ref - plan.a);
     b = e;
   } else if (!fit_nearest_columns(&a, &b)) {
@@ -235,8 +236,8 @@ std::vector<UnlabelledJunction> UnlabelledJunctions(const interpretation::TrackN
 }
 
 // The labelled junctions of the network, one per label (JunctionPerLabel),
-// placed (thesis 5.2) in the full frame: planned, their segments' columns
-// measured once each, and placed, each step in parallel.
+// placed (thesis 5.2) in the full frame: planned with their segments'
+// columns measured, then placed, each step in parallel.
 std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
                                                  const interpretation::TrackNetwork& net,
                                                  const interpretation::TrackLabels& labels,
@@ -246,15 +247,15 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
   const std::vector<int> placed = JunctionPerLabel(net, labels, conflicts);
   const cv::Range all(0, static_cast<int>(placed.size()));
   std::vector<JunctionPlan> plans(placed.size());
+  // Each plan measures its own columns: a segment's two junctions share
+  // few of them here, and gathering them once costs more than it saves.
   cv::parallel_for_(all, [&](const cv::Range& r) {
-    for (int i = r.start; i < r.end; ++i)
-      plans[i] = PlanTrackJunction(net, placed[i], centres[net.junctions[placed[i]].line], params);
-  });
-  ColumnCentres columns = ColumnCentres::Wanted(plans);
-  cv::parallel_for_(cv::Range(0, static_cast<int>(columns.keys.size())), [&](const cv::Range& r) {
     for (int i = r.start; i < r.end; ++i) {
-      const auto [x, y] = columns.keys[i];
-      columns.centres[i] = extraction::RidgeCentreInColumn(working, x, y);
+      JunctionPlan& plan = plans[i];
+      plan = PlanTrackJunction(net, placed[i], centres[net.junctions[placed[i]].line], params);
+      plan.centres.reserve(plan.columns.size());
+      for (const cv::Point& c : plan.columns)
+        plan.centres.push_back(extraction::RidgeCentreInColumn(working, c.x, c.y));
     }
   });
   const int q_offset = params.q_offset.value_or(0);
@@ -268,10 +269,9 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
       d.kind = net.junctions[j].kind;
       std::optional<cv::Point2d> at;
       if (StraightThrough(plans[i], params))
-        at = RefineJunction(plans[i], columns, net.junctions[j].position.y, params, 1);
+        at = RefineJunction(plans[i], net.junctions[j].position.y, params, 1);
       if (!at)
-        at = PlaceJunction(working, net, j, centres[net.junctions[j].line], plans[i], columns,
-                           params);
+        at = PlaceJunction(working, net, j, centres[net.junctions[j].line], plans[i], params);
       d.position = scale.ToFull(*at);
     }
   });

@@ -25,8 +25,8 @@ std::vector<UnlabelledJunction> UnlabelledJunctions(const interpretation::TrackN
                                                     const WorkingScale& scale);
 
 // The labelled junctions of the network, one per label (JunctionPerLabel),
-// placed (thesis 5.2) in the full frame: planned, their segments' columns
-// measured once each, and placed, each step in parallel.
+// placed (thesis 5.2) in the full frame: planned with their segments'
+// columns measured, then placed, each step in parallel.
 std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
                                                  const interpretation::TrackNetwork& net,
                                                  const interpretation::TrackLabels& labels,

@@ -551,9 +551,12 @@ std::vector<Track> LinkTracks(const extraction::RidgePoints& points, const Track
   for (int i = 0; i < n; ++i) {
     if (i % 8192 == 0) cancel.ThrowIfRequested(stage);
     if (prev[i] >= 0) continue;
+    int length = 0;
+    for (int k = i; k >= 0; k = next[k]) ++length;
+    if (length < params.min_track) continue;
     Track t;
+    t.points.reserve(static_cast<size_t>(length));
     for (int k = i; k >= 0; k = next[k]) t.points.push_back(k);
-    if (static_cast<int>(t.points.size()) < params.min_track) continue;
     if (track_of_point)
       for (int k : t.points) (*track_of_point)[k] = static_cast<int>(tracks.size());
     tracks.push_back(std::move(t));
