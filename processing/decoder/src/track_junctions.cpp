@@ -273,6 +273,7 @@ std::vector<DecodedJunction> PlaceTrackJunctions(const cv::Mat& working,
       if (!at)
         at = PlaceJunction(working, net, j, centres[net.junctions[j].line], plans[i], params);
       d.position = scale.ToFull(*at);
+      plans[i] = {};  // freed here, in parallel, not one by one at the end
     }
   });
   return junctions;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <span>
 #include <vector>
@@ -155,18 +156,26 @@ std::optional<double> MeasureStripePitch(const cv::Mat& grey, const StripePitchP
   else
     smoothed = sampled;
   smoothed.convertTo(smoothed, CV_32F);
-  std::vector<double> spacings, ridges;
-  for (int i = 0; i < rows; ++i) {
-    const float* r = smoothed.ptr<float>(i);
-    const double noise = RowNoise(sampled.ptr<uchar>(i), width) * kept;
-    const double least = std::max({params.min_prominence_noise * noise,
-                                   params.min_prominence_contrast * RowSpread(r, width), 1e-3});
-    RowRidges(r, width, least, reach, &ridges);
-    for (size_t k = 1; k < ridges.size(); ++k) {
-      const double s = ridges[k] - ridges[k - 1];
-      if (s >= params.min_pitch && s <= max_pitch) spacings.push_back(s);
+  // The rows are independent: in parallel, each row's spacings apart, then
+  // gathered (they are sorted next, so their order does not matter).
+  std::vector<std::vector<double>> spacings_of(rows);
+  cv::parallel_for_(cv::Range(0, rows), [&](const cv::Range& range) {
+    std::vector<double> ridges;
+    for (int i = range.start; i < range.end; ++i) {
+      const float* r = smoothed.ptr<float>(i);
+      const double noise = RowNoise(sampled.ptr<uchar>(i), width) * kept;
+      const double least = std::max({params.min_prominence_noise * noise,
+                                     params.min_prominence_contrast * RowSpread(r, width), 1e-3});
+      RowRidges(r, width, least, reach, &ridges);
+      for (size_t k = 1; k < ridges.size(); ++k) {
+        const double s = ridges[k] - ridges[k - 1];
+        if (s >= params.min_pitch && s <= max_pitch) spacings_of[i].push_back(s);
+      }
     }
-  }
+  });
+  std::vector<double> spacings;
+  for (const std::vector<double>& row : spacings_of)
+    spacings.insert(spacings.end(), row.begin(), row.end());
   if (spacings.empty()) return std::nullopt;
   std::sort(spacings.begin(), spacings.end());
   auto [first, last] = DensestCluster(spacings, params.cluster_spread);

@@ -133,17 +133,28 @@ class LeaningLines {
   LeaningLines(const TrackParams& params, TrackNetwork* net)
       : params_(params), net_(*net), typical_(TypicalSegmentSlope(*net)) {
     const int rows = Rows();
-    by_row_.resize(rows);
+    // The column points by row, counted first and then placed, each row's
+    // in the order of pool, track and point.
+    row_start_.assign(static_cast<size_t>(rows) + 1, 0);
+    auto each_place = [&](const auto& visit) {
+      for (int pool = 0; pool < 2; ++pool)
+        for (int t = 0; t < static_cast<int>(Pool(pool).size()); ++t) {
+          const std::vector<int>& pts = Pool(pool)[t].points;
+          for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
+            const int y = static_cast<int>(std::lround(ColumnPoint(net_, pts[i]).y));
+            if (y >= 0 && y < rows) visit(y, ColumnPlace{pool, t, i});
+          }
+        }
+    };
+    each_place([&](int y, const ColumnPlace&) { ++row_start_[y + 1]; });
+    for (int y = 0; y < rows; ++y) row_start_[y + 1] += row_start_[y];
+    places_.resize(static_cast<size_t>(row_start_[rows]));
+    std::vector<int> filled(row_start_.begin(), row_start_.end() - 1);
+    each_place([&](int y, const ColumnPlace& c) { places_[filled[y]++] = c; });
     for (int pool = 0; pool < 2; ++pool) {
       used_[pool].resize(Pool(pool).size());
-      for (int t = 0; t < static_cast<int>(Pool(pool).size()); ++t) {
-        const std::vector<int>& pts = Pool(pool)[t].points;
-        used_[pool][t].assign(pts.size(), 0);
-        for (int i = 0; i < static_cast<int>(pts.size()); ++i) {
-          const int y = static_cast<int>(std::lround(ColumnPoint(net_, pts[i]).y));
-          if (y >= 0 && y < rows) by_row_[y].push_back({pool, t, i});
-        }
-      }
+      for (int t = 0; t < static_cast<int>(Pool(pool).size()); ++t)
+        used_[pool][t].assign(Pool(pool)[t].points.size(), 0);
     }
     starting_.resize(rows);
     for (int t = 0; t < static_cast<int>(net_.lines.size()); ++t)
@@ -191,7 +202,14 @@ class LeaningLines {
   void RemoveFollowedPieces() {
     for (int pool = 0; pool < 2; ++pool) {
       std::vector<Track> kept;
+      kept.reserve(Pool(pool).size());
       for (size_t t = 0; t < Pool(pool).size(); ++t) {
+        const std::vector<char>& used = used_[pool][t];
+        if (std::find(used.begin(), used.end(), 1) == used.end() &&
+            static_cast<int>(used.size()) >= params_.min_track) {  // untouched: kept whole
+          kept.push_back(std::move(Pool(pool)[t]));
+          continue;
+        }
         const std::vector<int>& pts = Pool(pool)[t].points;
         for (size_t i = 0; i < pts.size();) {
           Track piece;
@@ -236,7 +254,8 @@ class LeaningLines {
     double least_turn = kMaxTurnDeg;
     const int y_at = static_cast<int>(at.y), reach_y = static_cast<int>(std::ceil(reach));
     for (int y = std::max(0, y_at - reach_y); y <= std::min(Rows() - 1, y_at + reach_y); ++y)
-      for (const ColumnPlace& c : by_row_[y]) {
+      for (int k = row_start_[y]; k < row_start_[y + 1]; ++k) {
+        const ColumnPlace& c = places_[k];
         const std::vector<int>& pts = Pool(c.pool)[c.track].points;
         const cv::Point2d q = ColumnPoint(net_, pts[c.at]);
         const std::optional<double> descent = Descent(pts, c.at, d);
@@ -301,9 +320,12 @@ class LeaningLines {
   const TrackParams& params_;
   TrackNetwork& net_;
   const double typical_;
-  std::vector<std::vector<ColumnPlace>> by_row_;  // column points of both pools by image row
-  std::vector<std::vector<int>> starting_;        // line tracks by their first row
-  std::vector<std::vector<char>> used_[2];        // per pool, track and point: followed
+  // The column points of both pools by image row: row y's are
+  // places_[row_start_[y] .. row_start_[y + 1]).
+  std::vector<int> row_start_;
+  std::vector<ColumnPlace> places_;
+  std::vector<std::vector<int>> starting_;  // line tracks by their first row
+  std::vector<std::vector<char>> used_[2];  // per pool, track and point: followed
 };
 
 // Follows every line track that leans past max_step (LeaningLines).
