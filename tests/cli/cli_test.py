@@ -659,6 +659,8 @@ class SurfaceCliTest(unittest.TestCase):
                 r = run(*args, *extra)
                 self.assertEqual(r.returncode, EXIT_OK, (where, name, r.stderr))
                 printed[name] = r.stdout
+            # The tracks are drawn where --skeleton asks for them.
+            self.assertGreater(os.path.getsize(p("s.png")), 1000, where)
             files = {}
             for f in sorted(os.listdir(self.dir.name)):
                 if f.startswith(f"one_{where}_"):

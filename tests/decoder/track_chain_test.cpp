@@ -40,6 +40,22 @@ TEST(TrackChain, TheResultDoesNotDependOnTheThreadCount) {
 // on as the same line across the break (line 0 at the lips' fold on the
 // thesis face), keeps its rows beside that junction: the surface and the
 // join's mouth profile need them.
+TEST(TrackChain, DrawsItsTracksOnlyWhenAsked) {
+  const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 1);
+  const DecodeResult plain = Decode(frame.image, Side::kLeft, TrackChain());
+  ASSERT_TRUE(plain.ok) << plain.error;
+  EXPECT_TRUE(plain.skeleton.empty());
+  DecodeParams params = TrackChain();
+  params.draw_tracks = true;
+  const DecodeResult drawn = Decode(frame.image, Side::kLeft, params);
+  ASSERT_TRUE(drawn.ok) << drawn.error;
+  ASSERT_EQ(drawn.skeleton.size(), frame.image.size());
+  EXPECT_GT(cv::countNonZero(drawn.skeleton), 5000);
+  ASSERT_EQ(drawn.junctions.size(), plain.junctions.size());
+  for (size_t k = 0; k < plain.junctions.size(); ++k)
+    EXPECT_EQ(drawn.junctions[k].position, plain.junctions[k].position);
+}
+
 TEST(TrackChain, ALineKeepsItsRowsAcrossAnUnprovenJunctionBetweenTwoOfItsStretches) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kFace, Side::kLeft, 4);
   const DecodeResult r = Decode(frame.image, Side::kLeft, TrackChain());

@@ -138,7 +138,7 @@ void DecodeByTracks(const cv::Mat& grey, pattern::Side side, const DecodeParams&
   result->label_conflicts = labels.conflicts;
   cancel.ThrowIfRequested("the labelling");
   // The tracks' ridge points, as the skeleton chain's repaired skeleton.
-  result->skeleton = DrawTracks(net, scale, grey.size(), cancel);
+  if (params.draw_tracks) result->skeleton = DrawTracks(net, scale, grey.size(), cancel);
   if (!labels.ok) {
     result->error = labels.error;
     return;

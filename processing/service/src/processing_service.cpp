@@ -604,6 +604,7 @@ grpc::ServerWriteReactor<v1::WorkEvent>* ProcessingService::ProcessFrame(
     reconstruction::SidePipelineParams params =
         contract::SideParams(request->decode(), request->surface());
     params.reconstruct = request->want_surface();
+    params.decode.draw_tracks = request->want_skeleton();
 
     w.observer.CheckCancelled("the decode");
     w.observer.Report(request->want_surface() ? "decode and reconstruct" : "decode", 0.0);

@@ -173,6 +173,11 @@ struct DecodeParams {
   // to place the parts not joined to line 0 (islands). Unset: they stay
   // unlabelled.
   std::shared_ptr<const LabelGeometry> geometry;
+  // The track chain draws its tracks into DecodeResult::skeleton (the
+  // `--skeleton` image) only when asked: nothing downstream reads it, and
+  // drawing every track costs 2 % of a decode. The skeleton chain's comes
+  // with its work, always.
+  bool draw_tracks = false;
 
   // True when every part is usable; otherwise says which and why.
   bool IsValid(std::string* error) const;
@@ -243,7 +248,8 @@ struct DecodeResult {
   int ruled_out = 0;
   std::map<interpretation::LoopClass, int> loop_classes;
   // The repaired skeleton, CV_8UC1 0/255, frame size (redrawn when binned);
-  // for the track chain, the ridge points of its line and segment tracks.
+  // for the track chain, the ridge points of its line and segment tracks,
+  // where DecodeParams::draw_tracks asks for them (else empty).
   cv::Mat skeleton;
 };
 
