@@ -195,7 +195,7 @@ TEST(Decoder, TheChinsBottomRowIsDecodedAndPlaced) {
 // A decode of a frame worked at another scale, scored against its truth:
 // labels matched within `reach` px (none wrong), line centres; checks that
 // the lines have one point per full-frame row, in order, and the skeleton
-// the frame's size.
+// (drawn: DecodeParams::draw_tracks) the frame's size.
 std::pair<simulator::LabelScore, simulator::LineScore> ScoreResizedFrame(
     const simulator::Frame& frame, const DecodeResult& r, double reach) {
   std::vector<simulator::PointLabel> decoded;
@@ -243,7 +243,9 @@ TEST_P(LargeFrame, IsBinnedAndDecodedAsWell) {
   // the 512 frames' 3 x 3 rays (and 9x quicker to render, most of this
   // test's time under the sanitizers).
   const simulator::Frame frame = FaceOfSize(kSize, Side::kRight, 1);
-  const DecodeResult r = Decode(frame.image, Side::kRight, WithChain(GetParam()));
+  DecodeParams params = WithChain(GetParam());
+  params.draw_tracks = true;  // the skeleton image, checked at the frame's size
+  const DecodeResult r = Decode(frame.image, Side::kRight, params);
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(r.pitch, 61.0, 3.0);
   EXPECT_EQ(r.binning, GetParam() == DecodeChain::kTracks ? 4 : 3);
@@ -274,6 +276,7 @@ TEST(Decoder, ASmallPitchIsEnlargedAndDecodedAsWell) {
   const simulator::Frame frame = FaceOfSize(kSize, Side::kLeft);
   DecodeParams params;
   params.track_chain.min_scale = 0.5;
+  params.draw_tracks = true;  // the skeleton image, checked at the frame's size
   const DecodeResult r = Decode(frame.image, Side::kLeft, params);
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_NEAR(r.pitch, 15.3 * kScale, 1.0);

@@ -207,6 +207,7 @@ TEST(TrackChain, OutputsFollowTheContracts) {
   const simulator::Frame frame = RenderFrame(SurfaceKind::kPlane, Side::kRight, 7);
   DecodeParams params = TrackChain();
   params.q_offset = 4;
+  params.draw_tracks = true;
   const DecodeResult r = Decode(frame.image, Side::kRight, params);
   ASSERT_TRUE(r.ok) << r.error;
   EXPECT_TRUE(r.q_absolute);
