@@ -81,6 +81,7 @@ void PlaceMissingJunctions(const std::vector<DecodedLine>& lines, const pattern:
       }
     }
   }
+  if (added.empty()) return;
   // An unlabelled junction where one is placed is that junction, seen.
   std::erase_if(*unlabelled, [&](const UnlabelledJunction& u) {
     return std::any_of(added.begin(), added.end(), [&](const DecodedJunction& j) {
